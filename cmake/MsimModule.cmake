@@ -1,0 +1,18 @@
+# msim_module(NAME [DIR path] DEPS targets...): library msim_NAME from src/msim/<path>/*.cpp
+# (path defaults to NAME). Header-only modules become INTERFACE libraries.
+function(msim_module name)
+  cmake_parse_arguments(M "" "DIR" "DEPS" ${ARGN})
+  if(NOT M_DIR)
+    set(M_DIR ${name})
+  endif()
+  file(GLOB sources CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/src/msim/${M_DIR}/*.cpp)
+  if(sources)
+    add_library(msim_${name} STATIC ${sources})
+    target_include_directories(msim_${name} PUBLIC ${PROJECT_SOURCE_DIR}/src ${PROJECT_BINARY_DIR}/generated)
+    target_link_libraries(msim_${name} PUBLIC ${M_DEPS})
+  else()
+    add_library(msim_${name} INTERFACE)
+    target_include_directories(msim_${name} INTERFACE ${PROJECT_SOURCE_DIR}/src ${PROJECT_BINARY_DIR}/generated)
+    target_link_libraries(msim_${name} INTERFACE ${M_DEPS})
+  endif()
+endfunction()

@@ -1,0 +1,73 @@
+#pragma once
+// Parallel loops over grids and index ranges on oneTBB. Loops over a grid split the slowest axis
+// so each task walks contiguous memory. Reductions go through fixed-size blocks combined in a fixed
+// order, so a sum is the same whatever the thread count (deterministic reruns).
+#include <cstddef>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "msim/core/grid.hpp"
+
+namespace msim {
+
+// f(i) for i in [begin, end).
+template <typename F>
+void parallelFor(std::size_t begin, std::size_t end, F&& f, std::size_t grain = 1024) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, grain), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) f(i);
+  });
+}
+
+// f(coord, linear index) for every sample of an index box of the given size (x fastest).
+template <int D, typename F>
+void parallelForCells(const IVec<D>& size, F&& f) {
+  const int outer = size[D - 1];
+  tbb::parallel_for(tbb::blocked_range<int>(0, outer, 1), [&](const tbb::blocked_range<int>& r) {
+    IVec<D> c = IVec<D>::Zero();
+    for (int k = r.begin(); k != r.end(); ++k) {
+      c[D - 1] = k;
+      if constexpr (D == 2) {
+        std::size_t lin = static_cast<std::size_t>(k) * size[0];
+        for (int i = 0; i < size[0]; ++i, ++lin) {
+          c[0] = i;
+          f(c, lin);
+        }
+      } else {
+        for (int j = 0; j < size[1]; ++j) {
+          c[1] = j;
+          std::size_t lin = (static_cast<std::size_t>(k) * size[1] + j) * size[0];
+          for (int i = 0; i < size[0]; ++i, ++lin) {
+            c[0] = i;
+            f(c, lin);
+          }
+        }
+      }
+    }
+  });
+}
+
+template <typename T, int D, typename F>
+void parallelForCells(const Grid<T, D>& g, F&& f) {
+  parallelForCells<D>(g.size(), std::forward<F>(f));
+}
+
+// Deterministic parallel sum of f(i) over [0, n) in double precision.
+template <typename F>
+double parallelSum(std::size_t n, F&& f) {
+  constexpr std::size_t kBlock = 4096;
+  const std::size_t blocks = (n + kBlock - 1) / kBlock;
+  std::vector<double> partial(blocks, 0.0);
+  tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
+    double s = 0.0;
+    const std::size_t end = std::min(n, (b + 1) * kBlock);
+    for (std::size_t i = b * kBlock; i < end; ++i) s += f(i);
+    partial[b] = s;
+  });
+  double total = 0.0;
+  for (double p : partial) total += p;
+  return total;
+}
+
+}  // namespace msim
