@@ -1,8 +1,140 @@
+// msim: the command-line program. run / info / validate a scene.
+// Exit codes: 0 success, 2 bad input (scene, command line, files), 3 simulation failure,
+// 130 interrupted by the user (the last frame written is complete; --resume continues).
 #include <cstdio>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
 
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <tbb/global_control.h>
+#include <tbb/info.h>
+
+#include "msim/core/error.hpp"
+#include "msim/core/log.hpp"
+#include "msim/core/system_memory.hpp"
+#include "msim/scene/interrupt.hpp"
+#include "msim/scene/runner.hpp"
+#include "msim/scene/scene_file.hpp"
+#include "msim/scene/schema/describe.hpp"
 #include "msim/version.hpp"
 
-int main() {
-  std::printf("msim %s\n", msim::kVersion);
-  return 0;
+namespace {
+
+using namespace msim;
+
+std::string joinArgs(int argc, char** argv) {
+  std::string s;
+  for (int i = 0; i < argc; ++i) s += (i ? " " : "") + std::string(argv[i]);
+  return s;
+}
+
+void printInfo(const scene::Scene& s) {
+  std::printf("scene        %s\n", s.file.c_str());
+  std::printf("phenomenon   %s: %s\n", s.type->name.c_str(), s.type->description.c_str());
+  std::printf("grid         %dD, %d x %d%s cells (%zu), dx = %.4g m\n", s.dimensions, s.resolution.x(),
+              s.resolution.y(), s.dimensions == 3 ? fmt::format(" x {}", s.resolution.z()).c_str() : "", s.cellCount(),
+              s.dx);
+  std::printf("frames       %d at %.4g fps (%.4g s)\n", s.frameCount, s.fps, s.frameCount / s.fps);
+  std::printf("memory       about %s (available: %s)\n\n", formatBytes(s.memoryEstimate).c_str(),
+              formatBytes(static_cast<double>(availableMemoryBytes())).c_str());
+  const auto rows = scene::describe(scene::sceneSchema(*s.type), s.resolved);
+  std::printf("%s", scene::formatParamTable(rows).c_str());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"msim: multi-scale simulation of natural phenomena"};
+  app.set_version_flag("--version", std::string("msim ") + kVersion);
+  app.require_subcommand(1);
+  app.fallthrough();  // --threads and -q may follow the subcommand
+  int threads = 0;
+  bool quiet = false;
+  app.add_option("--threads", threads, "worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  app.add_flag("-q,--quiet", quiet, "only errors, no progress bar");
+
+  std::string scenePath;
+  std::vector<std::string> overrides;
+  scene::RunOptions runOptions;
+  int frames = -1;
+  auto* run = app.add_subcommand("run", "simulate a scene and write its frames");
+  run->add_option("scene", scenePath, "scene file (.json)")->required();
+  run->add_option("--out", runOptions.outDir, "output folder (default: out/<scene name>)");
+  run->add_option("--frames", frames, "stop after N frames")->check(CLI::PositiveNumber);
+  run->add_option("--set", overrides, "override a scene key: key.path=value (repeatable)");
+  run->add_flag("--resume", runOptions.resume, "continue after the last complete frame in --out");
+
+  auto* info = app.add_subcommand("info", "list every resolved parameter with default, unit and memory estimate");
+  info->add_option("scene", scenePath, "scene file (.json)")->required();
+  info->add_option("--set", overrides, "override a scene key: key.path=value (repeatable)");
+
+  auto* validate = app.add_subcommand("validate", "check a scene file without running it");
+  validate->add_option("scene", scenePath, "scene file (.json)")->required();
+  validate->add_option("--set", overrides, "override a scene key: key.path=value (repeatable)");
+
+  std::string phenomenonName;
+  auto* schema = app.add_subcommand("schema", "print the Markdown reference of every scene key of a phenomenon");
+  schema->add_option("phenomenon", phenomenonName, "phenomenon name, e.g. gas")->required();
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : kExitInputError;
+  }
+
+  initLogging(spdlog::level::info);
+  setQuiet(quiet);
+  std::optional<tbb::global_control> threadLimit;
+  if (threads > 0) threadLimit.emplace(tbb::global_control::max_allowed_parallelism, threads);
+
+  try {
+    if (*schema) {
+      const scene::PhenomenonType* type = scene::findPhenomenonType(phenomenonName);
+      if (!type) throw InputError(fmt::format("unknown phenomenon '{}'", phenomenonName));
+      std::printf("%s", scene::markdownReference(scene::sceneSchema(*type)).c_str());
+      return 0;
+    }
+    const scene::Scene s = scene::loadScene(scenePath, overrides);
+    if (*info) {
+      printInfo(s);
+      return 0;
+    }
+    if (*validate) {
+      // Building the phenomenon also loads meshes and places sources: everything but stepping.
+      StageTimers timers;
+      s.type->create(s, timers);
+      std::printf("%s: ok (%s, %zu cells, %d frames)\n", scenePath.c_str(), s.type->name.c_str(), s.cellCount(),
+                  s.frameCount);
+      return 0;
+    }
+    if (runOptions.outDir.empty()) runOptions.outDir = std::filesystem::path("out") / s.name();
+    runOptions.frameLimit = frames;
+    runOptions.showProgress = !quiet;
+    runOptions.commandLine = joinArgs(argc, argv);
+    scene::installInterruptHandler();
+    logger().info("{}: {} {}D, {} x {}{} cells, {} frames -> {}", scenePath, s.type->name, s.dimensions,
+                  s.resolution.x(), s.resolution.y(), s.dimensions == 3 ? fmt::format(" x {}", s.resolution.z()) : "",
+                  s.frameCount, runOptions.outDir.string());
+    const scene::RunStatus status = scene::runScene(s, runOptions);
+    if (status == scene::RunStatus::Interrupted) {
+      logger().warn("interrupted; the frames written are complete. Continue with: msim run {} --out {} --resume",
+                    scenePath, runOptions.outDir.string());
+      return kExitInterrupted;
+    }
+    logger().info("done: {}", runOptions.outDir.string());
+    return 0;
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "msim: error: %s\n", e.what());
+    return kExitInputError;
+  } catch (const SimulationError& e) {
+    std::fprintf(stderr, "msim: simulation failed: %s\n", e.what());
+    return kExitSimulationError;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "msim: error: %s\n", e.what());
+    return 1;
+  }
 }

@@ -80,38 +80,41 @@ void FluxTransport<D>::evaluateRate(const Grid<float, D>& phi, const MacGrid<D>&
                                     const TransportSettings& settings, Grid<float, D>& rate) {
   const float kappaOverDx = static_cast<float>(settings.diffusivity / spec_.dx);
   const float inflow = static_cast<float>(settings.inflowValue);
+  const float* p = phi.data().data();
+  const float* solid = solid_.data().data();
   for (int a = 0; a < D; ++a) {
     const auto& u = openVelocity_.component(a);
     auto& flux = flux_.component(a);
-    const IVec<D> e = unit<D>(a);
+    const std::ptrdiff_t s = phi.stride(a);  // cell index step along axis a
     const int n = spec_.res[a];
+    // Linear indices throughout: this loop is the solver's hot spot.
     parallelForCells<D>(flux.size(), [&](const IVec<D>& f, std::size_t lin) {
       const float uf = u[lin];
       const int i = f[a];
-      if (uf == 0.0f && (i == 0 || i == n)) {
-        flux[lin] = 0.0f;
-        return;
-      }
-      if (i == 0 || i == n) {  // open domain boundary (closed ones have uf == 0)
+      std::ptrdiff_t cell = 0;  // the cell above the face (index of f in the cell grid)
+      for (int b = 0; b < D; ++b) cell += f[b] * phi.stride(b);
+      if (i == 0 || i == n) {
+        // Domain boundary: closed sides and solid neighbours have uf == 0 and carry nothing;
+        // open sides let the upwind interior value out and the inflow value in, with no diffusion.
+        if (uf == 0.0f) {
+          flux[lin] = 0.0f;
+          return;
+        }
         const bool outflow = (i == 0) ? uf < 0.0f : uf > 0.0f;
-        const float interior = phi(i == 0 ? f : IVec<D>(f - e));
-        flux[lin] = uf * (outflow ? interior : inflow);
+        flux[lin] = uf * (outflow ? p[i == 0 ? cell : cell - s] : inflow);
         return;
       }
-      const IVec<D> left = f - e;
-      const float phiL = phi(left), phiR = phi(f);
-      float total = 0.0f;
-      if (settings.diffusivity > 0.0 && solid_(left) <= 0.5f && solid_(f) <= 0.5f)
-        total -= kappaOverDx * (phiR - phiL);
+      const std::ptrdiff_t left = cell - s;
+      const float phiL = p[left], phiR = p[cell];
+      const bool fluidPair = solid[left] <= 0.5f && solid[cell] <= 0.5f;
+      float total = fluidPair ? -kappaOverDx * (phiR - phiL) : 0.0f;
       if (uf > 0.0f) {
-        const IVec<D> farLeft = left - e;
-        const bool smooth = i >= 2 && solid_(farLeft) <= 0.5f;
-        const float slope = smooth ? mcSlope(phiL - phi(farLeft), phiR - phiL) : 0.0f;
+        const bool smooth = i >= 2 && solid[left - s] <= 0.5f;
+        const float slope = smooth ? mcSlope(phiL - p[left - s], phiR - phiL) : 0.0f;
         total += uf * (phiL + 0.5f * slope);
       } else if (uf < 0.0f) {
-        const IVec<D> farRight = f + e;
-        const bool smooth = i + 1 < n && solid_(farRight) <= 0.5f;
-        const float slope = smooth ? mcSlope(phiR - phiL, phi(farRight) - phiR) : 0.0f;
+        const bool smooth = i + 1 < n && solid[cell + s] <= 0.5f;
+        const float slope = smooth ? mcSlope(phiR - phiL, p[cell + s] - phiR) : 0.0f;
         total += uf * (phiR - 0.5f * slope);
       }
       flux[lin] = total;

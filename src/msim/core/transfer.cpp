@@ -1,0 +1,284 @@
+#include "msim/core/transfer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include <tbb/parallel_for.h>
+
+#include "msim/core/parallel.hpp"
+
+namespace msim {
+
+namespace {
+
+// Each kernel fills the weights of its taps first, first+1, ... along one axis (sample space)
+// and returns `first`.
+struct LinearKernel {
+  static constexpr int kSupport = 2;
+  static int taps(double s, double* w) {
+    const double first = std::floor(s);
+    const double t = s - first;
+    w[0] = 1.0 - t;
+    w[1] = t;
+    return static_cast<int>(first);
+  }
+};
+
+struct QuadraticBSplineKernel {
+  static constexpr int kSupport = 3;
+  static int taps(double s, double* w) {
+    const double first = std::floor(s + 0.5) - 1.0;
+    const double x = s - first;  // in [0.5, 1.5): distance from the first tap
+    w[0] = 0.5 * (1.5 - x) * (1.5 - x);
+    w[1] = 0.75 - (x - 1.0) * (x - 1.0);
+    w[2] = 0.5 * (x - 0.5) * (x - 0.5);
+    return static_cast<int>(first);
+  }
+};
+
+// Far outside the grid every tap folds onto the border sample anyway; clamping the coordinate to
+// a band just beyond the grid keeps std::floor's result in int range (and maps NaN to the band's
+// lower end) without changing any folded weight.
+double clampToTapBand(double s, int n) {
+  const double lo = -2.0, hi = static_cast<double>(n) + 1.0;
+  return s > lo ? (s < hi ? s : hi) : lo;
+}
+
+// The folded taps of one particle: memory offsets and weights per axis.
+template <typename Kernel, int D>
+struct Stencil {
+  static constexpr int K = Kernel::kSupport;
+  std::ptrdiff_t offset[D][K];
+  double weight[D][K];
+
+  Stencil(const Grid<float, D>& grid, const Vecf<D>& position) {
+    const Vec<D> s = grid.toSampleSpace(position.template cast<double>());
+    for (int a = 0; a < D; ++a) {
+      const int n = grid.size()[a];
+      const int first = Kernel::taps(clampToTapBand(s[a], n), weight[a]);
+      for (int k = 0; k < K; ++k) offset[a][k] = std::clamp(first + k, 0, n - 1) * grid.stride(a);
+    }
+  }
+
+  // f(memory offset, weight) for every one of the K^D taps.
+  template <int Axis = D - 1, typename F>
+  void forEachTap(F&& f, std::ptrdiff_t base = 0, double w = 1.0) const {
+    for (int k = 0; k < K; ++k) {
+      if constexpr (Axis == 0)
+        f(base + offset[0][k], w * weight[0][k]);
+      else
+        forEachTap<Axis - 1>(f, base + offset[Axis][k], w * weight[Axis][k]);
+    }
+  }
+};
+
+// The clamped first tap along the slowest axis decides which slab a particle belongs to.
+template <typename Kernel, int D>
+std::uint32_t slabOf(const Grid<float, D>& grid, const Vecf<D>& position, int slabWidth) {
+  constexpr int A = D - 1;
+  const int n = grid.size()[A];
+  const double s = (static_cast<double>(position[A]) - grid.spec().origin[A]) / grid.spec().dx - grid.offset()[A];
+  double w[Kernel::kSupport];
+  const int first = std::clamp(Kernel::taps(clampToTapBand(s, n), w), 0, n - 1);
+  return static_cast<std::uint32_t>(first / slabWidth);
+}
+
+template <typename F>
+decltype(auto) withKernel(TransferKernel kernel, F&& f) {
+  if (kernel == TransferKernel::Linear) return f(LinearKernel{});
+  return f(QuadraticBSplineKernel{});
+}
+
+constexpr std::size_t kBucketBlock = 1 << 16;
+
+}  // namespace
+
+template <int D>
+template <typename Kernel>
+void Splatter<D>::bucketBySlab(std::span<const Vecf<D>> positions, const Grid<float, D>& target) {
+  const std::size_t n = positions.size();
+  if (n > std::numeric_limits<std::uint32_t>::max())
+    throw std::length_error("Splatter: more than 2^32 particles in one splat (" + std::to_string(n) + ")");
+  const std::size_t slabs = (target.size()[D - 1] + kSlabWidth - 1) / kSlabWidth;
+  const std::size_t blocks = (n + kBucketBlock - 1) / kBucketBlock;
+
+  slabOf_.resize(n);
+  order_.resize(n);
+  blockSlabCursor_.assign(blocks * slabs, 0);
+  slabBegin_.assign(slabs + 1, 0);
+
+  // Per-block histograms, so the counting sort is parallel yet independent of the thread count.
+  tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
+    std::size_t* count = &blockSlabCursor_[b * slabs];
+    const std::size_t end = std::min(n, (b + 1) * kBucketBlock);
+    for (std::size_t i = b * kBucketBlock; i < end; ++i) {
+      slabOf_[i] = slabOf<Kernel>(target, positions[i], kSlabWidth);
+      ++count[slabOf_[i]];
+    }
+  });
+  // Exclusive prefix in (slab, block) order turns the counts into each block's write cursor.
+  std::size_t running = 0;
+  for (std::size_t s = 0; s < slabs; ++s) {
+    slabBegin_[s] = running;
+    for (std::size_t b = 0; b < blocks; ++b) {
+      const std::size_t count = blockSlabCursor_[b * slabs + s];
+      blockSlabCursor_[b * slabs + s] = running;
+      running += count;
+    }
+  }
+  slabBegin_[slabs] = running;
+  tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
+    std::size_t* cursor = &blockSlabCursor_[b * slabs];
+    const std::size_t end = std::min(n, (b + 1) * kBucketBlock);
+    for (std::size_t i = b * kBucketBlock; i < end; ++i) order_[cursor[slabOf_[i]]++] = static_cast<std::uint32_t>(i);
+  });
+}
+
+template <int D>
+template <typename Kernel, typename ValueOf>
+void Splatter<D>::splatWith(std::span<const Vecf<D>> positions, const ValueOf& valueOf, Grid<float, D>& target,
+                            SplatMode mode, float emptyValue) {
+  static_assert(Kernel::kSupport - 1 <= kSlabWidth, "slabs of one colour must not share samples");
+  const bool normalized = mode == SplatMode::Normalized;
+  const std::size_t samples = target.count();
+  weightedSum_.resize(samples);
+  weightSum_.resize(normalized ? samples : 0);
+  parallelFor(0, samples, [&](std::size_t i) {
+    weightedSum_[i] = 0.0;
+    if (normalized) weightSum_[i] = 0.0;
+  }, 1 << 14);
+
+  bucketBySlab<Kernel>(positions, target);
+
+  const std::size_t slabs = slabBegin_.size() - 1;
+  double* sum = weightedSum_.data();
+  double* weight = weightSum_.data();
+  for (std::size_t colour = 0; colour < 2; ++colour) {
+    const std::size_t slabsOfColour = (slabs + 1 - colour) / 2;
+    tbb::parallel_for(std::size_t(0), slabsOfColour, [&](std::size_t j) {
+      const std::size_t slab = 2 * j + colour;
+      for (std::size_t k = slabBegin_[slab]; k < slabBegin_[slab + 1]; ++k) {
+        const std::uint32_t p = order_[k];
+        const double v = valueOf(p);
+        const Stencil<Kernel, D> stencil(target, positions[p]);
+        if (normalized)
+          stencil.forEachTap([&](std::ptrdiff_t at, double w) {
+            sum[at] += w * v;
+            weight[at] += w;
+          });
+        else
+          stencil.forEachTap([&](std::ptrdiff_t at, double w) { sum[at] += w * v; });
+      }
+    });
+  }
+
+  float* out = target.data().data();
+  if (normalized)
+    parallelFor(0, samples, [&](std::size_t i) {
+      out[i] = weight[i] > 0.0 ? static_cast<float>(sum[i] / weight[i]) : emptyValue;
+    }, 1 << 14);
+  else
+    parallelFor(0, samples, [&](std::size_t i) { out[i] = static_cast<float>(out[i] + sum[i]); }, 1 << 14);
+}
+
+template <int D>
+void Splatter<D>::splat(std::span<const Vecf<D>> positions, std::span<const float> values, Grid<float, D>& target,
+                        TransferKernel kernel, SplatMode mode, float emptyValue) {
+  if (values.size() != positions.size())
+    throw std::invalid_argument("splat: " + std::to_string(values.size()) + " values for " +
+                                std::to_string(positions.size()) + " positions");
+  withKernel(kernel, [&](auto k) {
+    splatWith<decltype(k)>(positions, [&](std::size_t p) { return values[p]; }, target, mode, emptyValue);
+  });
+}
+
+template <int D>
+void Splatter<D>::splat(std::span<const Vecf<D>> positions, std::span<const Vecf<D>> values, MacGrid<D>& target,
+                        TransferKernel kernel, SplatMode mode, float emptyValue) {
+  if (values.size() != positions.size())
+    throw std::invalid_argument("splat: " + std::to_string(values.size()) + " values for " +
+                                std::to_string(positions.size()) + " positions");
+  withKernel(kernel, [&](auto k) {
+    for (int a = 0; a < D; ++a)
+      splatWith<decltype(k)>(positions, [&](std::size_t p) { return values[p][a]; }, target.component(a), mode,
+                             emptyValue);
+  });
+}
+
+template <int D>
+void splat(std::type_identity_t<std::span<const Vecf<D>>> positions, std::span<const float> values,
+           Grid<float, D>& target, TransferKernel kernel, SplatMode mode, float emptyValue) {
+  Splatter<D>().splat(positions, values, target, kernel, mode, emptyValue);
+}
+
+template <int D>
+void splat(std::type_identity_t<std::span<const Vecf<D>>> positions,
+           std::type_identity_t<std::span<const Vecf<D>>> values, MacGrid<D>& target, TransferKernel kernel,
+           SplatMode mode, float emptyValue) {
+  Splatter<D>().splat(positions, values, target, kernel, mode, emptyValue);
+}
+
+template <int D>
+void gather(const Grid<float, D>& grid, std::type_identity_t<std::span<const Vecf<D>>> positions,
+            TransferKernel kernel, std::span<float> out) {
+  if (out.size() != positions.size())
+    throw std::invalid_argument("gather: output holds " + std::to_string(out.size()) + " values for " +
+                                std::to_string(positions.size()) + " positions");
+  const float* data = grid.data().data();
+  withKernel(kernel, [&](auto k) {
+    parallelFor(0, positions.size(), [&](std::size_t p) {
+      double value = 0.0;
+      Stencil<decltype(k), D>(grid, positions[p]).forEachTap([&](std::ptrdiff_t at, double w) {
+        value += w * data[at];
+      });
+      out[p] = static_cast<float>(value);
+    });
+  });
+}
+
+template <int D>
+std::vector<float> gather(const Grid<float, D>& grid, std::type_identity_t<std::span<const Vecf<D>>> positions,
+                          TransferKernel kernel) {
+  std::vector<float> out(positions.size());
+  gather<D>(grid, positions, kernel, out);
+  return out;
+}
+
+template <int D>
+void gather(const MacGrid<D>& grid, std::type_identity_t<std::span<const Vecf<D>>> positions, TransferKernel kernel,
+            std::type_identity_t<std::span<Vecf<D>>> out) {
+  if (out.size() != positions.size())
+    throw std::invalid_argument("gather: output holds " + std::to_string(out.size()) + " values for " +
+                                std::to_string(positions.size()) + " positions");
+  withKernel(kernel, [&](auto k) {
+    for (int a = 0; a < D; ++a) {
+      const float* data = grid.component(a).data().data();
+      parallelFor(0, positions.size(), [&](std::size_t p) {
+        double value = 0.0;
+        Stencil<decltype(k), D>(grid.component(a), positions[p]).forEachTap([&](std::ptrdiff_t at, double w) {
+          value += w * data[at];
+        });
+        out[p][a] = static_cast<float>(value);
+      });
+    }
+  });
+}
+
+#define MSIM_INSTANTIATE_TRANSFER(D)                                                                                \
+  template class Splatter<D>;                                                                                       \
+  template void splat<D>(std::span<const Vecf<D>>, std::span<const float>, Grid<float, D>&, TransferKernel,        \
+                         SplatMode, float);                                                                         \
+  template void splat<D>(std::span<const Vecf<D>>, std::span<const Vecf<D>>, MacGrid<D>&, TransferKernel,          \
+                         SplatMode, float);                                                                         \
+  template void gather<D>(const Grid<float, D>&, std::span<const Vecf<D>>, TransferKernel, std::span<float>);      \
+  template std::vector<float> gather<D>(const Grid<float, D>&, std::span<const Vecf<D>>, TransferKernel);          \
+  template void gather<D>(const MacGrid<D>&, std::span<const Vecf<D>>, TransferKernel, std::span<Vecf<D>>);
+
+MSIM_INSTANTIATE_TRANSFER(2)
+MSIM_INSTANTIATE_TRANSFER(3)
+#undef MSIM_INSTANTIATE_TRANSFER
+
+}  // namespace msim

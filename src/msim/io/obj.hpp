@@ -1,0 +1,15 @@
+#pragma once
+// Wavefront OBJ geometry import: vertex positions (`v`) and faces (`f`) into a TriangleMesh.
+// Texture coordinates, normals, groups and materials do not affect the geometry and are ignored.
+#include <filesystem>
+
+#include "msim/geometry/triangle_mesh.hpp"
+
+namespace msim::io {
+
+// Face corners may be written v, v/vt, v//vn or v/vt/vn; negative indices count back from the
+// last vertex defined so far. Polygons are fan-triangulated. InputError naming file:line for a
+// missing file, a malformed number, an out-of-range index or a face with fewer than 3 corners.
+geometry::TriangleMesh readObj(const std::filesystem::path& path);
+
+}  // namespace msim::io

@@ -1,0 +1,438 @@
+#include "msim/io/vdb.hpp"
+
+#include <openvdb/openvdb.h>
+#include <openvdb/points/PointAttribute.h>
+#include <openvdb/points/PointConversion.h>
+#include <openvdb/points/PointCount.h>
+#include <openvdb/points/PointDataGrid.h>
+#include <openvdb/tools/PointIndexGrid.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <mutex>
+#include <numeric>
+#include <set>
+#include <stdexcept>
+
+#include "msim/core/error.hpp"
+#include "msim/io/atomic_file.hpp"
+
+namespace msim::io {
+
+namespace {
+
+constexpr const char* kMetaOrigin = "msim_origin";
+constexpr const char* kMetaDx = "msim_dx";
+constexpr const char* kMetaRes = "msim_res";
+// Points are stored bucketed by voxel; this attribute remembers each point's original position
+// in the cloud so reading restores the caller's order.
+constexpr const char* kPointIndexAttribute = "msim_index";
+
+void initializeOpenVdb() {
+  static std::once_flag once;
+  std::call_once(once, [] { openvdb::initialize(); });
+}
+
+openvdb::math::Transform::Ptr cellCentredTransform(const GridSpec<3>& spec) {
+  auto xform = openvdb::math::Transform::createLinearTransform(spec.dx);
+  const Vec3 firstCentre = spec.cellCenter(IVec3::Zero());
+  xform->postTranslate(openvdb::Vec3d(firstCentre.x(), firstCentre.y(), firstCentre.z()));
+  return xform;
+}
+
+void storeSpec(openvdb::GridBase& grid, const GridSpec<3>& spec) {
+  grid.insertMeta(kMetaOrigin, openvdb::Vec3DMetadata(openvdb::Vec3d(spec.origin.x(), spec.origin.y(), spec.origin.z())));
+  grid.insertMeta(kMetaDx, openvdb::DoubleMetadata(spec.dx));
+  grid.insertMeta(kMetaRes, openvdb::Vec3IMetadata(openvdb::Vec3i(spec.res.x(), spec.res.y(), spec.res.z())));
+}
+
+GridSpec<3> toSpec3(const GridSpec<2>& s) {
+  return GridSpec<3>(Vec3(s.origin.x(), s.origin.y(), 0.0), s.dx, IVec3(s.res.x(), s.res.y(), 1));
+}
+
+bool isPositiveZero(float v) { return std::bit_cast<std::uint32_t>(v) == 0u; }
+
+bool keepScalar(float v, float tolerance) { return tolerance > 0.0f ? !(std::abs(v) <= tolerance) : !isPositiveZero(v); }
+
+bool keepVector(const openvdb::Vec3f& v, float tolerance) {
+  if (tolerance > 0.0f) return !(v.length() <= tolerance);
+  return !(isPositiveZero(v[0]) && isPositiveZero(v[1]) && isPositiveZero(v[2]));
+}
+
+// Builds a sparse grid from a dense x-fastest array of res cells, one leaf-sized block per task.
+// Values for which keep() is false stay background (0) and inactive.
+template <typename GridT, typename ValueAt, typename Keep>
+typename GridT::Ptr buildSparse(const IVec3& res, ValueAt valueAt, Keep keep) {
+  using TreeT = typename GridT::TreeType;
+  using LeafT = typename TreeT::LeafNodeType;
+  using ValueT = typename GridT::ValueType;
+  constexpr int kDim = static_cast<int>(LeafT::DIM);
+  const IVec3 blocks = (res.array() + kDim - 1) / kDim;
+  const std::size_t blockCount = static_cast<std::size_t>(blocks.x()) * blocks.y() * blocks.z();
+  const ValueT background = openvdb::zeroVal<ValueT>();
+  std::vector<std::unique_ptr<LeafT>> leaves(blockCount);
+  tbb::parallel_for(std::size_t(0), blockCount, [&](std::size_t b) {
+    const int bx = static_cast<int>(b % blocks.x());
+    const int by = static_cast<int>((b / blocks.x()) % blocks.y());
+    const int bz = static_cast<int>(b / (static_cast<std::size_t>(blocks.x()) * blocks.y()));
+    const openvdb::Coord lower(bx * kDim, by * kDim, bz * kDim);
+    std::unique_ptr<LeafT> leaf;
+    for (int z = lower.z(); z < std::min(lower.z() + kDim, res.z()); ++z)
+      for (int y = lower.y(); y < std::min(lower.y() + kDim, res.y()); ++y)
+        for (int x = lower.x(); x < std::min(lower.x() + kDim, res.x()); ++x) {
+          const IVec3 c(x, y, z);
+          const std::size_t linear = (static_cast<std::size_t>(z) * res.y() + y) * res.x() + x;
+          const ValueT v = valueAt(c, linear);
+          if (!keep(v)) continue;
+          if (!leaf) leaf = std::make_unique<LeafT>(lower, background, false);
+          leaf->setValueOn(openvdb::Coord(x, y, z), v);
+        }
+    leaves[b] = std::move(leaf);
+  });
+  auto tree = std::make_shared<TreeT>(background);
+  for (auto& leaf : leaves)
+    if (leaf) tree->addLeaf(leaf.release());
+  return GridT::create(tree);
+}
+
+openvdb::Vec3f toVdb(const Vecf<3>& v) { return {v.x(), v.y(), v.z()}; }
+
+// ---- reading ----
+
+[[noreturn]] void failRead(const std::filesystem::path& path, const std::string& what) {
+  throw InputError(path.string() + ": " + what);
+}
+
+openvdb::GridBase::Ptr readGridNamed(const std::filesystem::path& path, const std::string& name) {
+  initializeOpenVdb();
+  try {
+    openvdb::io::File file(path.string());
+    // Load everything now: delayed loading would keep the file mapped behind our back.
+    file.open(/*delayLoad=*/false);
+    if (!file.hasGrid(name)) {
+      std::string names;
+      for (auto it = file.beginName(); it != file.endName(); ++it) names += (names.empty() ? "" : ", ") + *it;
+      failRead(path, "no grid named '" + name + "' (the file has: " + (names.empty() ? "none" : names) + ")");
+    }
+    auto grid = file.readGrid(name);
+    file.close();
+    return grid;
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {  // openvdb::Exception, or a stream error on a corrupt file
+    failRead(path, std::string("cannot read VDB file (") + e.what() + ")");
+  }
+}
+
+template <typename GridT>
+typename GridT::Ptr readGridOfType(const std::filesystem::path& path, const std::string& name) {
+  auto base = readGridNamed(path, name);
+  auto grid = openvdb::gridPtrCast<GridT>(base);
+  if (!grid)
+    failRead(path, "grid '" + name + "' has type " + base->valueType() + ", expected " +
+                       openvdb::typeNameAsString<typename GridT::ValueType>());
+  return grid;
+}
+
+// Where the grid's voxels go in the returned msim grid: msim cell = voxel - shift.
+struct Placement {
+  GridSpec<3> spec;
+  openvdb::Coord shift;
+};
+
+Placement placementOf(const openvdb::GridBase& grid, const std::filesystem::path& path) {
+  const auto origin = grid.getMetadata<openvdb::Vec3DMetadata>(kMetaOrigin);
+  const auto dx = grid.getMetadata<openvdb::DoubleMetadata>(kMetaDx);
+  const auto res = grid.getMetadata<openvdb::Vec3IMetadata>(kMetaRes);
+  constexpr double kMaxCells = 1ull << 34;  // rejects corrupt metadata before a huge allocation
+  if (origin && dx && res) {
+    const openvdb::Vec3i r = res->value();
+    if (r.x() <= 0 || r.y() <= 0 || r.z() <= 0 || double(r.x()) * r.y() * r.z() > kMaxCells || !(dx->value() > 0))
+      failRead(path, "grid '" + grid.getName() + "' has invalid msim_res/msim_dx metadata");
+    const openvdb::Vec3d o = origin->value();
+    return {GridSpec<3>(Vec3(o.x(), o.y(), o.z()), dx->value(), IVec3(r.x(), r.y(), r.z())), openvdb::Coord(0)};
+  }
+  // A grid from another tool: cover its active voxels; this needs an axis-aligned uniform grid.
+  const openvdb::math::Transform& xform = grid.transform();
+  const double voxel = xform.voxelSize()[0];
+  const openvdb::Vec3d zero = xform.indexToWorld(openvdb::Vec3d(0.0));
+  for (int a = 0; a < 3; ++a) {
+    openvdb::Vec3d unit(0.0);
+    unit[a] = 1.0;
+    const openvdb::Vec3d step = xform.indexToWorld(unit) - zero;
+    for (int b = 0; b < 3; ++b)
+      if (!xform.isLinear() || std::abs(step[b] - (a == b ? voxel : 0.0)) > 1e-9 * voxel)
+        failRead(path, "grid '" + grid.getName() + "' has a transform that is not a uniform axis-aligned scale");
+  }
+  openvdb::CoordBBox box = grid.evalActiveVoxelBoundingBox();
+  if (box.empty()) box = openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(0));
+  const openvdb::Coord dim = box.dim();
+  if (double(dim.x()) * dim.y() * dim.z() > kMaxCells)
+    failRead(path, "grid '" + grid.getName() + "' is too large to read densely");
+  const openvdb::Vec3d corner = xform.indexToWorld(box.min().asVec3d() - openvdb::Vec3d(0.5));
+  return {GridSpec<3>(Vec3(corner.x(), corner.y(), corner.z()), voxel, IVec3(dim.x(), dim.y(), dim.z())), box.min()};
+}
+
+// Copies the active values (leaf voxels and tiles) of tree into a dense grid of placement's
+// layout via store(linear, value). Active values outside the layout are dropped.
+template <typename TreeT, typename Store>
+void copyActiveValues(const TreeT& tree, const Placement& placement, Store store) {
+  const IVec3& res = placement.spec.res;
+  const auto linearOf = [&](const openvdb::Coord& voxel, std::size_t& linear) {
+    const openvdb::Coord c = voxel - placement.shift;
+    if (c.x() < 0 || c.y() < 0 || c.z() < 0 || c.x() >= res.x() || c.y() >= res.y() || c.z() >= res.z()) return false;
+    linear = (static_cast<std::size_t>(c.z()) * res.y() + c.y()) * res.x() + c.x();
+    return true;
+  };
+  std::vector<const typename TreeT::LeafNodeType*> leaves;
+  tree.getNodes(leaves);
+  tbb::parallel_for(std::size_t(0), leaves.size(), [&](std::size_t l) {
+    for (auto it = leaves[l]->cbeginValueOn(); it; ++it) {
+      std::size_t linear = 0;
+      if (linearOf(it.getCoord(), linear)) store(linear, *it);
+    }
+  });
+  typename TreeT::ValueOnCIter tiles = tree.cbeginValueOn();
+  tiles.setMaxDepth(TreeT::ValueOnCIter::LEAF_DEPTH - 1);
+  for (; tiles; ++tiles) {
+    const openvdb::CoordBBox box = tiles.getBoundingBox();
+    for (auto ijk = box.begin(); ijk; ++ijk) {
+      std::size_t linear = 0;
+      if (linearOf(*ijk, linear)) store(linear, *tiles);
+    }
+  }
+}
+
+template <typename VdbGridT>
+Grid<Vecf<3>, 3> readVectorGridAs(const VdbGridT& grid, const std::filesystem::path& path) {
+  const Placement placement = placementOf(grid, path);
+  Grid<Vecf<3>, 3> out(placement.spec, Vecf<3>::Zero());
+  copyActiveValues(grid.tree(), placement, [&](std::size_t linear, const typename VdbGridT::ValueType& v) {
+    out[linear] = Vecf<3>(static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2]));
+  });
+  return out;
+}
+
+}  // namespace
+
+struct VdbWriter::Impl {
+  openvdb::GridPtrVec grids;
+  std::set<std::string> names;
+
+  void add(const std::string& name, openvdb::GridBase::Ptr grid) {
+    if (name.empty()) throw std::invalid_argument("VdbWriter: empty grid name");
+    if (!names.insert(name).second) throw std::invalid_argument("VdbWriter: duplicate grid name '" + name + "'");
+    grid->setName(name);
+    grids.push_back(std::move(grid));
+  }
+};
+
+VdbWriter::VdbWriter() : impl_(std::make_unique<Impl>()) { initializeOpenVdb(); }
+VdbWriter::~VdbWriter() = default;
+
+void VdbWriter::addFloatGrid(const std::string& name, const Grid<float, 3>& grid, float tolerance) {
+  auto vdb = buildSparse<openvdb::FloatGrid>(
+      grid.size(), [&](const IVec3&, std::size_t linear) { return grid[linear]; },
+      [&](float v) { return keepScalar(v, tolerance); });
+  vdb->setTransform(cellCentredTransform(grid.spec()));
+  storeSpec(*vdb, grid.spec());
+  impl_->add(name, vdb);
+}
+
+void VdbWriter::addFloatGrid(const std::string& name, const Grid<float, 2>& grid, float tolerance) {
+  const GridSpec<3> spec = toSpec3(grid.spec());
+  auto vdb = buildSparse<openvdb::FloatGrid>(
+      spec.res, [&](const IVec3&, std::size_t linear) { return grid[linear]; },
+      [&](float v) { return keepScalar(v, tolerance); });
+  vdb->setTransform(cellCentredTransform(spec));
+  storeSpec(*vdb, spec);
+  impl_->add(name, vdb);
+}
+
+void VdbWriter::addVectorGrid(const std::string& name, const Grid<Vecf<3>, 3>& grid, float tolerance) {
+  auto vdb = buildSparse<openvdb::Vec3SGrid>(
+      grid.size(), [&](const IVec3&, std::size_t linear) { return toVdb(grid[linear]); },
+      [&](const openvdb::Vec3f& v) { return keepVector(v, tolerance); });
+  vdb->setTransform(cellCentredTransform(grid.spec()));
+  storeSpec(*vdb, grid.spec());
+  impl_->add(name, vdb);
+}
+
+void VdbWriter::addVectorGrid(const std::string& name, const Grid<Vec3, 3>& grid, float tolerance) {
+  auto vdb = buildSparse<openvdb::Vec3SGrid>(
+      grid.size(), [&](const IVec3&, std::size_t linear) { return toVdb(grid[linear].cast<float>()); },
+      [&](const openvdb::Vec3f& v) { return keepVector(v, tolerance); });
+  vdb->setTransform(cellCentredTransform(grid.spec()));
+  storeSpec(*vdb, grid.spec());
+  impl_->add(name, vdb);
+}
+
+void VdbWriter::addVectorGrid(const std::string& name, const MacGrid<3>& velocity, float tolerance) {
+  const auto centre = [&](const IVec3& c, std::size_t) {
+    openvdb::Vec3f v;
+    for (int a = 0; a < 3; ++a) {
+      IVec3 upper = c;
+      upper[a] += 1;
+      v[a] = 0.5f * (velocity.component(a)(c) + velocity.component(a)(upper));
+    }
+    return v;
+  };
+  auto vdb = buildSparse<openvdb::Vec3SGrid>(velocity.spec().res, centre,
+                                             [&](const openvdb::Vec3f& v) { return keepVector(v, tolerance); });
+  vdb->setTransform(cellCentredTransform(velocity.spec()));
+  storeSpec(*vdb, velocity.spec());
+  impl_->add(name, vdb);
+}
+
+void VdbWriter::addPoints(const std::string& name, const PointCloud& points, double voxelSize) {
+  const std::size_t n = points.positions.size();
+  if (!(voxelSize > 0) || !std::isfinite(voxelSize))
+    throw std::invalid_argument("VdbWriter: points '" + name + "' need a positive voxel size");
+  std::set<std::string> attributeNames{"P", kPointIndexAttribute};
+  for (const auto& a : points.attributes) {
+    if (a.values.size() != n)
+      throw std::invalid_argument("VdbWriter: attribute '" + a.name + "' of points '" + name + "' has " +
+                                  std::to_string(a.values.size()) + " values for " + std::to_string(n) + " points");
+    if (a.name.empty() || !attributeNames.insert(a.name).second)
+      throw std::invalid_argument("VdbWriter: attribute name '" + a.name + "' of points '" + name +
+                                  "' is empty, reserved or repeated");
+  }
+  std::vector<openvdb::Vec3f> positions(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!points.positions[i].allFinite())
+      throw std::invalid_argument("VdbWriter: point " + std::to_string(i) + " of '" + name + "' is not finite");
+    positions[i] = toVdb(points.positions[i]);
+  }
+  const double powerOfTwoVoxel = std::exp2(std::round(std::log2(voxelSize)));
+  const auto xform = openvdb::math::Transform::createLinearTransform(powerOfTwoVoxel);
+  const openvdb::points::PointAttributeVector<openvdb::Vec3f> positionWrapper(positions);
+  const auto indexGrid = openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(positionWrapper, *xform);
+  // NullCodec stores the voxel-local offsets as plain floats (no quantisation).
+  auto grid = openvdb::points::createPointDataGrid<openvdb::points::NullCodec, openvdb::points::PointDataGrid>(
+      *indexGrid, positionWrapper, *xform);
+  auto& tree = grid->tree();
+
+  std::vector<std::int64_t> order(n);
+  std::iota(order.begin(), order.end(), std::int64_t{0});
+  openvdb::points::appendAttribute<std::int64_t>(tree, kPointIndexAttribute);
+  openvdb::points::populateAttribute(tree, indexGrid->tree(), kPointIndexAttribute,
+                                     openvdb::points::PointAttributeVector<std::int64_t>(order));
+  for (const auto& a : points.attributes) {
+    openvdb::points::appendAttribute<float>(tree, a.name);
+    openvdb::points::populateAttribute(tree, indexGrid->tree(), a.name,
+                                       openvdb::points::PointAttributeVector<float>(a.values));
+  }
+  impl_->add(name, grid);
+}
+
+void VdbWriter::write(const std::filesystem::path& path) const {
+  writeFileAtomically(path, [&](const std::filesystem::path& tmp) {
+    try {
+      openvdb::io::File file(tmp.string());
+      file.write(impl_->grids);
+      file.close();
+    } catch (const openvdb::Exception& e) {
+      throw std::runtime_error("cannot write " + path.string() + ": " + e.what());
+    }
+  });
+}
+
+std::vector<std::string> listVdbGrids(const std::filesystem::path& path) {
+  initializeOpenVdb();
+  try {
+    openvdb::io::File file(path.string());
+    file.open(/*delayLoad=*/false);
+    std::vector<std::string> names;
+    for (auto it = file.beginName(); it != file.endName(); ++it) names.push_back(*it);
+    file.close();
+    return names;
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {  // openvdb::Exception, or a stream error on a corrupt file
+    failRead(path, std::string("cannot read VDB file (") + e.what() + ")");
+  }
+}
+
+Grid<float, 3> readFloatGrid(const std::filesystem::path& path, const std::string& name) {
+  const auto grid = readGridOfType<openvdb::FloatGrid>(path, name);
+  const Placement placement = placementOf(*grid, path);
+  Grid<float, 3> out(placement.spec, 0.0f);
+  copyActiveValues(grid->tree(), placement, [&](std::size_t linear, float v) { out[linear] = v; });
+  return out;
+}
+
+Grid<Vecf<3>, 3> readVectorGrid(const std::filesystem::path& path, const std::string& name) {
+  const auto base = readGridNamed(path, name);
+  if (const auto vs = openvdb::gridPtrCast<openvdb::Vec3SGrid>(base)) return readVectorGridAs(*vs, path);
+  if (const auto vd = openvdb::gridPtrCast<openvdb::Vec3DGrid>(base)) return readVectorGridAs(*vd, path);
+  failRead(path, "grid '" + name + "' has type " + base->valueType() + ", expected vec3s or vec3d");
+}
+
+PointCloud readPoints(const std::filesystem::path& path, const std::string& name) {
+  using openvdb::points::PointDataGrid;
+  const auto grid = readGridOfType<PointDataGrid>(path, name);
+  const auto& tree = grid->tree();
+  PointCloud cloud;
+  const auto firstLeaf = tree.cbeginLeaf();
+  if (!firstLeaf) return cloud;
+
+  const auto& descriptor = firstLeaf->attributeSet().descriptor();
+  const std::size_t positionIndex = descriptor.find("P");
+  if (positionIndex == openvdb::points::AttributeSet::INVALID_POS)
+    failRead(path, "points '" + name + "' have no position attribute P");
+  const std::size_t orderIndex = descriptor.find(kPointIndexAttribute);
+  const bool hasOrder = orderIndex != openvdb::points::AttributeSet::INVALID_POS &&
+                        descriptor.valueType(orderIndex) == openvdb::typeNameAsString<std::int64_t>();
+  // Only float attributes map onto PointAttribute; others (groups, ints, strings) are skipped.
+  std::vector<std::pair<std::string, std::size_t>> floatAttributes;
+  for (const auto& [attributeName, index] : descriptor.map())
+    if (index != positionIndex && descriptor.valueType(index) == openvdb::typeNameAsString<float>())
+      floatAttributes.emplace_back(attributeName, index);
+  std::sort(floatAttributes.begin(), floatAttributes.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
+
+  std::vector<const PointDataGrid::TreeType::LeafNodeType*> leaves;
+  tree.getNodes(leaves);
+  std::vector<std::size_t> firstPoint(leaves.size() + 1, 0);
+  for (std::size_t l = 0; l < leaves.size(); ++l) firstPoint[l + 1] = firstPoint[l] + leaves[l]->pointCount();
+  const std::size_t n = firstPoint.back();
+  cloud.positions.resize(n);
+  for (const auto& [attributeName, index] : floatAttributes) cloud.attributes.push_back({attributeName, std::vector<float>(n)});
+
+  const openvdb::math::Transform& xform = grid->transform();
+  tbb::parallel_for(std::size_t(0), leaves.size(), [&](std::size_t l) {
+    const auto& leaf = *leaves[l];
+    if (!(leaf.attributeSet().descriptor() == descriptor))
+      failRead(path, "points '" + name + "' have leaves with different attribute layouts");
+    openvdb::points::AttributeHandle<openvdb::Vec3f> position(leaf.constAttributeArray(positionIndex));
+    std::unique_ptr<openvdb::points::AttributeHandle<std::int64_t>> order;
+    if (hasOrder) order = std::make_unique<openvdb::points::AttributeHandle<std::int64_t>>(leaf.constAttributeArray(orderIndex));
+    std::vector<openvdb::points::AttributeHandle<float>> values;
+    for (const auto& [attributeName, index] : floatAttributes) values.emplace_back(leaf.constAttributeArray(index));
+    std::size_t next = firstPoint[l];
+    for (auto it = leaf.beginIndexAll(); it; ++it, ++next) {
+      const openvdb::Index p = *it;
+      std::size_t slot = next;
+      if (order) {
+        const std::int64_t original = order->get(p);
+        if (original < 0 || static_cast<std::size_t>(original) >= n)
+          failRead(path, "points '" + name + "' have an invalid " + kPointIndexAttribute + " value");
+        slot = static_cast<std::size_t>(original);
+      }
+      // Index space = voxel + stored offset; with msim's power-of-two voxel size this is exact.
+      // In voxel 0 the offset is used alone, because 0 + (-0) would turn a -0 coordinate into +0.
+      const openvdb::Coord voxel = it.getCoord();
+      const openvdb::Vec3f offset = position.get(p);
+      openvdb::Vec3d index;
+      for (int a = 0; a < 3; ++a) index[a] = voxel[a] == 0 ? double(offset[a]) : voxel[a] + double(offset[a]);
+      const openvdb::Vec3d world = xform.indexToWorld(index);
+      cloud.positions[slot] = Vecf<3>(static_cast<float>(world.x()), static_cast<float>(world.y()), static_cast<float>(world.z()));
+      for (std::size_t a = 0; a < values.size(); ++a) cloud.attributes[a].values[slot] = values[a].get(p);
+    }
+  });
+  return cloud;
+}
+
+}  // namespace msim::io

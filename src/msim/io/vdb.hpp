@@ -1,0 +1,69 @@
+#pragma once
+// OpenVDB output and input of msim fields and particles. OpenVDB headers stay in vdb.cpp (they
+// are slow to compile), so this interface only speaks msim types.
+//
+// Grid layout: VDB voxel (i,j,k) is msim cell (i,j,k), and the transform (uniform scale dx,
+// translated by origin + dx/2) puts voxel centres exactly on msim cell centres, so tools such as
+// Houdini or Blender show the field where msim simulated it. The GridSpec is stored as grid
+// metadata (msim_origin, msim_dx, msim_res) and restored exactly on reading.
+//
+// Sparsity: with the default tolerance 0 only values whose bits equal +0 (the background) become
+// inactive, so grids round-trip bit-equal; a positive tolerance also drops |v| <= tolerance.
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "msim/core/grid.hpp"
+#include "msim/core/mac_grid.hpp"
+#include "msim/io/point_cloud.hpp"
+
+namespace msim::io {
+
+// Collects named grids and point sets, then writes them into one .vdb file. Each add*() copies
+// the data, so the source may change afterwards. Grid names must be unique and non-empty
+// (std::invalid_argument otherwise).
+class VdbWriter {
+ public:
+  VdbWriter();
+  ~VdbWriter();
+  VdbWriter(const VdbWriter&) = delete;
+  VdbWriter& operator=(const VdbWriter&) = delete;
+
+  // Cell-centred scalar field. A 2D grid becomes a one-voxel-thick 3D grid (z origin 0, z res 1).
+  void addFloatGrid(const std::string& name, const Grid<float, 3>& grid, float tolerance = 0.0f);
+  void addFloatGrid(const std::string& name, const Grid<float, 2>& grid, float tolerance = 0.0f);
+  // Vector fields as Vec3s grids; tolerance applies to the vector length. A MAC velocity is
+  // averaged from its faces to the cell centres.
+  void addVectorGrid(const std::string& name, const Grid<Vecf<3>, 3>& grid, float tolerance = 0.0f);
+  void addVectorGrid(const std::string& name, const Grid<Vec3, 3>& grid, float tolerance = 0.0f);
+  void addVectorGrid(const std::string& name, const MacGrid<3>& velocity, float tolerance = 0.0f);
+  // A PointDataGrid with float positions and float attributes; point order is kept. voxelSize
+  // only sets how points are bucketed (about 8-16 points per voxel is efficient); it is rounded to
+  // a power of two, which makes the world <-> voxel-offset conversion exact, so positions read
+  // back bit-equal. std::invalid_argument for non-finite positions or mismatched attributes.
+  void addPoints(const std::string& name, const PointCloud& points, double voxelSize);
+
+  // Writes all added grids atomically (std::runtime_error if writing fails).
+  void write(const std::filesystem::path& path) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Names of the grids stored in a .vdb file.
+std::vector<std::string> listVdbGrids(const std::filesystem::path& path);
+
+// Reads a float grid. Grids written by msim get their GridSpec back exactly; other grids get one
+// covering their active voxels (voxel size from the transform, which must be uniform and
+// axis-aligned). InputError naming the file for a missing file or grid, a grid of another type
+// or an unsupported transform.
+Grid<float, 3> readFloatGrid(const std::filesystem::path& path, const std::string& name);
+// Reads a Vec3s (or Vec3d, converted to float) grid, as readFloatGrid.
+Grid<Vecf<3>, 3> readVectorGrid(const std::filesystem::path& path, const std::string& name);
+// Reads a point set: positions and every float attribute, in the original order for points
+// written by msim. InputError as readFloatGrid.
+PointCloud readPoints(const std::filesystem::path& path, const std::string& name);
+
+}  // namespace msim::io

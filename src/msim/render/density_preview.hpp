@@ -1,0 +1,24 @@
+#pragma once
+// A quick look at a density field: an emission-absorption projection along one grid axis with a
+// single directional light from "above" (Beer-Lambert shadowing computed by one sweep), an ambient
+// term and a dark background. It is the per-frame preview every scene writes; the physically
+// based renderer (Stam ch. 5) is a separate module.
+#include "msim/core/grid.hpp"
+#include "msim/io/png.hpp"
+
+namespace msim::render {
+
+struct PreviewSettings {
+  int viewAxis = 2;           // looking down -viewAxis (3D); ignored in 2D
+  int upAxis = 1;             // image up; the light shines down this axis
+  double extinction = 10.0;   // sigma_t per unit density [m^2/kg]
+  double albedo = 0.9;        // scattered fraction of extinguished light
+  double ambient = 0.25;      // sky light reaching every voxel, relative to the key light
+  int minWidth = 480;         // images are upscaled by an integer factor to at least this width
+  double depth2D = 0.0;       // optical depth thickness of a 2D grid [m]; 0 means 8 cells
+};
+
+template <int D>
+io::Image renderDensityPreview(const Grid<float, D>& density, const PreviewSettings& settings);
+
+}  // namespace msim::render

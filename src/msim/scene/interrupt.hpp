@@ -1,0 +1,10 @@
+#pragma once
+// Ctrl-C (SIGINT) and SIGTERM ask the run to stop: the time loop finishes the frame file it is
+// writing, records the run as interrupted and exits; nothing half-written is left behind.
+namespace msim::scene {
+
+void installInterruptHandler();
+bool interruptRequested();
+void requestInterrupt();  // what the handler does; tests call it directly
+
+}  // namespace msim::scene

@@ -1,0 +1,50 @@
+#pragma once
+// The contract between the time loop (runner) and a phenomenon. A phenomenon owns its state and
+// parameters; the runner owns time, substeps, frames, files and the user's interrupts.
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "msim/core/timer.hpp"
+#include "msim/io/png.hpp"
+#include "msim/scene/schema/schema.hpp"
+
+namespace msim::scene {
+
+struct Scene;
+
+class Phenomenon {
+ public:
+  virtual ~Phenomenon() = default;
+  // Largest stable step from the current state, already scaled by the scene's CFL factor [s].
+  virtual double stableTimestep() const = 0;
+  virtual void step(double dt) = 0;
+  // Throws SimulationError naming the field and `stepIndex` if the state is not finite.
+  virtual void checkFinite(long stepIndex, double time) const = 0;
+  // Frame outputs. Each call writes one complete file (the runner makes it atomic).
+  virtual void writeVolume(const std::filesystem::path& vdbFile) const = 0;
+  virtual io::Image preview() const = 0;
+  // Restores the state saved by writeVolume (for --resume).
+  virtual void restore(const std::filesystem::path& vdbFile) = 0;
+  // Summary numbers of the current state, one JSON object of named numbers.
+  virtual nlohmann::json statistics() const = 0;
+};
+
+// A kind of phenomenon the scene key "phenomenon" can name.
+struct PhenomenonType {
+  std::string name;
+  std::string description;
+  // Adds the phenomenon's own keys to the root scene schema.
+  void (*declare)(Schema& root);
+  // Bytes of memory per grid cell while running (state, scratch, output buffers).
+  double (*bytesPerCell)(int dimensions);
+  std::unique_ptr<Phenomenon> (*create)(const Scene& scene, StageTimers& timers);
+};
+
+const std::vector<PhenomenonType>& phenomenonTypes();
+const PhenomenonType* findPhenomenonType(const std::string& name);
+
+}  // namespace msim::scene

@@ -1,0 +1,17 @@
+#include "msim/scene/gas_phenomenon.hpp"
+#include "msim/scene/phenomenon.hpp"
+
+namespace msim::scene {
+
+const std::vector<PhenomenonType>& phenomenonTypes() {
+  static const std::vector<PhenomenonType> types = {gasPhenomenonType()};
+  return types;
+}
+
+const PhenomenonType* findPhenomenonType(const std::string& name) {
+  for (const auto& t : phenomenonTypes())
+    if (t.name == name) return &t;
+  return nullptr;
+}
+
+}  // namespace msim::scene

@@ -1,0 +1,251 @@
+#include "msim/scene/runner.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <regex>
+
+#include <fmt/format.h>
+
+#include "msim/core/error.hpp"
+#include "msim/core/log.hpp"
+#include "msim/core/timer.hpp"
+#include "msim/io/atomic_file.hpp"
+#include "msim/io/csv.hpp"
+#include "msim/io/png.hpp"
+#include "msim/io/video.hpp"
+#include "msim/scene/interrupt.hpp"
+#include "msim/scene/progress_bar.hpp"
+#include "msim/version.hpp"
+
+namespace msim::scene {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+fs::path frameFile(const fs::path& dir, const std::string& name, int frame, const std::string& extension) {
+  return dir / fmt::format("{}_{:04d}.{}", name, frame, extension);
+}
+
+namespace {
+
+struct Layout {
+  fs::path root, vdbDir, pngDir;
+  bool vdb = false, png = false, mp4 = false;
+  std::string name;
+};
+
+Layout layoutFor(const Scene& scene, const fs::path& outDir) {
+  const json& o = scene.resolved.at("outputs");
+  Layout l;
+  l.root = outDir;
+  l.vdbDir = outDir / "vdb";
+  l.pngDir = outDir / "png";
+  l.vdb = o.at("vdb").get<bool>();
+  l.png = o.at("png").get<bool>();
+  l.mp4 = o.at("mp4").get<bool>() && l.png;
+  l.name = scene.name();
+  return l;
+}
+
+bool frameComplete(const Layout& l, int frame) {
+  if (l.vdb && !fs::exists(frameFile(l.vdbDir, l.name, frame, "vdb"))) return false;
+  if (l.png && !fs::exists(frameFile(l.pngDir, l.name, frame, "png"))) return false;
+  return l.vdb || l.png;
+}
+
+// Removes frame files of an earlier run with the same name so a fresh run never mixes with them.
+void clearFrames(const Layout& l) {
+  const std::regex pattern(fmt::format("{}_[0-9]{{4,}}\\.(vdb|png)", l.name));
+  for (const fs::path& dir : {l.vdbDir, l.pngDir}) {
+    if (!fs::exists(dir)) continue;
+    for (const auto& entry : fs::directory_iterator(dir))
+      if (std::regex_match(entry.path().filename().string(), pattern)) fs::remove(entry.path());
+  }
+}
+
+void writeJson(const fs::path& path, const json& document) {
+  io::writeFileAtomically(path, [&](const fs::path& tmp) {
+    std::FILE* f = std::fopen(tmp.c_str(), "w");
+    if (!f) throw std::runtime_error("cannot write " + tmp.string());
+    const std::string text = document.dump(2) + "\n";
+    const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+    if (std::fclose(f) != 0 || !ok) throw std::runtime_error("cannot write " + tmp.string());
+  });
+}
+
+void writeStatsCsv(const fs::path& path, const json& frames) {
+  if (frames.empty()) return;
+  std::vector<std::string> columns;
+  for (const auto& [key, value] : frames.front().items()) columns.push_back(key);
+  io::CsvWriter csv(path, columns);
+  std::vector<double> row(columns.size());
+  for (const json& f : frames) {
+    for (std::size_t c = 0; c < columns.size(); ++c) row[c] = f.at(columns[c]).get<double>();
+    csv.addRow(row);
+  }
+  csv.commit();
+}
+
+json timingJson(const StageTimers& timers) {
+  json stages = json::array();
+  for (const auto& s : timers.table())
+    stages.push_back({{"stage", s.name}, {"seconds", s.seconds}, {"calls", s.calls}, {"percent", s.percent}});
+  return stages;
+}
+
+class RunRecord {
+ public:
+  RunRecord(const Scene& scene, const RunOptions& options, const Layout& layout)
+      : path_(layout.root / "run.json"), statsPath_(layout.root / "stats.csv") {
+    doc_ = {{"msim_version", kVersion},
+            {"scene_file", scene.file.string()},
+            {"command_line", options.commandLine},
+            {"status", "running"},
+            {"grid",
+             {{"dimensions", scene.dimensions},
+              {"resolution", std::vector<int>(scene.resolution.data(), scene.resolution.data() + scene.dimensions)},
+              {"dx_m", scene.dx},
+              {"cells", scene.cellCount()},
+              {"memory_estimate_bytes", scene.memoryEstimate}}},
+            {"frames_planned", scene.frameCount},
+            {"fps", scene.fps},
+            {"parameters", scene.resolved},
+            {"frames", json::array()}};
+  }
+  // Frame statistics of the run being resumed, if its run.json is readable.
+  void adoptPreviousFrames(int upToFrame) {
+    std::FILE* f = std::fopen(path_.c_str(), "r");
+    if (!f) return;
+    const json previous = json::parse(f, nullptr, false);
+    std::fclose(f);
+    if (previous.is_discarded() || !previous.contains("frames")) return;
+    for (const json& frame : previous.at("frames"))
+      if (frame.value("frame", 0.0) <= upToFrame) doc_["frames"].push_back(frame);
+  }
+  void addFrame(json stats) { doc_["frames"].push_back(std::move(stats)); }
+  void save(const std::string& status, const StageTimers& timers, double wallSeconds) {
+    doc_["status"] = status;
+    doc_["wall_seconds"] = wallSeconds;
+    doc_["timings"] = timingJson(timers);
+    if (!doc_["frames"].empty()) doc_["summary"] = doc_["frames"].back();
+    writeJson(path_, doc_);
+    writeStatsCsv(statsPath_, doc_["frames"]);
+  }
+  void note(const std::string& key, const std::string& value) { doc_[key] = value; }
+
+ private:
+  fs::path path_, statsPath_;
+  json doc_;
+};
+
+}  // namespace
+
+RunStatus runScene(const Scene& scene, const RunOptions& options) {
+  const auto wallStart = std::chrono::steady_clock::now();
+  auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count(); };
+  const Layout layout = layoutFor(scene, options.outDir);
+  const int lastFrame = options.frameLimit > 0 ? std::min(options.frameLimit, scene.frameCount) : scene.frameCount;
+  if (options.resume && !layout.vdb)
+    throw InputError(scene.file.string() + ": --resume needs the VDB frames, but 'outputs.vdb' is false");
+
+  fs::create_directories(layout.root);
+  if (layout.vdb) fs::create_directories(layout.vdbDir);
+  if (layout.png) fs::create_directories(layout.pngDir);
+  for (const fs::path& dir : {layout.root, layout.vdbDir, layout.pngDir}) io::removeStaleTemporaries(dir);
+
+  StageTimers timers;
+  std::unique_ptr<Phenomenon> phenomenon;
+  {
+    ScopedStage stage(timers, "setup");
+    phenomenon = scene.type->create(scene, timers);
+  }
+  RunRecord record(scene, options, layout);
+
+  int firstFrame = 1;
+  if (options.resume) {
+    int done = 0;
+    while (done < lastFrame && frameComplete(layout, done + 1)) ++done;
+    if (done > 0) {
+      ScopedStage stage(timers, "resume: read frame");
+      phenomenon->restore(frameFile(layout.vdbDir, layout.name, done, "vdb"));
+      record.adoptPreviousFrames(done);
+    }
+    firstFrame = done + 1;
+    logger().info("resuming after frame {} of {}", done, lastFrame);
+  } else {
+    clearFrames(layout);
+  }
+
+  const double frameDt = 1.0 / scene.fps;
+  const int maxSubsteps = scene.resolved.at("time").at("max_substeps").get<int>();
+  long stepIndex = 0;
+  ProgressBar progress(firstFrame, lastFrame);
+  RunStatus status = RunStatus::Complete;
+  try {
+    for (int frame = firstFrame; frame <= lastFrame; ++frame) {
+      const double frameEnd = frame * frameDt;
+      double time = (frame - 1) * frameDt, remaining = frameDt;
+      int substeps = 0;
+      while (remaining > 1e-12 * frameDt) {
+        const double stable = phenomenon->stableTimestep();
+        const double needed = std::ceil(remaining / stable);
+        if (!(stable > 0.0) || substeps + needed > maxSubsteps)
+          throw SimulationError(fmt::format(
+              "step {} (t = {:.4g} s): frame {} needs more than time.max_substeps = {} substeps (stable step {:.3g} s "
+              "for a frame of {:.3g} s): the flow is too fast for the grid (CFL)",
+              stepIndex, time, frame, maxSubsteps, stable, frameDt));
+        const double dt = remaining / needed;
+        phenomenon->step(dt);
+        ++stepIndex;
+        ++substeps;
+        remaining -= dt;
+        time = frameEnd - remaining;
+      }
+      {
+        ScopedStage stage(timers, "check finite");
+        phenomenon->checkFinite(stepIndex, frameEnd);
+      }
+      if (layout.vdb) {
+        ScopedStage stage(timers, "write vdb");
+        phenomenon->writeVolume(frameFile(layout.vdbDir, layout.name, frame, "vdb"));
+      }
+      if (layout.png) {
+        ScopedStage stage(timers, "write png");
+        io::writePng(frameFile(layout.pngDir, layout.name, frame, "png"), phenomenon->preview());
+      }
+      json stats = {{"frame", frame}, {"time_s", frameEnd}, {"substeps", substeps}};
+      stats.update(phenomenon->statistics());
+      record.addFrame(std::move(stats));
+      record.save(frame == lastFrame ? "complete" : "running", timers, wall());
+      if (options.showProgress) progress.update(frame, substeps);
+      if (interruptRequested() && frame < lastFrame) {
+        status = RunStatus::Interrupted;
+        break;
+      }
+    }
+  } catch (const std::exception& e) {
+    if (options.showProgress) progress.finish();
+    record.note("error", e.what());
+    record.save("failed", timers, wall());
+    throw;
+  }
+  if (options.showProgress) progress.finish();
+
+  if (status == RunStatus::Complete && layout.mp4) {
+    ScopedStage stage(timers, "encode mp4");
+    std::vector<fs::path> frames;
+    for (int f = 1; f <= lastFrame; ++f) frames.push_back(frameFile(layout.pngDir, layout.name, f, "png"));
+    const io::VideoResult video = io::encodeMp4(frames, scene.fps, layout.root / (layout.name + ".mp4"));
+    if (!video.written) {
+      logger().warn("{}", video.note);
+      record.note("mp4", video.note);
+    }
+  }
+  record.save(status == RunStatus::Complete ? "complete" : "interrupted", timers, wall());
+  std::fprintf(stderr, "%s", timers.formatTable().c_str());
+  return status;
+}
+
+}  // namespace msim::scene

@@ -1,0 +1,191 @@
+// End-to-end checks of the msim program: bad input gives one clear message and exit code 2 with
+// no frame written; runs write complete frames; --resume continues bit-exactly.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "msim/io/vdb.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int exitCode = -1;
+  std::string output;  // stdout and stderr
+};
+
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::path(MSIM_TEST_TMP) / "app" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+Result runMsim(const std::string& args) {
+  const fs::path log = fs::path(MSIM_TEST_TMP) / "app" / "last_output.txt";
+  fs::create_directories(log.parent_path());
+  const std::string cmd = std::string(MSIM_APP_PATH) + " " + args + " > " + log.string() + " 2>&1";
+  const int status = std::system(cmd.c_str());
+  Result r;
+  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream in(log);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  r.output = ss.str();
+  return r;
+}
+
+void writeText(const fs::path& path, const std::string& text) {
+  std::ofstream(path) << text;
+}
+
+// A small, fast 3D gas scene; `extra` is spliced into the top-level object.
+std::string tinyScene(const std::string& extra = "", int resolution = 16) {
+  return R"({
+  "name": "tiny",
+  "phenomenon": "gas",
+  "domain": {"min": [0, 0, 0], "max": [1, 1, 1], "resolution": )" +
+         std::to_string(resolution) + R"(},
+  "time": {"duration": 0.5, "fps": 8},
+  "gas": {"density": {"diffusion": 0.001}},
+  "motion_fields": [{"type": "uniform", "magnitude": 0.5, "axis": [0, 1, 0]},
+                    {"type": "line_vortex", "magnitude": 0.2, "position": [0.5, 0.5, 0.5], "core_radius": 0.1}],
+  "sources": [{"shape": {"type": "sphere", "center": [0.5, 0.2, 0.5], "radius": 0.12}, "density_rate": 2.0}],
+  "outputs": {"mp4": false}
+  )" + extra + "}\n";
+}
+
+bool noFramesIn(const fs::path& out) {
+  if (!fs::exists(out)) return true;
+  for (const auto& e : fs::recursive_directory_iterator(out))
+    if (e.is_regular_file()) return false;
+  return true;
+}
+
+}  // namespace
+
+TEST(Cli, VersionAndHelp) {
+  EXPECT_EQ(runMsim("--version").exitCode, 0);
+  const Result help = runMsim("--help");
+  EXPECT_EQ(help.exitCode, 0);
+  EXPECT_NE(help.output.find("run"), std::string::npos);
+}
+
+TEST(Cli, MissingSceneFile) {
+  const fs::path dir = scratch("missing");
+  const Result r = runMsim("run " + (dir / "nope.json").string() + " --out " + (dir / "out").string());
+  EXPECT_EQ(r.exitCode, 2) << r.output;
+  EXPECT_NE(r.output.find("not found"), std::string::npos) << r.output;
+  EXPECT_TRUE(noFramesIn(dir / "out"));
+}
+
+TEST(Cli, MalformedJsonReportsLineAndColumn) {
+  const fs::path dir = scratch("malformed");
+  writeText(dir / "bad.json", "{\n  \"name\": \"x\",\n  \"phenomenon\": \"gas\"\n  \"domain\": {}\n}\n");
+  const Result r = runMsim("run " + (dir / "bad.json").string() + " --out " + (dir / "out").string());
+  EXPECT_EQ(r.exitCode, 2) << r.output;
+  EXPECT_NE(r.output.find("bad.json:4:"), std::string::npos) << r.output;  // the error is on line 4
+  EXPECT_TRUE(noFramesIn(dir / "out"));
+}
+
+TEST(Cli, UnknownKeySuggestsTheClosest) {
+  const fs::path dir = scratch("unknown");
+  std::string text = tinyScene();
+  text.replace(text.find("\"resolution\""), 12, "\"resolutoin\"");
+  writeText(dir / "s.json", text);
+  const Result r = runMsim("run " + (dir / "s.json").string() + " --out " + (dir / "out").string());
+  EXPECT_EQ(r.exitCode, 2) << r.output;
+  EXPECT_NE(r.output.find("domain.resolutoin"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("did you mean 'resolution'"), std::string::npos) << r.output;
+  EXPECT_TRUE(noFramesIn(dir / "out"));
+}
+
+TEST(Cli, WrongTypeNamesKeyAndExpectation) {
+  const fs::path dir = scratch("wrongtype");
+  std::string text = tinyScene();
+  text.replace(text.find("\"duration\": 0.5"), 15, "\"duration\": \"long\"");
+  writeText(dir / "s.json", text);
+  const Result r = runMsim("run " + (dir / "s.json").string() + " --out " + (dir / "out").string());
+  EXPECT_EQ(r.exitCode, 2) << r.output;
+  EXPECT_NE(r.output.find("time.duration"), std::string::npos) << r.output;
+  EXPECT_TRUE(noFramesIn(dir / "out"));
+}
+
+TEST(Cli, NonPositiveResolutionIsRejected) {
+  const fs::path dir = scratch("resolution");
+  for (const char* value : {"0", "-8"}) {
+    writeText(dir / "s.json", tinyScene());
+    const Result r = runMsim("run " + (dir / "s.json").string() + " --out " + (dir / "out").string() +
+                             " --set domain.resolution=" + value);
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("domain.resolution"), std::string::npos) << r.output;
+    EXPECT_TRUE(noFramesIn(dir / "out"));
+  }
+}
+
+TEST(Cli, DomainLargerThanMemoryIsRefusedBeforeAllocating) {
+  const fs::path dir = scratch("memory");
+  writeText(dir / "s.json", tinyScene("", 200000));
+  const Result r = runMsim("run " + (dir / "s.json").string() + " --out " + (dir / "out").string());
+  EXPECT_EQ(r.exitCode, 2) << r.output;
+  EXPECT_NE(r.output.find("domain.resolution"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("available"), std::string::npos) << r.output;
+  EXPECT_TRUE(noFramesIn(dir / "out"));
+}
+
+TEST(Cli, SourceOutsideTheDomainIsAnError) {
+  const fs::path dir = scratch("outside");
+  std::string text = tinyScene();
+  text.replace(text.find("[0.5, 0.2, 0.5]"), 15, "[5.0, 0.2, 0.5]");
+  writeText(dir / "s.json", text);
+  const Result r = runMsim("validate " + (dir / "s.json").string());
+  EXPECT_EQ(r.exitCode, 2) << r.output;
+  EXPECT_NE(r.output.find("sources[0].shape"), std::string::npos) << r.output;
+}
+
+TEST(Cli, CflBlowUpStopsWithAMessage) {
+  const fs::path dir = scratch("cfl");
+  writeText(dir / "s.json", tinyScene());
+  const Result r = runMsim("run " + (dir / "s.json").string() + " -q --out " + (dir / "out").string() +
+                           " --set time.max_substeps=1 --set motion_fields[0].magnitude=500");
+  EXPECT_EQ(r.exitCode, 3) << r.output;
+  EXPECT_NE(r.output.find("max_substeps"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("step "), std::string::npos) << r.output;
+}
+
+TEST(Cli, InfoListsParametersWithUnits) {
+  const fs::path dir = scratch("info");
+  writeText(dir / "s.json", tinyScene());
+  const Result r = runMsim("info " + (dir / "s.json").string());
+  EXPECT_EQ(r.exitCode, 0) << r.output;
+  for (const char* needle : {"gas.density.diffusion", "m^2/s", "domain.resolution", "memory", "sources[0].density_rate"})
+    EXPECT_NE(r.output.find(needle), std::string::npos) << needle << "\n" << r.output;
+}
+
+TEST(Cli, ResumeContinuesBitExactly) {
+  const fs::path dir = scratch("resume");
+  writeText(dir / "s.json", tinyScene());
+  const std::string scene = (dir / "s.json").string();
+  ASSERT_EQ(runMsim("run " + scene + " -q --out " + (dir / "full").string()).exitCode, 0);
+  ASSERT_EQ(runMsim("run " + scene + " -q --frames 2 --out " + (dir / "split").string()).exitCode, 0);
+  EXPECT_FALSE(fs::exists(dir / "split" / "vdb" / "tiny_0003.vdb"));
+  const Result resumed = runMsim("run " + scene + " --resume --out " + (dir / "split").string());
+  ASSERT_EQ(resumed.exitCode, 0) << resumed.output;
+  EXPECT_NE(resumed.output.find("resuming after frame 2"), std::string::npos) << resumed.output;
+  for (const char* frame : {"tiny_0003.vdb", "tiny_0004.vdb"}) {
+    const auto a = msim::io::readFloatGrid(dir / "full" / "vdb" / frame, "density");
+    const auto b = msim::io::readFloatGrid(dir / "split" / "vdb" / frame, "density");
+    ASSERT_EQ(a.count(), b.count());
+    EXPECT_EQ(0, std::memcmp(a.data().data(), b.data().data(), a.count() * sizeof(float))) << frame;
+  }
+  EXPECT_TRUE(fs::exists(dir / "full" / "run.json"));
+  EXPECT_TRUE(fs::exists(dir / "full" / "stats.csv"));
+  EXPECT_TRUE(fs::exists(dir / "full" / "png" / "tiny_0004.png"));
+}
