@@ -1,7 +1,13 @@
 // End-to-end checks of the msim program: bad input gives one clear message and exit code 2 with
 // no frame written; runs write complete frames; --resume continues bit-exactly.
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <sys/wait.h>
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <thread>
 
 #include <cstdlib>
 #include <cstring>
@@ -29,7 +35,9 @@ fs::path scratch(const std::string& name) {
 }
 
 Result runMsim(const std::string& args) {
-  const fs::path log = fs::path(MSIM_TEST_TMP) / "app" / "last_output.txt";
+  // One log per test: ctest runs the tests of this program in parallel processes.
+  const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  const fs::path log = fs::path(MSIM_TEST_TMP) / "app" / (test + ".log");
   fs::create_directories(log.parent_path());
   const std::string cmd = std::string(MSIM_APP_PATH) + " " + args + " > " + log.string() + " 2>&1";
   const int status = std::system(cmd.c_str());
@@ -188,4 +196,47 @@ TEST(Cli, ResumeContinuesBitExactly) {
   EXPECT_TRUE(fs::exists(dir / "full" / "run.json"));
   EXPECT_TRUE(fs::exists(dir / "full" / "stats.csv"));
   EXPECT_TRUE(fs::exists(dir / "full" / "png" / "tiny_0004.png"));
+}
+
+TEST(Cli, InterruptFinishesTheFrameAndStops) {
+  const fs::path dir = scratch("interrupt");
+  writeText(dir / "s.json", tinyScene("", 40));
+  const fs::path out = dir / "out";
+  const std::string scene = (dir / "s.json").string(), outDir = out.string();
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    const int devnull = open("/dev/null", O_WRONLY);
+    dup2(devnull, STDOUT_FILENO);
+    dup2(devnull, STDERR_FILENO);
+    execl(MSIM_APP_PATH, MSIM_APP_PATH, "run", scene.c_str(), "--out", outDir.c_str(), "--set", "time.duration=30",
+          static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (!fs::exists(out / "vdb" / "tiny_0002.vdb") && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  kill(child, SIGINT);
+  int status = 0;
+  waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  // Every frame written is complete (both files), numbered without gaps, and no temporary is left.
+  int frames = 0;
+  while (fs::exists(out / "vdb" / ("tiny_" + std::string(4 - std::to_string(frames + 1).size(), '0') +
+                                   std::to_string(frames + 1) + ".vdb")))
+    ++frames;
+  EXPECT_GE(frames, 2);
+  EXPECT_LT(frames, 240);
+  std::size_t files = 0;
+  for (const auto& e : fs::recursive_directory_iterator(out)) {
+    const std::string name = e.path().filename().string();
+    EXPECT_EQ(name.find(".tmp-"), std::string::npos) << name;
+    if (e.path().extension() == ".vdb" || e.path().extension() == ".png") ++files;
+  }
+  EXPECT_EQ(files, 2u * frames);
+  std::ifstream run(out / "run.json");
+  std::stringstream text;
+  text << run.rdbuf();
+  EXPECT_NE(text.str().find("\"status\": \"interrupted\""), std::string::npos);
 }

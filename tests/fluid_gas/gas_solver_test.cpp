@@ -27,8 +27,9 @@ TEST(GasSolver, ClosedBoxWithObstacleConservesMassOver100Steps) {
   GasSolver<3> gas(spec, GasParams{.densityDiffusion = 1e-4}, swirl(Vec3(0.5, 0.5, 0.5)),
                    numerics::TransportBoundaries<3>::allClosed());
   Grid<float, 3> solid(spec, 0.0f);
-  for (std::size_t i = 0; i < solid.count(); ++i)
+  for (std::size_t i = 0; i < solid.count(); ++i) {
     if ((solid.position(solid.coord(i)) - Vec3(0.5, 0.75, 0.5)).norm() < 0.1) solid[i] = 1.0f;
+  }
   gas.setSolid(solid);
   auto& rho = gas.density();
   for (std::size_t i = 0; i < rho.count(); ++i)
@@ -39,8 +40,9 @@ TEST(GasSolver, ClosedBoxWithObstacleConservesMassOver100Steps) {
   const GasStatistics after = gas.statistics();
   EXPECT_NEAR(after.mass / before, 1.0, 1e-4);
   EXPECT_GT((after.centroid - Vec3(0.3, 0.5, 0.5)).norm(), 0.01);  // the gas did move
-  for (std::size_t i = 0; i < rho.count(); ++i)
+  for (std::size_t i = 0; i < rho.count(); ++i) {
     if (solid[i] > 0.5f) ASSERT_EQ(rho[i], 0.0f);  // nothing leaks into the obstacle
+  }
 }
 
 TEST(GasSolver, PureDiffusionSpreadsAGaussianAtTwoKappaT) {

@@ -1,7 +1,8 @@
 #pragma once
 // A quick look at a density field: an emission-absorption projection along one grid axis with a
 // single directional light from "above" (Beer-Lambert shadowing computed by one sweep), an ambient
-// term and a dark background. It is the per-frame preview every scene writes; the physically
+// term and a dark background. Solid cells (obstacles), when given, are drawn as opaque matte
+// surfaces that also cast shadows into the gas. It is the per-frame preview every scene writes; the physically
 // based renderer (Stam ch. 5) is a separate module.
 #include "msim/core/grid.hpp"
 #include "msim/io/png.hpp"
@@ -18,7 +19,9 @@ struct PreviewSettings {
   double depth2D = 0.0;       // optical depth thickness of a 2D grid [m]; 0 means 8 cells
 };
 
+// `solid` (optional, same layout as density): cells > 0.5 are opaque obstacles.
 template <int D>
-io::Image renderDensityPreview(const Grid<float, D>& density, const PreviewSettings& settings);
+io::Image renderDensityPreview(const Grid<float, D>& density, const PreviewSettings& settings,
+                               const Grid<float, D>* solid = nullptr);
 
 }  // namespace msim::render

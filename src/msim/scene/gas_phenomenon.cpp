@@ -165,7 +165,9 @@ class GasPhenomenon final : public Phenomenon {
     writer.write(vdbFile);
   }
 
-  io::Image preview() const override { return render::renderDensityPreview(solver_.density(), preview_); }
+  io::Image preview() const override {
+    return render::renderDensityPreview(solver_.density(), preview_, &solver_.solid());
+  }
 
   void restore(const std::filesystem::path& vdbFile) override {
     load(vdbFile, "density", solver_.density());

@@ -7,7 +7,12 @@ namespace msim::scene {
 
 namespace {
 std::atomic<bool> gInterrupted{false};
-extern "C" void onSignal(int) { gInterrupted.store(true); }
+// First signal: ask the loop to stop after the frame in progress. A second one gets the default
+// action (terminate); frames are written atomically, so even that leaves no half-written frame.
+extern "C" void onSignal(int signal) {
+  gInterrupted.store(true);
+  std::signal(signal, SIG_DFL);
+}
 }  // namespace
 
 void installInterruptHandler() {

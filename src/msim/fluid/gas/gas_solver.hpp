@@ -64,6 +64,7 @@ class GasSolver {
   Grid<float, D>& temperature() { return temperature_; }
   const Grid<float, D>& temperature() const { return temperature_; }
   const MacGrid<D>& velocity() const { return velocity_; }
+  const Grid<float, D>& solid() const { return transport_.solid(); }
   const GridSpec<D>& spec() const { return spec_; }
   const GasParams& params() const { return params_; }
 
