@@ -1,4 +1,5 @@
 // Conservation and analytic checks of the grid gas solver (Stam ch. 6.4.1 equations).
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -38,10 +39,13 @@ TEST(GasSolver, ClosedBoxWithObstacleConservesMassOver100Steps) {
   const double dt = gas.stableTimestep();
   for (int s = 0; s < 100; ++s) gas.step(dt);
   const GasStatistics after = gas.statistics();
+  RecordProperty("mass_ratio_minus_1", fmt::format("{:.4e}", after.mass / before - 1.0));
   EXPECT_NEAR(after.mass / before, 1.0, 1e-4);
   EXPECT_GT((after.centroid - Vec3(0.3, 0.5, 0.5)).norm(), 0.01);  // the gas did move
   for (std::size_t i = 0; i < rho.count(); ++i) {
-    if (solid[i] > 0.5f) ASSERT_EQ(rho[i], 0.0f);  // nothing leaks into the obstacle
+    if (solid[i] > 0.5f) {
+      ASSERT_EQ(rho[i], 0.0f);  // nothing leaks into the obstacle
+    }
   }
 }
 
@@ -69,6 +73,8 @@ TEST(GasSolver, PureDiffusionSpreadsAGaussianAtTwoKappaT) {
   const int steps = static_cast<int>(std::ceil(tEnd / gas.stableTimestep()));
   for (int s = 0; s < steps; ++s) gas.step(tEnd / steps);
   const Vec3 growth = (variances() - v0) / (2 * kappa * tEnd);
+  RecordProperty("variance_growth_ratio", fmt::format("{:.4e}", growth.x()) + " " + fmt::format("{:.4e}", growth.y()) + " " +
+                                              fmt::format("{:.4e}", growth.z()));
   for (int a = 0; a < 3; ++a) EXPECT_NEAR(growth[a], 1.0, 0.02) << "axis " << a;
 }
 

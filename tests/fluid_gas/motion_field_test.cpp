@@ -74,6 +74,10 @@ TEST(MotionField, RadialConeAndDirectionalSupports) {
   EXPECT_EQ(MotionField::primitive(dir, Vec3(1.5, 0, 1)), Vec3::Zero());
   EXPECT_EQ(MotionField::primitive(dir, Vec3(0, 0, -1)), Vec3::Zero());
   EXPECT_NEAR(MotionField::primitive(dir, Vec3(0.5, -0.5, 2.0)).z(), 0.5, 1e-12);  // halves at d_half
+  dir.edgeSoftness = 0.5;  // fades continuously to zero at the edge, unchanged in the core
+  EXPECT_NEAR(MotionField::primitive(dir, Vec3(0.4, -0.2, 2.0)).z(), 0.5, 1e-12);
+  EXPECT_NEAR(MotionField::primitive(dir, Vec3(0.999, 0.0, 2.0)).z(), 0.0, 1e-4);
+  EXPECT_NEAR(MotionField::primitive(dir, Vec3(0.75, 0.0, 2.0)).z(), 0.25, 1e-12);  // smoothstep(1/2) = 1/2
 }
 
 TEST(MotionField, InstanceTransformRotatesTheField) {

@@ -33,6 +33,7 @@ FluxTransport<D>::FluxTransport(const GridSpec<D>& spec, const TransportBoundari
       boundaries_(boundaries),
       solid_(spec, 0.0f),
       flux_(spec),
+      velocity_(spec),
       openVelocity_(spec),
       stage_(spec),
       rate_(spec) {}
@@ -40,6 +41,37 @@ FluxTransport<D>::FluxTransport(const GridSpec<D>& spec, const TransportBoundari
 template <int D>
 void FluxTransport<D>::setSolid(const Grid<float, D>& solidMask) {
   solid_ = solidMask;
+  updateOpenVelocity();
+}
+
+template <int D>
+void FluxTransport<D>::setVelocity(const MacGrid<D>& velocity) {
+  velocity_ = velocity;
+  updateOpenVelocity();
+}
+
+template <int D>
+void FluxTransport<D>::updateOpenVelocity() {
+  for (int a = 0; a < D; ++a) {
+    const auto& u = velocity_.component(a);
+    auto& open = openVelocity_.component(a);
+    parallelForCells<D>(open.size(), [&](const IVec<D>& f, std::size_t lin) {
+      open[lin] = faceOpen(a, f) ? u[lin] : 0.0f;
+    });
+  }
+  // Courant sum of each fluid cell: over axes, the larger |u| of its two faces.
+  std::vector<float> courant(spec_.cellCount(), 0.0f);
+  parallelForCells<D>(spec_.res, [&](const IVec<D>& c, std::size_t lin) {
+    float sum = 0.0f;
+    for (int a = 0; a < D; ++a) {
+      const auto& u = openVelocity_.component(a);
+      IVec<D> upper = c;
+      upper[a] += 1;
+      sum += std::max(std::abs(u(c)), std::abs(u(upper)));
+    }
+    courant[lin] = sum;
+  });
+  maxCourantSum_ = *std::max_element(courant.begin(), courant.end());
 }
 
 template <int D>
@@ -55,29 +87,16 @@ bool FluxTransport<D>::faceOpen(int axis, const IVec<D>& face) const {
 }
 
 template <int D>
-double FluxTransport<D>::maxStableDt(const MacGrid<D>& velocity, double diffusivity) const {
-  // Courant number of each cell: sum over axes of the largest |u| on its two faces.
-  std::vector<float> courant(spec_.cellCount(), 0.0f);
-  parallelForCells<D>(spec_.res, [&](const IVec<D>& c, std::size_t lin) {
-    float sum = 0.0f;
-    for (int a = 0; a < D; ++a) {
-      const auto& u = velocity.component(a);
-      IVec<D> upper = c;
-      upper[a] += 1;
-      sum += std::max(std::abs(u(c)), std::abs(u(upper)));
-    }
-    courant[lin] = solid_[lin] > 0.5f ? 0.0f : sum;
-  });
-  const double maxSpeedSum = *std::max_element(courant.begin(), courant.end());
+double FluxTransport<D>::maxStableDt(double diffusivity) const {
   // MUSCL with the MC limiter and SSP-RK2 stays positive for Courant sums up to 1/2; explicit
   // diffusion needs 2 D kappa dt / dx^2 <= 1. The two rates add.
-  const double rate = maxSpeedSum / (0.5 * spec_.dx) + 2.0 * D * diffusivity / (spec_.dx * spec_.dx);
+  const double rate = maxCourantSum_ / (0.5 * spec_.dx) + 2.0 * D * diffusivity / (spec_.dx * spec_.dx);
   return rate > 0.0 ? 1.0 / rate : std::numeric_limits<double>::infinity();
 }
 
 template <int D>
-void FluxTransport<D>::evaluateRate(const Grid<float, D>& phi, const MacGrid<D>& velocity,
-                                    const TransportSettings& settings, Grid<float, D>& rate) {
+void FluxTransport<D>::evaluateRate(const Grid<float, D>& phi, const TransportSettings& settings,
+                                    Grid<float, D>& rate) {
   const float kappaOverDx = static_cast<float>(settings.diffusivity / spec_.dx);
   const float inflow = static_cast<float>(settings.inflowValue);
   const float* p = phi.data().data();
@@ -143,20 +162,12 @@ void FluxTransport<D>::evaluateRate(const Grid<float, D>& phi, const MacGrid<D>&
 }
 
 template <int D>
-void FluxTransport<D>::step(Grid<float, D>& phi, const MacGrid<D>& velocity, const TransportSettings& settings,
-                            double dt) {
-  for (int a = 0; a < D; ++a) {
-    const auto& u = velocity.component(a);
-    auto& open = openVelocity_.component(a);
-    parallelForCells<D>(open.size(), [&](const IVec<D>& f, std::size_t lin) {
-      open[lin] = faceOpen(a, f) ? u[lin] : 0.0f;
-    });
-  }
+void FluxTransport<D>::step(Grid<float, D>& phi, const TransportSettings& settings, double dt) {
   const float h = static_cast<float>(dt);
   // SSP-RK2 (Shu & Osher): phi1 = phi + h L(phi); phi_new = (phi + phi1 + h L(phi1)) / 2.
-  evaluateRate(phi, velocity, settings, rate_);
+  evaluateRate(phi, settings, rate_);
   parallelFor(0, phi.count(), [&](std::size_t i) { stage_[i] = phi[i] + h * rate_[i]; });
-  evaluateRate(stage_, velocity, settings, rate_);
+  evaluateRate(stage_, settings, rate_);
   parallelFor(0, phi.count(), [&](std::size_t i) { phi[i] = 0.5f * (phi[i] + stage_[i] + h * rate_[i]); });
 }
 

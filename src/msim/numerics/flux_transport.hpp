@@ -50,25 +50,31 @@ class FluxTransport {
   void setSolid(const Grid<float, D>& solidMask);
   const Grid<float, D>& solid() const { return solid_; }
 
-  // Largest dt for which one step is stable and positivity preserving with the given face
-  // velocities and diffusivity: sum_a |u_a| dt/dx <= 1 (advection) and 2 D kappa dt/dx^2 <= 1.
-  double maxStableDt(const MacGrid<D>& velocity, double diffusivity) const;
+  // The face velocities that carry phi. Velocities on faces touching solids or closed walls are
+  // ignored (treated as zero). Set once for a steady flow; set again whenever the flow changes.
+  void setVelocity(const MacGrid<D>& velocity);
+  const MacGrid<D>& velocity() const { return velocity_; }
 
-  // Advance phi by dt with face velocities `velocity` (SSP-RK2). Velocities on faces touching
-  // solids or closed walls are ignored (treated as zero).
-  void step(Grid<float, D>& phi, const MacGrid<D>& velocity, const TransportSettings& settings, double dt);
+  // Largest dt for which one step is stable and positivity preserving with the current velocity
+  // and the given diffusivity: sum_a |u_a| dt/dx <= 1/2 (MUSCL + SSP-RK2) and 2 D kappa dt/dx^2 <= 1.
+  double maxStableDt(double diffusivity) const;
+
+  // Advance phi by dt (SSP-RK2).
+  void step(Grid<float, D>& phi, const TransportSettings& settings, double dt);
 
  private:
   // rate = d(phi)/dt evaluated at the state `phi`.
-  void evaluateRate(const Grid<float, D>& phi, const MacGrid<D>& velocity, const TransportSettings& settings,
-                    Grid<float, D>& rate);
+  void evaluateRate(const Grid<float, D>& phi, const TransportSettings& settings, Grid<float, D>& rate);
   bool faceOpen(int axis, const IVec<D>& face) const;
+  void updateOpenVelocity();
 
   GridSpec<D> spec_;
   TransportBoundaries<D> boundaries_;
   Grid<float, D> solid_;
   MacGrid<D> flux_;          // advective + diffusive flux per unit area through each face
-  MacGrid<D> openVelocity_;  // face velocity where the face is open, 0 elsewhere
+  MacGrid<D> velocity_;      // as given
+  MacGrid<D> openVelocity_;  // velocity_ where the face is open, 0 elsewhere
+  double maxCourantSum_ = 0.0;  // max over cells of sum_a max(|u| on its two a-faces) [m/s]
   Grid<float, D> stage_;     // RK intermediate state
   Grid<float, D> rate_;
 };

@@ -112,9 +112,20 @@ Radiance project(const Grid<float, 2>& rho, const float* solid, const PreviewSet
   return r;
 }
 
+// Linear radiance -> 8-bit sRGB through a table: a pow() per channel per pixel would cost more
+// than the whole projection.
 std::uint8_t toByte(float linear) {
-  const float srgb = linear <= 0.0031308f ? 12.92f * linear : 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
-  return static_cast<std::uint8_t>(std::lround(std::clamp(srgb, 0.0f, 1.0f) * 255.0f));
+  constexpr int kSteps = 4096;
+  static const std::array<std::uint8_t, kSteps + 1> table = [] {
+    std::array<std::uint8_t, kSteps + 1> t{};
+    for (int i = 0; i <= kSteps; ++i) {
+      const double v = static_cast<double>(i) / kSteps;
+      const double srgb = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+      t[i] = static_cast<std::uint8_t>(std::lround(srgb * 255.0));
+    }
+    return t;
+  }();
+  return table[static_cast<int>(std::clamp(linear, 0.0f, 1.0f) * kSteps + 0.5f)];
 }
 
 }  // namespace

@@ -42,6 +42,9 @@ void declareGas(Schema& root) {
   field.number("half_distance", "", 0.0, "decay W(d) = 2^(-d/half_distance) in local units; 0 = no decay").min(0.0);
   field.number("ring_radius", "", 1.0, "ring vortex radius R, local units").min(0.0, Bound::Exclusive);
   field.number("core_radius", "", 0.05, "vortex core radius, local units (smooths the axis)").min(0.0);
+  field.number("edge_softness", "", 0.0, "directional: fraction of the half-width fading to zero; 0 = hard edge")
+      .min(0.0)
+      .max(1.0);
   root.array("motion_fields", field, "summed to give the velocity u(x) (eq. 6.1)");
 
   Schema source = Schema::object("a region emitting gas");
@@ -81,6 +84,7 @@ fluid::MotionField motionField(const json& fields) {
     m.halfDistance = f.at("half_distance").get<double>();
     m.ringRadius = f.at("ring_radius").get<double>();
     m.coreRadius = f.at("core_radius").get<double>();
+    m.edgeSoftness = f.at("edge_softness").get<double>();
     instances.push_back(m);
   }
   return fluid::MotionField(std::move(instances));

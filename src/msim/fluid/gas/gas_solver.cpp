@@ -23,17 +23,19 @@ GasSolver<D>::GasSolver(const GridSpec<D>& spec, const GasParams& params, const 
                         const numerics::TransportBoundaries<D>& boundaries)
     : spec_(spec),
       params_(params),
-      velocity_(spec),
       density_(spec, 0.0f),
       temperature_(spec, static_cast<float>(params.ambientTemperature)),
       transport_(spec, boundaries) {
-  // 2D scenes live in the z = 0 plane of the 3D motion field.
+  // The motion field sampled on the cell faces, once: it is steady. 2D scenes live in the z = 0
+  // plane of the 3D field.
+  MacGrid<D> velocity(spec);
   for (int a = 0; a < D; ++a) {
-    auto& u = velocity_.component(a);
+    auto& u = velocity.component(a);
     parallelForCells(u, [&](const IVec<D>& f, std::size_t lin) {
       u[lin] = static_cast<float>(field.velocity(toVec3<D>(u.position(f)))[a]);
     });
   }
+  transport_.setVelocity(velocity);
 }
 
 template <int D>
@@ -46,7 +48,7 @@ void GasSolver<D>::setSolid(const Grid<float, D>& solid) {
 
 template <int D>
 double GasSolver<D>::stableTimestep() const {
-  return params_.cfl * transport_.maxStableDt(velocity_, std::max(params_.densityDiffusion, params_.temperatureDiffusion));
+  return params_.cfl * transport_.maxStableDt(std::max(params_.densityDiffusion, params_.temperatureDiffusion));
 }
 
 template <int D>
@@ -83,13 +85,13 @@ void GasSolver<D>::step(double dt) {
   numerics::TransportSettings densitySettings;
   densitySettings.form = numerics::TransportForm::Conservative;
   densitySettings.diffusivity = params_.densityDiffusion;
-  transport_.step(density_, velocity_, densitySettings, dt);
+  transport_.step(density_, densitySettings, dt);
 
   numerics::TransportSettings temperatureSettings;
   temperatureSettings.form = numerics::TransportForm::Advective;
   temperatureSettings.diffusivity = params_.temperatureDiffusion;
   temperatureSettings.inflowValue = params_.ambientTemperature;
-  transport_.step(temperature_, velocity_, temperatureSettings, dt);
+  transport_.step(temperature_, temperatureSettings, dt);
   // Exact integration of the linear loss terms over the step (no stability limit of their own).
   decay(dt);
 }

@@ -63,7 +63,7 @@ class GasSolver {
   const Grid<float, D>& density() const { return density_; }
   Grid<float, D>& temperature() { return temperature_; }
   const Grid<float, D>& temperature() const { return temperature_; }
-  const MacGrid<D>& velocity() const { return velocity_; }
+  const MacGrid<D>& velocity() const { return transport_.velocity(); }
   const Grid<float, D>& solid() const { return transport_.solid(); }
   const GridSpec<D>& spec() const { return spec_; }
   const GasParams& params() const { return params_; }
@@ -74,7 +74,6 @@ class GasSolver {
 
   GridSpec<D> spec_;
   GasParams params_;
-  MacGrid<D> velocity_;  // the motion field sampled on cell faces (steady)
   Grid<float, D> density_;
   Grid<float, D> temperature_;
   numerics::FluxTransport<D> transport_;

@@ -1,5 +1,6 @@
 #include "msim/fluid/gas/motion_field.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -41,9 +42,18 @@ Vec3 MotionField::primitive(const MotionFieldInstance& inst, const Vec3& p) {
   switch (inst.type) {
     case MotionPrimitive::Uniform:
       return Vec3::UnitZ();
-    case MotionPrimitive::Directional:
-      if (std::abs(p.x()) <= 1.0 && std::abs(p.y()) <= 1.0 && p.z() > 0.0) return decay(p.z(), h) * Vec3::UnitZ();
-      return Vec3::Zero();
+    case MotionPrimitive::Directional: {
+      if (std::abs(p.x()) > 1.0 || std::abs(p.y()) > 1.0 || p.z() <= 0.0) return Vec3::Zero();
+      // Stam notes the hard cutoff "can be smoothed out by multiplying the field by a smooth
+      // function which is zero outside of the unit square": a smoothstep over the outer band.
+      double mask = 1.0;
+      if (inst.edgeSoftness > 0.0)
+        for (double t : {std::abs(p.x()), std::abs(p.y())}) {
+          const double s = std::clamp((1.0 - t) / inst.edgeSoftness, 0.0, 1.0);
+          mask *= s * s * (3.0 - 2.0 * s);
+        }
+      return mask * decay(p.z(), h) * Vec3::UnitZ();
+    }
     case MotionPrimitive::Radial: {
       // Printed as (d/|d|) W(d) x/(d+1); d + 1 = |x|, and W takes the distance to the sphere.
       const double r = p.norm();

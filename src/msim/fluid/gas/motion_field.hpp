@@ -18,7 +18,7 @@ namespace msim::fluid {
 
 enum class MotionPrimitive {
   Uniform,      // constant wind along the axis, everywhere (no decay)
-  Directional,  // W(z) e_z inside the half-infinite box |x|,|y| <= 1, z > 0
+  Directional,  // W(z) e_z inside the half-infinite box |x|,|y| <= 1, z > 0 (optionally soft-edged)
   Radial,       // sign(d) W(|d|) x/|x|, d = |x| - 1: out of the unit sphere outside, inwards inside
   Cone,         // W(|x|) x/|x| inside the upward cone x^2 + y^2 < z^2, z > 0 (heat expansion)
   Source,       // W(|x|) x/|x|: point source (a sink with a negative magnitude)
@@ -35,6 +35,8 @@ struct MotionFieldInstance {
   Vec3 scale = Vec3::Ones();          // local-to-world scale per local axis [m]
   double ringRadius = 1.0;            // R, local units (ring vortex)
   double coreRadius = 0.05;           // vortex core, local units: removes the 1/r singularity
+  double edgeSoftness = 0.0;          // directional: fraction of the half-width over which the field
+                                      // fades to zero (0: the hard cutoff printed in the seed)
 };
 
 class MotionField {
