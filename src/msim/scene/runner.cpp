@@ -244,7 +244,7 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
     }
   }
   record.save(status == RunStatus::Complete ? "complete" : "interrupted", timers, wall());
-  std::fprintf(stderr, "%s", timers.formatTable().c_str());
+  if (options.showProgress) std::fprintf(stderr, "%s", timers.formatTable().c_str());
   return status;
 }
 
