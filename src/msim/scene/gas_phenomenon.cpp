@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "msim/core/error.hpp"
+#include "msim/scene/json_vectors.hpp"
 #include "msim/core/parallel.hpp"
 #include "msim/fluid/gas/gas_solver.hpp"
 #include "msim/geometry/occupancy.hpp"
@@ -64,12 +65,6 @@ double gasBytesPerCell(int dimensions) {
   return 4.0 * (5 + 3 * dimensions + 3);
 }
 
-Vec3 padded(const json& v, double fill = 0.0) {
-  Vec3 p = Vec3::Constant(fill);
-  for (std::size_t i = 0; i < v.size(); ++i) p[static_cast<int>(i)] = v[i].get<double>();
-  return p;
-}
-
 int axisIndex(const json& name) { return name.get<std::string>()[0] - 'x'; }
 
 fluid::MotionField motionField(const json& fields) {
@@ -78,9 +73,9 @@ fluid::MotionField motionField(const json& fields) {
     fluid::MotionFieldInstance m;
     m.type = fluid::parseMotionPrimitive(f.at("type").get<std::string>());
     m.magnitude = f.at("magnitude").get<double>();
-    m.position = padded(f.at("position"));
-    m.axis = padded(f.at("axis"));
-    m.scale = padded(f.at("scale"), 1.0);
+    m.position = paddedVec3(f.at("position"));
+    m.axis = paddedVec3(f.at("axis"));
+    m.scale = paddedVec3(f.at("scale"), 1.0);
     m.halfDistance = f.at("half_distance").get<double>();
     m.ringRadius = f.at("ring_radius").get<double>();
     m.coreRadius = f.at("core_radius").get<double>();

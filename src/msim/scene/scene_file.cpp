@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "msim/core/error.hpp"
+#include "msim/scene/json_vectors.hpp"
 #include "msim/core/system_memory.hpp"
 #include "msim/scene/schema/json_file.hpp"
 #include "msim/scene/schema/key_suggestion.hpp"
@@ -51,12 +52,6 @@ Schema outputsSchema() {
   preview.integer("width", 480, "minimum picture width (integer upscaling)").min(16).max(8192);
   outputs.field("preview", preview);
   return outputs;
-}
-
-Vec3 padded(const nlohmann::json& v) {
-  Vec3 p = Vec3::Zero();
-  for (std::size_t i = 0; i < v.size(); ++i) p[static_cast<int>(i)] = v[i].get<double>();
-  return p;
 }
 
 const PhenomenonType& pickPhenomenon(const nlohmann::json& raw, const std::string& source) {
@@ -107,7 +102,7 @@ Scene loadScene(const std::filesystem::path& file, const std::vector<std::string
     throw InputError(fmt::format("{}: 'domain.min' has {} numbers but 'domain.max' has {}; both must be 2 (2D) or 3 (3D)",
                                  source, lo.size(), hi.size()));
   scene.dimensions = static_cast<int>(lo.size());
-  const Vec3 minCorner = padded(lo), maxCorner = padded(hi);
+  const Vec3 minCorner = paddedVec3(lo), maxCorner = paddedVec3(hi);
   double longest = 0.0;
   for (int a = 0; a < scene.dimensions; ++a) {
     const double extent = maxCorner[a] - minCorner[a];
