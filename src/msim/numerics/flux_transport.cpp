@@ -35,6 +35,7 @@ FluxTransport<D>::FluxTransport(const GridSpec<D>& spec, const TransportBoundari
       flux_(spec),
       velocity_(spec),
       openVelocity_(spec),
+      netOutflow_(spec),
       stage_(spec),
       rate_(spec) {}
 
@@ -59,17 +60,20 @@ void FluxTransport<D>::updateOpenVelocity() {
       open[lin] = faceOpen(a, f) ? u[lin] : 0.0f;
     });
   }
-  // Courant sum of each fluid cell: over axes, the larger |u| of its two faces.
+  // Per fluid cell: the Courant sum (over axes, the larger |u| of its two faces) for the stable
+  // step, and the net outflow sum_a (u_upper - u_lower) = dx div(u) for the advective form.
   std::vector<float> courant(spec_.cellCount(), 0.0f);
   parallelForCells<D>(spec_.res, [&](const IVec<D>& c, std::size_t lin) {
-    float sum = 0.0f;
+    float sum = 0.0f, outflow = 0.0f;
     for (int a = 0; a < D; ++a) {
       const auto& u = openVelocity_.component(a);
       IVec<D> upper = c;
       upper[a] += 1;
       sum += std::max(std::abs(u(c)), std::abs(u(upper)));
+      outflow += u(upper) - u(c);
     }
     courant[lin] = sum;
+    netOutflow_[lin] = outflow;
   });
   maxCourantSum_ = *std::max_element(courant.begin(), courant.end());
 }
@@ -146,17 +150,14 @@ void FluxTransport<D>::evaluateRate(const Grid<float, D>& phi, const TransportSe
       rate[lin] = 0.0f;
       return;
     }
-    float netOut = 0.0f, divergence = 0.0f;
+    float netOut = 0.0f;
     for (int a = 0; a < D; ++a) {
       const auto& flux = flux_.component(a);
-      const auto& u = openVelocity_.component(a);
       const std::size_t lower = flux.index(c);
-      const std::size_t upper = lower + flux.stride(a);
-      netOut += flux[upper] - flux[lower];
-      divergence += u[upper] - u[lower];
+      netOut += flux[lower + flux.stride(a)] - flux[lower];
     }
     float r = -netOut * invDx;
-    if (advective) r += phi[lin] * divergence * invDx;
+    if (advective) r += phi[lin] * netOutflow_[lin] * invDx;
     rate[lin] = r;
   });
 }

@@ -74,6 +74,7 @@ class FluxTransport {
   MacGrid<D> flux_;          // advective + diffusive flux per unit area through each face
   MacGrid<D> velocity_;      // as given
   MacGrid<D> openVelocity_;  // velocity_ where the face is open, 0 elsewhere
+  Grid<float, D> netOutflow_;   // dx div(u) per cell, from the open face velocities
   double maxCourantSum_ = 0.0;  // max over cells of sum_a max(|u| on its two a-faces) [m/s]
   Grid<float, D> stage_;     // RK intermediate state
   Grid<float, D> rate_;

@@ -60,9 +60,10 @@ void declareGas(Schema& root) {
 }
 
 double gasBytesPerCell(int dimensions) {
-  // density, temperature, solid, RK stage, rate (5 floats) + velocity, flux and open-face velocity
-  // (3 x D floats) + the preview's light buffer and the VDB copies of two fields (~3 floats).
-  return 4.0 * (5 + 3 * dimensions + 3);
+  // density, temperature, solid, RK stage, rate, net outflow (6 floats) + velocity, flux and
+  // open-face velocity (3 x D floats) + the preview's light buffer and the VDB copies of two
+  // fields (~3 floats).
+  return 4.0 * (6 + 3 * dimensions + 3);
 }
 
 int axisIndex(const json& name) { return name.get<std::string>()[0] - 'x'; }
