@@ -63,7 +63,8 @@ Grid<float, 3> readFloatGrid(const std::filesystem::path& path, const std::strin
 // Reads a Vec3s (or Vec3d, converted to float) grid, as readFloatGrid.
 Grid<Vecf<3>, 3> readVectorGrid(const std::filesystem::path& path, const std::string& name);
 // Reads a point set: positions and every float attribute, in the original order for points
-// written by msim. InputError as readFloatGrid.
+// written by msim. An empty set comes back without attributes (VDB keeps attribute names in the
+// leaves, and an empty grid has none). InputError as readFloatGrid.
 PointCloud readPoints(const std::filesystem::path& path, const std::string& name);
 
 }  // namespace msim::io
