@@ -1,6 +1,6 @@
 #pragma once
 // The unit cube [0,1]^3 as 12 outward-wound triangles, shared by the mesh tests.
-#include "msim/geometry/triangle_mesh.hpp"
+#include "msim/core/triangle_mesh.hpp"
 
 namespace msim::geometry::testing {
 

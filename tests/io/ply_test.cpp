@@ -44,8 +44,8 @@ void expectBitEqual(const PointCloud& a, const PointCloud& b) {
   }
 }
 
-geometry::TriangleMesh tetrahedron() {
-  geometry::TriangleMesh mesh;
+TriangleMesh tetrahedron() {
+  TriangleMesh mesh;
   mesh.vertices = {Vec3(0, 0, 0), Vec3(1.0 / 3.0, 0, 0), Vec3(0, 1e-7, 0), Vec3(0.1, 0.2, -12345.678)};
   mesh.triangles = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}};
   return mesh;

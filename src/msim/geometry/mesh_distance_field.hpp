@@ -1,7 +1,7 @@
 #pragma once
 // Signed distance of a closed triangle mesh sampled on a grid, via OpenVDB's mesh-to-level-set.
 #include "msim/core/grid.hpp"
-#include "msim/geometry/triangle_mesh.hpp"
+#include "msim/core/triangle_mesh.hpp"
 
 namespace msim::geometry {
 

@@ -1,7 +1,7 @@
 #pragma once
 // A closed triangle mesh as a Shape.
 #include "msim/geometry/shape.hpp"
-#include "msim/geometry/triangle_mesh.hpp"
+#include "msim/core/triangle_mesh.hpp"
 
 namespace msim::geometry {
 

@@ -26,10 +26,10 @@ std::vector<std::string_view> words(std::string_view line) {
 
 }  // namespace
 
-geometry::TriangleMesh readObj(const std::filesystem::path& path) {
+TriangleMesh readObj(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path.string() + ": cannot open OBJ file");
-  geometry::TriangleMesh mesh;
+  TriangleMesh mesh;
   std::string line;
   int lineNo = 0;
   std::vector<int> corners;

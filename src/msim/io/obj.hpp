@@ -3,13 +3,13 @@
 // Texture coordinates, normals, groups and materials do not affect the geometry and are ignored.
 #include <filesystem>
 
-#include "msim/geometry/triangle_mesh.hpp"
+#include "msim/core/triangle_mesh.hpp"
 
 namespace msim::io {
 
 // Face corners may be written v, v/vt, v//vn or v/vt/vn; negative indices count back from the
 // last vertex defined so far. Polygons are fan-triangulated. InputError naming file:line for a
 // missing file, a malformed number, an out-of-range index or a face with fewer than 3 corners.
-geometry::TriangleMesh readObj(const std::filesystem::path& path);
+TriangleMesh readObj(const std::filesystem::path& path);
 
 }  // namespace msim::io

@@ -433,7 +433,7 @@ PointCloud readPlyPoints(const std::filesystem::path& path) {
   return cloud;
 }
 
-void writePlyMesh(const std::filesystem::path& path, const geometry::TriangleMesh& mesh,
+void writePlyMesh(const std::filesystem::path& path, const TriangleMesh& mesh,
                   std::span<const PointAttribute> vertexAttributes, const PlyWriteOptions& options) {
   const std::size_t n = mesh.vertices.size();
   checkAttributes(vertexAttributes, n, path);

@@ -9,7 +9,7 @@
 #include <span>
 #include <vector>
 
-#include "msim/geometry/triangle_mesh.hpp"
+#include "msim/core/triangle_mesh.hpp"
 #include "msim/io/point_cloud.hpp"
 
 namespace msim::io {
@@ -35,11 +35,11 @@ PointCloud readPlyPoints(const std::filesystem::path& path);
 // Element "vertex" (x y z, then the float vertex attributes) and element "face" with
 // `property list uchar int vertex_indices`. std::invalid_argument for out-of-range triangle
 // indices or bad attributes (as writePlyPoints).
-void writePlyMesh(const std::filesystem::path& path, const geometry::TriangleMesh& mesh,
+void writePlyMesh(const std::filesystem::path& path, const TriangleMesh& mesh,
                   std::span<const PointAttribute> vertexAttributes = {}, const PlyWriteOptions& options = {});
 
 struct PlyMesh {
-  geometry::TriangleMesh mesh;
+  TriangleMesh mesh;
   std::vector<PointAttribute> vertexAttributes;
 };
 
