@@ -5,7 +5,7 @@ SCENE ?= scenes/steam.json
 OUT ?= out/steam
 JOBS ?= $(shell nproc)
 
-.PHONY: deps configure build run test bench clean
+.PHONY: deps configure build app run test bench clean
 
 deps:
 	@bash scripts/install-deps.sh
@@ -16,7 +16,11 @@ configure: deps
 build: configure
 	@cmake --build $(BUILD_DIR) -j $(JOBS)
 
-run: build
+# The program alone: a first run should not wait for the test suite and benchmarks to compile.
+app: configure
+	@cmake --build $(BUILD_DIR) -j $(JOBS) --target msim_app
+
+run: app
 	$(BUILD_DIR)/bin/msim run $(SCENE) --out $(OUT)
 
 test: build

@@ -156,6 +156,9 @@ TEST(Cli, SourceOutsideTheDomainIsAnError) {
   const Result r = runMsim("validate " + (dir / "s.json").string());
   EXPECT_EQ(r.exitCode, 2) << r.output;
   EXPECT_NE(r.output.find("sources[0].shape"), std::string::npos) << r.output;
+  const Result run = runMsim("run " + (dir / "s.json").string() + " --out " + (dir / "out").string());
+  EXPECT_EQ(run.exitCode, 2) << run.output;
+  EXPECT_FALSE(fs::exists(dir / "out"));
 }
 
 TEST(Cli, CflBlowUpStopsWithAMessage) {

@@ -150,17 +150,18 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
   if (options.resume && !layout.vdb)
     throw InputError(scene.file.string() + ": --resume needs the VDB frames, but 'outputs.vdb' is false");
 
-  fs::create_directories(layout.root);
-  if (layout.vdb) fs::create_directories(layout.vdbDir);
-  if (layout.png) fs::create_directories(layout.pngDir);
-  for (const fs::path& dir : {layout.root, layout.vdbDir, layout.pngDir}) io::removeStaleTemporaries(dir);
-
+  // Build first: a scene that fails here (a mesh that does not load, a source outside the
+  // domain) must not leave even an empty output folder behind.
   StageTimers timers;
   std::unique_ptr<Phenomenon> phenomenon;
   {
     ScopedStage stage(timers, "setup");
     phenomenon = scene.type->create(scene, timers);
   }
+  fs::create_directories(layout.root);
+  if (layout.vdb) fs::create_directories(layout.vdbDir);
+  if (layout.png) fs::create_directories(layout.pngDir);
+  for (const fs::path& dir : {layout.root, layout.vdbDir, layout.pngDir}) io::removeStaleTemporaries(dir);
   RunRecord record(scene, options, layout);
 
   int firstFrame = 1;
