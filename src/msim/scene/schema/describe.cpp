@@ -85,27 +85,33 @@ std::vector<ParamRow> describe(const Schema& schema, const json& resolved) {
 }
 
 std::string formatParamTable(const std::vector<ParamRow>& rows) {
-  const std::array<std::string, 5> header{"parameter", "value", "default", "unit", "description"};
-  const auto cells = [](const ParamRow& r) {
-    return std::array<const std::string*, 5>{&r.path, &r.value, &r.defaultValue, &r.unit, &r.description};
+  // Columns before the description are capped so one long value (a scene's free-text
+  // description, a mesh path) does not push every other row off the screen; a cut value ends in "...".
+  constexpr std::size_t kMaxWidth = 36;
+  const auto fit = [](const std::string& text) {
+    return text.size() <= kMaxWidth ? text : text.substr(0, kMaxWidth - 3) + "...";
   };
+  const auto cells = [&](const ParamRow& r) {
+    return std::array<std::string, 5>{fit(r.path), fit(r.value), fit(r.defaultValue), fit(r.unit), r.description};
+  };
+  const std::array<std::string, 5> header{"parameter", "value", "default", "unit", "description"};
   std::array<std::size_t, 5> width{};
   for (std::size_t c = 0; c < 5; ++c) width[c] = header[c].size();
   for (const auto& r : rows) {
     const auto cs = cells(r);
-    for (std::size_t c = 0; c < 5; ++c) width[c] = std::max(width[c], cs[c]->size());
+    for (std::size_t c = 0; c < 5; ++c) width[c] = std::max(width[c], cs[c].size());
   }
-  const auto line = [&](const std::array<const std::string*, 5>& cs) {
+  const auto line = [&](const std::array<std::string, 5>& cs) {
     std::string text;
     for (std::size_t c = 0; c < 5; ++c) {
-      text += *cs[c];
+      text += cs[c];
       // The last column is not padded: trailing spaces only make copy-paste worse.
-      if (c + 1 < 5) text += std::string(width[c] - cs[c]->size() + 2, ' ');
+      if (c + 1 < 5) text += std::string(width[c] - cs[c].size() + 2, ' ');
     }
     text.erase(text.find_last_not_of(' ') + 1);
     return text + "\n";
   };
-  std::string out = line({&header[0], &header[1], &header[2], &header[3], &header[4]});
+  std::string out = line(header);
   for (const auto& r : rows) out += line(cells(r));
   return out;
 }
