@@ -12,15 +12,25 @@
 
 namespace msim {
 
+// The zero of a sample type: T{} for scalars, T::Zero() for Eigen vectors (whose T{} is
+// uninitialised).
+template <typename T>
+T zeroOf() {
+  if constexpr (requires { T::Zero(); })
+    return T::Zero();
+  else
+    return T{};
+}
+
 template <typename T, int D>
 class Grid {
  public:
   Grid() = default;
   // Cell-centred grid over spec.
-  explicit Grid(const GridSpec<D>& spec, T value = T{})
+  explicit Grid(const GridSpec<D>& spec, T value = zeroOf<T>())
       : Grid(spec, spec.res, Vec<D>::Constant(0.5), value) {}
   // General sampled grid: `samples` per axis at positions origin + (i + offset) * dx.
-  Grid(const GridSpec<D>& spec, const IVec<D>& samples, const Vec<D>& offset, T value = T{})
+  Grid(const GridSpec<D>& spec, const IVec<D>& samples, const Vec<D>& offset, T value = zeroOf<T>())
       : spec_(spec), size_(samples), offset_(offset) {
     std::size_t n = 1;
     for (int a = 0; a < D; ++a) {

@@ -1,0 +1,40 @@
+#pragma once
+// Vorticity confinement (Fedkiw, Stam and Jensen 2001; Selle ch. 3.2.1): the curl of the velocity,
+// omega = curl u (eq. 3.3), a unit field N = grad|omega| / |grad|omega|| pointing towards
+// concentrations of vorticity, and the force f = epsilon dx (N x omega) that spins those
+// concentrations back up after numerical dissipation. The dx factor makes the force vanish under
+// refinement, where the dissipation it compensates vanishes too.
+#include "msim/core/grid.hpp"
+#include "msim/core/mac_grid.hpp"
+
+namespace msim::fluid {
+
+// Vorticity at cell centres from the staggered velocity by central differences of the
+// face velocities averaged to the centres: 3 components in 3D; in 2D the scalar w_z is stored in
+// component 0 of a 1-vector. Exact for linear velocity fields away from the border (one-sided
+// differences at the border).
+template <int D>
+using Vorticity = Grid<Eigen::Matrix<float, (D == 3 ? 3 : 1), 1>, D>;
+
+template <int D>
+void computeVorticity(const MacGrid<D>& velocity, Vorticity<D>& vorticity);
+
+// Adds dt * f to the face velocities, with f = epsilon dx (N x omega) at cell centres averaged to
+// the faces. `vorticity` and `force` are scratch grids reused between calls (no allocation once
+// sized). Faces next to solid cells (solid > 0.5, optional) receive no force.
+template <int D>
+class VorticityConfinement {
+ public:
+  explicit VorticityConfinement(const GridSpec<D>& spec);
+  void apply(MacGrid<D>& velocity, double epsilon, double dt, const Grid<float, D>* solid = nullptr);
+  const Vorticity<D>& vorticity() const { return vorticity_; }
+  // Force per unit mass at cell centres from the last apply() [m/s^2].
+  const Grid<Vecf<D>, D>& force() const { return force_; }
+
+ private:
+  Vorticity<D> vorticity_;
+  Grid<float, D> magnitude_;
+  Grid<Vecf<D>, D> force_;
+};
+
+}  // namespace msim::fluid

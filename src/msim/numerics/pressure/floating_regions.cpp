@@ -1,0 +1,63 @@
+#include "msim/numerics/pressure/floating_regions.hpp"
+
+#include "msim/core/parallel.hpp"
+
+namespace msim::numerics {
+
+template <int D>
+FloatingRegions<D>::FloatingRegions(const MacGrid<D>& faceWeight) {
+  const GridSpec<D>& spec = faceWeight.spec();
+  const Grid<float, D> cells(spec);  // only for its index arithmetic
+  std::vector<std::uint8_t> visited(spec.cellCount(), 0);
+  std::vector<std::uint32_t> stack;
+  // Flood fill one region at a time (done once per change of the solids, not per solve).
+  for (std::size_t seed = 0; seed < visited.size(); ++seed) {
+    if (visited[seed]) continue;
+    std::vector<std::uint32_t> region;
+    bool grounded = false;
+    visited[seed] = 1;
+    stack.push_back(static_cast<std::uint32_t>(seed));
+    while (!stack.empty()) {
+      const std::uint32_t cell = stack.back();
+      stack.pop_back();
+      const IVec<D> c = cells.coord(cell);
+      bool open = false;
+      for (int a = 0; a < D; ++a) {
+        for (int side = 0; side < 2; ++side) {
+          IVec<D> face = c;
+          face[a] += side;
+          if (faceWeight.component(a)(face) <= 0.0f) continue;
+          open = true;
+          IVec<D> nb = c;
+          nb[a] += side ? 1 : -1;
+          if (!cells.inside(nb)) {
+            grounded = true;
+            continue;
+          }
+          const std::size_t n = cells.index(nb);
+          if (!visited[n]) {
+            visited[n] = 1;
+            stack.push_back(static_cast<std::uint32_t>(n));
+          }
+        }
+      }
+      if (open) region.push_back(cell);  // cells with no open face are inside the solid
+    }
+    if (!grounded && !region.empty()) regions_.push_back(std::move(region));
+  }
+}
+
+template <int D>
+void FloatingRegions<D>::removeMeans(std::vector<float>& v) const {
+  for (const auto& region : regions_) {
+    const double mean = parallelSum(region.size(), [&](std::size_t k) { return double(v[region[k]]); }) /
+                        static_cast<double>(region.size());
+    const float m = static_cast<float>(mean);
+    parallelFor(0, region.size(), [&](std::size_t k) { v[region[k]] -= m; });
+  }
+}
+
+template class FloatingRegions<2>;
+template class FloatingRegions<3>;
+
+}  // namespace msim::numerics

@@ -1,0 +1,221 @@
+#include "msim/numerics/pressure/multigrid.hpp"
+
+#include "msim/core/parallel.hpp"
+
+namespace msim::numerics {
+
+namespace {
+
+// 1D weight of coarse cell C in the linear prolongation to fine cell f: a fine cell lies at
+// 1/4 of a coarse spacing from its parent I and 3/4 from the neighbour J on its side; with no
+// neighbour (domain edge) the parent's value is used alone. The restriction uses the same weights
+// (transposed), so R and P are exact transposes of each other.
+inline float weight1D(int f, int C, int coarseCount) {
+  const int I = f / 2;
+  const int J = (f % 2 == 0) ? I - 1 : I + 1;
+  const bool hasJ = J >= 0 && J < coarseCount;
+  if (C == I) return hasJ ? 0.75f : 1.0f;
+  return (C == J && hasJ) ? 0.25f : 0.0f;
+}
+
+template <int D>
+bool canCoarsen(const IVec<D>& res, int minCells) {
+  for (int a = 0; a < D; ++a)
+    if (res[a] % 2 != 0 || res[a] / 2 < minCells) return false;
+  return true;
+}
+
+}  // namespace
+
+template <int D>
+MacGrid<D> coarsenFaceWeights(const MacGrid<D>& fine) {
+  const GridSpec<D>& fs = fine.spec();
+  const GridSpec<D> cs(fs.origin, 2.0 * fs.dx, (fs.res / 2).eval());
+  MacGrid<D> coarse(cs);
+  constexpr int kSub = 1 << (D - 1);
+  for (int a = 0; a < D; ++a) {
+    const auto& wf = fine.component(a);
+    auto& wc = coarse.component(a);
+    parallelForCells(wc, [&](const IVec<D>& F, std::size_t lin) {
+      float sum = 0.0f;
+      for (int m = 0; m < kSub; ++m) {
+        IVec<D> f = 2 * F;
+        int bit = 0;
+        for (int b = 0; b < D; ++b)
+          if (b != a) f[b] += (m >> bit++) & 1;
+        sum += wf(f);
+      }
+      wc[lin] = sum / kSub;
+    });
+  }
+  return coarse;
+}
+
+template <int D>
+MultigridPreconditioner<D>::MultigridPreconditioner(const PoissonMatrix<D>& fine, const MacGrid<D>& fineFaceWeight,
+                                                    const MultigridSettings& settings)
+    : settings_(settings) {
+  MacGrid<D> weights;
+  const MacGrid<D>* current = &fineFaceWeight;
+  IVec<D> res = fine.res();
+  int levels = 1;
+  while (canCoarsen<D>(res, settings.coarsestMinCells)) {
+    res /= 2;
+    ++levels;
+  }
+  coarse_.reserve(levels - 1);  // matrices_ points into coarse_, which must not reallocate
+  matrices_.push_back(&fine);
+  for (int l = 1; l < levels; ++l) {
+    weights = coarsenFaceWeights(*current);
+    current = &weights;
+    coarse_.emplace_back(weights);
+    matrices_.push_back(&coarse_.back());
+  }
+  transfer_.resize(levels - 1);
+  for (int l = 0; l + 1 < levels; ++l) {
+    for (int a = 0; a < D; ++a) {
+      const int nf = matrices_[l]->res()[a], nc = matrices_[l + 1]->res()[a];
+      Transfer1D& t = transfer_[l][a];
+      for (int f = 0; f < nf; ++f) {
+        const int I = f / 2;
+        const int J = (f % 2 == 0) ? I - 1 : I + 1;
+        const bool hasJ = J >= 0 && J < nc;
+        t.parent.push_back(I);
+        t.parentWeight.push_back(weight1D(f, I, nc));
+        t.side.push_back(hasJ ? J : I);
+        t.sideWeight.push_back(hasJ ? weight1D(f, J, nc) : 0.0f);
+      }
+      for (int C = 0; C < nc; ++C) {
+        std::array<int, 4> idx{};
+        std::array<float, 4> w{};
+        for (int k = 0; k < 4; ++k) {
+          const int f = 2 * C - 1 + k;
+          const bool inside = f >= 0 && f < nf;
+          idx[k] = inside ? f : 2 * C;
+          w[k] = inside ? weight1D(f, C, nc) : 0.0f;
+        }
+        t.fine.push_back(idx);
+        t.fineWeight.push_back(w);
+      }
+    }
+  }
+  b_.resize(levels);
+  x_.resize(levels);
+  r_.resize(levels);
+  for (int l = 0; l < levels; ++l) {
+    const std::size_t n = matrices_[l]->size();
+    r_[l].assign(n, 0.0f);
+    if (l > 0) {
+      b_[l].assign(n, 0.0f);
+      x_[l].assign(n, 0.0f);
+    }
+  }
+}
+
+template <int D>
+void MultigridPreconditioner<D>::apply(const std::vector<float>& r, std::vector<float>& z) {
+  vcycle(0, r, z);
+}
+
+template <int D>
+void MultigridPreconditioner<D>::smooth(int level, const std::vector<float>& b, std::vector<float>& x, int first,
+                                        int sweeps) {
+  for (int s = 0; s < sweeps; ++s) {
+    matrices_[level]->gaussSeidel(b, x, first);
+    matrices_[level]->gaussSeidel(b, x, 1 - first);
+  }
+}
+
+template <int D>
+void MultigridPreconditioner<D>::vcycle(int level, const std::vector<float>& b, std::vector<float>& x) {
+  const PoissonMatrix<D>& A = *matrices_[level];
+  std::fill(x.begin(), x.end(), 0.0f);
+  if (level + 1 == levelCount()) {
+    // Red, then (black, red) pairs: a palindrome, hence a symmetric approximate inverse.
+    A.gaussSeidel(b, x, 0);
+    for (int s = 0; s < settings_.coarsestSweeps; ++s) {
+      A.gaussSeidel(b, x, 1);
+      A.gaussSeidel(b, x, 0);
+    }
+    return;
+  }
+  smooth(level, b, x, 0, settings_.smoothingSweeps);
+  A.residual(b, x, r_[level]);
+  restrictResidual(level);
+  vcycle(level + 1, b_[level + 1], x_[level + 1]);
+  prolongAdd(level, x);
+  smooth(level, b, x, 1, settings_.smoothingSweeps);
+}
+
+template <int D>
+void MultigridPreconditioner<D>::restrictResidual(int fineLevel) {
+  const PoissonMatrix<D>& fine = *matrices_[fineLevel];
+  const PoissonMatrix<D>& coarse = *matrices_[fineLevel + 1];
+  const auto& t = transfer_[fineLevel];
+  const std::vector<float>& r = r_[fineLevel];
+  std::vector<float>& b = b_[fineLevel + 1];
+  constexpr float kScale = 4.0f / (1 << D);
+  parallelForCells<D>(coarse.res(), [&](const IVec<D>& C, std::size_t lin) {
+    if (coarse.diag()[lin] <= 0.0f) {
+      b[lin] = 0.0f;
+      return;
+    }
+    const auto& fx = t[0].fine[C[0]];
+    const auto& wx = t[0].fineWeight[C[0]];
+    float sum = 0.0f;
+    if constexpr (D == 2) {
+      for (int j = 0; j < 4; ++j) {
+        const float* row = r.data() + static_cast<std::size_t>(t[1].fine[C[1]][j]) * fine.stride(1);
+        float s = 0.0f;
+        for (int i = 0; i < 4; ++i) s += wx[i] * row[fx[i]];
+        sum += t[1].fineWeight[C[1]][j] * s;
+      }
+    } else {
+      for (int k = 0; k < 4; ++k) {
+        const std::size_t zk = static_cast<std::size_t>(t[2].fine[C[2]][k]) * fine.stride(2);
+        float sk = 0.0f;
+        for (int j = 0; j < 4; ++j) {
+          const float* row = r.data() + zk + static_cast<std::size_t>(t[1].fine[C[1]][j]) * fine.stride(1);
+          float s = 0.0f;
+          for (int i = 0; i < 4; ++i) s += wx[i] * row[fx[i]];
+          sk += t[1].fineWeight[C[1]][j] * s;
+        }
+        sum += t[2].fineWeight[C[2]][k] * sk;
+      }
+    }
+    b[lin] = kScale * sum;
+  });
+}
+
+template <int D>
+void MultigridPreconditioner<D>::prolongAdd(int fineLevel, std::vector<float>& fineX) {
+  const PoissonMatrix<D>& fine = *matrices_[fineLevel];
+  const PoissonMatrix<D>& coarse = *matrices_[fineLevel + 1];
+  const auto& t = transfer_[fineLevel];
+  const std::vector<float>& xc = x_[fineLevel + 1];
+  parallelForCells<D>(fine.res(), [&](const IVec<D>& f, std::size_t lin) {
+    if (fine.diag()[lin] <= 0.0f) return;  // excluded cells stay at 0
+    const int xi[2] = {t[0].parent[f[0]], t[0].side[f[0]]};
+    const float wi[2] = {t[0].parentWeight[f[0]], t[0].sideWeight[f[0]]};
+    auto rowSum = [&](std::size_t rowBase) { return wi[0] * xc[rowBase + xi[0]] + wi[1] * xc[rowBase + xi[1]]; };
+    const std::size_t yj[2] = {t[1].parent[f[1]] * coarse.stride(1), t[1].side[f[1]] * coarse.stride(1)};
+    const float wj[2] = {t[1].parentWeight[f[1]], t[1].sideWeight[f[1]]};
+    float sum;
+    if constexpr (D == 2) {
+      sum = wj[0] * rowSum(yj[0]) + wj[1] * rowSum(yj[1]);
+    } else {
+      sum = 0.0f;
+      const std::size_t zk[2] = {t[2].parent[f[2]] * coarse.stride(2), t[2].side[f[2]] * coarse.stride(2)};
+      const float wk[2] = {t[2].parentWeight[f[2]], t[2].sideWeight[f[2]]};
+      for (int k = 0; k < 2; ++k) sum += wk[k] * (wj[0] * rowSum(zk[k] + yj[0]) + wj[1] * rowSum(zk[k] + yj[1]));
+    }
+    fineX[lin] += sum;
+  });
+}
+
+template MacGrid<2> coarsenFaceWeights<2>(const MacGrid<2>&);
+template MacGrid<3> coarsenFaceWeights<3>(const MacGrid<3>&);
+template class MultigridPreconditioner<2>;
+template class MultigridPreconditioner<3>;
+
+}  // namespace msim::numerics
