@@ -22,52 +22,55 @@ auto centralDifference(const Grid<T, D>& g, const IVec<D>& c, int axis, double d
 
 // Velocity at cell centres: the mean of the two faces of each axis.
 template <int D>
-Vecf<D> centreVelocity(const MacGrid<D>& u, const IVec<D>& c) {
-  Vecf<D> v;
-  for (int a = 0; a < D; ++a) {
-    IVec<D> upper = c;
-    upper[a] += 1;
-    v[a] = 0.5f * (u.component(a)(c) + u.component(a)(upper));
-  }
-  return v;
+void centreVelocities(const MacGrid<D>& u, Grid<Vecf<D>, D>& centre) {
+  parallelForCells(centre, [&](const IVec<D>& c, std::size_t lin) {
+    Vecf<D> v;
+    for (int a = 0; a < D; ++a) {
+      const auto& face = u.component(a);
+      const std::size_t lower = face.index(c);
+      v[a] = 0.5f * (face[lower] + face[lower + face.stride(a)]);
+    }
+    centre[lin] = v;
+  });
 }
 
-// d(u_component)/d(x_axis) at cell c from centre velocities of the neighbours.
 template <int D>
-double velocityDerivative(const MacGrid<D>& u, const IVec<D>& c, int component, int axis) {
-  const IVec<D>& res = u.spec().res;
-  IVec<D> lo = c, hi = c;
-  if (c[axis] > 0) lo[axis] -= 1;
-  if (c[axis] + 1 < res[axis]) hi[axis] += 1;
-  const double span = (hi[axis] - lo[axis]) * u.spec().dx;
-  if (span <= 0.0) return 0.0;
-  return (centreVelocity<D>(u, hi)[component] - centreVelocity<D>(u, lo)[component]) / span;
+void vorticityFromCentres(const Grid<Vecf<D>, D>& centre, Vorticity<D>& vorticity) {
+  const double dx = centre.spec().dx;
+  parallelForCells(vorticity, [&](const IVec<D>& c, std::size_t lin) {
+    // d(u_component)/d(x_axis) by central differences of the centre velocities.
+    auto d = [&](int component, int axis) {
+      return centralDifference(centre, c, axis, dx, [component](const Vecf<D>& v) { return static_cast<double>(v[component]); });
+    };
+    auto& w = vorticity[lin];
+    if constexpr (D == 2) {
+      w[0] = static_cast<float>(d(1, 0) - d(0, 1));
+    } else {
+      w[0] = static_cast<float>(d(2, 1) - d(1, 2));
+      w[1] = static_cast<float>(d(0, 2) - d(2, 0));
+      w[2] = static_cast<float>(d(1, 0) - d(0, 1));
+    }
+  });
 }
 
 }  // namespace
 
 template <int D>
 void computeVorticity(const MacGrid<D>& velocity, Vorticity<D>& vorticity) {
-  parallelForCells(vorticity, [&](const IVec<D>& c, std::size_t lin) {
-    auto& w = vorticity[lin];
-    if constexpr (D == 2) {
-      w[0] = static_cast<float>(velocityDerivative<2>(velocity, c, 1, 0) - velocityDerivative<2>(velocity, c, 0, 1));
-    } else {
-      w[0] = static_cast<float>(velocityDerivative<3>(velocity, c, 2, 1) - velocityDerivative<3>(velocity, c, 1, 2));
-      w[1] = static_cast<float>(velocityDerivative<3>(velocity, c, 0, 2) - velocityDerivative<3>(velocity, c, 2, 0));
-      w[2] = static_cast<float>(velocityDerivative<3>(velocity, c, 1, 0) - velocityDerivative<3>(velocity, c, 0, 1));
-    }
-  });
+  Grid<Vecf<D>, D> centre(velocity.spec());
+  centreVelocities<D>(velocity, centre);
+  vorticityFromCentres<D>(centre, vorticity);
 }
 
 template <int D>
 VorticityConfinement<D>::VorticityConfinement(const GridSpec<D>& spec)
-    : vorticity_(spec), magnitude_(spec), force_(spec) {}
+    : centre_(spec), vorticity_(spec), magnitude_(spec), force_(spec) {}
 
 template <int D>
 void VorticityConfinement<D>::apply(MacGrid<D>& velocity, double epsilon, double dt, const Grid<float, D>* solid) {
   const GridSpec<D>& spec = velocity.spec();
-  computeVorticity<D>(velocity, vorticity_);
+  centreVelocities<D>(velocity, centre_);
+  vorticityFromCentres<D>(centre_, vorticity_);
   parallelFor(0, magnitude_.count(), [&](std::size_t i) { magnitude_[i] = vorticity_[i].norm(); });
 
   const double dx = spec.dx;

@@ -20,8 +20,8 @@ template <int D>
 void computeVorticity(const MacGrid<D>& velocity, Vorticity<D>& vorticity);
 
 // Adds dt * f to the face velocities, with f = epsilon dx (N x omega) at cell centres averaged to
-// the faces. `vorticity` and `force` are scratch grids reused between calls (no allocation once
-// sized). Faces next to solid cells (solid > 0.5, optional) receive no force.
+// the faces. The centre velocities, vorticity and force are scratch grids reused between calls
+// (no allocation per step). Faces next to solid cells (solid > 0.5, optional) receive no force.
 template <int D>
 class VorticityConfinement {
  public:
@@ -32,6 +32,7 @@ class VorticityConfinement {
   const Grid<Vecf<D>, D>& force() const { return force_; }
 
  private:
+  Grid<Vecf<D>, D> centre_;
   Vorticity<D> vorticity_;
   Grid<float, D> magnitude_;
   Grid<Vecf<D>, D> force_;

@@ -10,7 +10,8 @@
 // studies need it; both run the same code. The velocity is always a float MacGrid over `spec`.
 //
 // Scratch grids live in the object and are reused while the field layout stays the same, so
-// steady stepping allocates nothing.
+// steady stepping allocates nothing. Semi-Lagrangian feet are cached: advecting several scalars
+// by the same velocity and dt traces the characteristics once (see Feet below).
 #include <concepts>
 #include <cstdint>
 #include <optional>
@@ -20,7 +21,7 @@
 #include "msim/core/mac_grid.hpp"
 #include "msim/numerics/advection/advection_settings.hpp"
 #include "msim/numerics/advection/field_layout.hpp"
-#include "msim/numerics/advection/velocity_sampler.hpp"
+#include "msim/numerics/advection/semi_lagrangian.hpp"
 
 namespace msim::numerics {
 
@@ -49,18 +50,38 @@ class Advector {
   struct Scratch {
     Grid<T, D> forward, backward, corrected, lo, hi;
     std::vector<std::uint8_t> solid, touched;
+    std::uint64_t solidVersion = 0;  // the solids `solid` was marked for (0: not marked)
+  };
+  // Semi-Lagrangian feet of the last field layout traced. They are reused while the layout, the
+  // velocity (compared by value against velocity_), dt, the trace and the solids stay the same,
+  // so every scalar after the first advected by one velocity skips the tracing.
+  struct FeetCache {
+    bool valid = false;
+    GridSpec<D> spec;
+    IVec<D> size;
+    Vec<D> offset;
+    double dt = 0.0;
+    BackTrace trace = BackTrace::RK2;
+    std::uint64_t solidVersion = 0;
+    Feet<T, D> forward, backward;
+    std::vector<std::uint8_t> touched;  // either stencil reads a solid sample (ch. 2.9)
   };
   Scratch& scratchFor(const Grid<T, D>& field, int slot);
-  void markSolidSamples(const Grid<T, D>& field, std::vector<std::uint8_t>& flags) const;
-  void advectComponent(Grid<T, D>& field, const VelocitySampler<D>& forward, const VelocitySampler<D>& backward,
-                       double dt, Scratch& s);
+  const std::uint8_t* solidSamples(const Grid<T, D>& field, Scratch& s);
+  const FeetCache& feetFor(const Grid<T, D>& field, double dt, const std::uint8_t* solid);
+  void holdVelocity(const MacGrid<D>& velocity);
+  void advectComponent(Grid<T, D>& field, double dt, Scratch& s);
 
   GridSpec<D> spec_;
   AdvectionSettings settings_;
   AxisBoundaries<D> boundaries_;
   std::optional<Grid<float, D>> solid_;
-  Scratch scratch_[D + 1];   // slot 0: cell-centred / arbitrary grids, slot 1 + a: face component a
-  MacGrid<D> velocityCopy_;  // for self-advection of a MAC grid
+  std::uint64_t solidVersion_ = 0;  // bumped by setSolid
+  Scratch scratch_[D + 1];  // slot 0: cell-centred / arbitrary grids, slot 1 + a: face component a
+  // Copy of the velocity being advected with: the key of feet_, and the velocity of time n when a
+  // MAC grid advects itself.
+  MacGrid<D> velocity_;
+  FeetCache feet_;
 };
 
 }  // namespace msim::numerics

@@ -42,28 +42,11 @@ double upwind(const FieldLayout<D>& layout, const T* src, const IVec<D>& c, std:
   return centre - dt / layout.dx * change;
 }
 
-// Ch. 2.3: phi(X, t+dt) = I(phi^n, foot), foot the upstream end of the characteristic through X.
-template <typename T, int D>
-double semiLagrangian(const FieldLayout<D>& layout, const T* src, const Vec<D>& x, const Vec<D>& ux,
-                      BackTrace trace, const VelocitySampler<D>& velocity, double dt, const std::uint8_t* solid,
-                      ReadSet& read) {
-  const Vec<D> foot = trace == BackTrace::Euler ? Vec<D>(x - dt * ux) : Vec<D>(x - dt * velocity(x - 0.5 * dt * ux));
-  const InterpolationStencil<D> st = layout.stencil(foot);
-  double v = 0.0;
-  for (int k = 0; k < InterpolationStencil<D>::kCorners; ++k) {
-    const double s = src[st.index[k]];
-    v += st.weight[k] * s;
-    read.add(s, solid && solid[st.index[k]]);
-  }
-  return v;
-}
-
 }  // namespace
 
 template <typename T, int D>
-void firstOrderStep(BuildingBlock block, BackTrace trace, const FieldLayout<D>& layout, const Grid<T, D>& src,
-                    Grid<T, D>& dst, const VelocitySampler<D>& velocity, double dt, const std::uint8_t* solid,
-                    const StepOutputs<T>& out) {
+void upwindStep(const FieldLayout<D>& layout, const Grid<T, D>& src, Grid<T, D>& dst,
+                const VelocitySampler<D>& velocity, double dt, const std::uint8_t* solid, const StepOutputs<T>& out) {
   const T* in = src.data().data();
   T* result = dst.data().data();
   parallelForCells<D>(layout.size, [&](const IVec<D>& c, std::size_t lin) {
@@ -72,12 +55,8 @@ void firstOrderStep(BuildingBlock block, BackTrace trace, const FieldLayout<D>& 
       if (out.lo) out.lo[lin] = out.hi[lin] = in[lin];
       return;
     }
-    const Vec<D> x = layout.position(c);
-    const Vec<D> ux = velocity(x);
     ReadSet read;
-    const double v = block == BuildingBlock::Upwind
-                         ? upwind(layout, in, c, lin, ux, dt, solid, read)
-                         : semiLagrangian(layout, in, x, ux, trace, velocity, dt, solid, read);
+    const double v = upwind(layout, in, c, lin, velocity(layout.position(c)), dt, solid, read);
     result[lin] = static_cast<T>(v);
     if (out.lo) {
       out.lo[lin] = static_cast<T>(read.lo);
@@ -88,9 +67,8 @@ void firstOrderStep(BuildingBlock block, BackTrace trace, const FieldLayout<D>& 
 }
 
 #define MSIM_INSTANTIATE(T, D)                                                                                   \
-  template void firstOrderStep<T, D>(BuildingBlock, BackTrace, const FieldLayout<D>&, const Grid<T, D>&,        \
-                                     Grid<T, D>&, const VelocitySampler<D>&, double, const std::uint8_t*, \
-                                     const StepOutputs<T>&);
+  template void upwindStep<T, D>(const FieldLayout<D>&, const Grid<T, D>&, Grid<T, D>&, const VelocitySampler<D>&, \
+                                 double, const std::uint8_t*, const StepOutputs<T>&);
 MSIM_INSTANTIATE(float, 2)
 MSIM_INSTANTIATE(float, 3)
 MSIM_INSTANTIATE(double, 2)

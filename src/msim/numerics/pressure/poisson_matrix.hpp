@@ -42,8 +42,13 @@ class PoissonMatrix {
   // One Gauss-Seidel update of the cells whose coordinate sum has parity `colour`. Cells of one
   // colour only couple to the other colour, so the half sweep is exact in parallel.
   void gaussSeidel(const std::vector<float>& b, std::vector<float>& x, int colour) const;
+  // gaussSeidel(colour first) followed by gaussSeidel(1 - first), with the same result, in one
+  // pass over memory.
+  void gaussSeidelPair(const std::vector<float>& b, std::vector<float>& x, int first) const;
 
  private:
+  void relaxRow(const std::vector<float>& b, std::vector<float>& x, int colour, std::size_t row) const;
+
   IVec<D> res_ = IVec<D>::Zero();
   std::array<std::size_t, D> stride_{};
   std::array<std::vector<float>, D> lower_;

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "msim/core/parallel.hpp"
 
 namespace msim::numerics {
@@ -56,26 +59,61 @@ void PressureProjection<D>::setSolidVelocity(const MacGrid<D>& solidVelocity) {
   }
 }
 
+// The per-face loops below run over x-rows (one task per block of rows) with the neighbouring
+// rows as pointers: the straightforward per-face coordinate arithmetic cost as much as a V-cycle.
+namespace {
+
+// f(row, coord) for every x-row of an index box: coord[b] (b >= 1) are the row's coordinates.
+template <int D, typename F>
+void forEachRow(const IVec<D>& size, F&& f) {
+  std::size_t rows = 1;
+  for (int b = 1; b < D; ++b) rows *= static_cast<std::size_t>(size[b]);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows, 16), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t row = r.begin(); row != r.end(); ++row) {
+      IVec<D> c = IVec<D>::Zero();
+      std::size_t rest = row;
+      for (int b = 1; b < D; ++b) {
+        c[b] = static_cast<int>(rest % static_cast<std::size_t>(size[b]));
+        rest /= static_cast<std::size_t>(size[b]);
+      }
+      f(row, c);
+    }
+  });
+}
+
+// Linear index of the first sample of the x-row at c (c[0] ignored).
+template <typename T, int D>
+std::size_t rowStart(const Grid<T, D>& g, const IVec<D>& c) {
+  std::ptrdiff_t i = 0;
+  for (int b = 1; b < D; ++b) i += c[b] * g.stride(b);
+  return static_cast<std::size_t>(i);
+}
+
+}  // namespace
+
 template <int D>
 void PressureProjection<D>::netOutflow(const MacGrid<D>& velocity, std::vector<float>& out) const {
-  const auto& diag = matrix_.diag();
-  parallelForCells<D>(spec_.res, [&](const IVec<D>& c, std::size_t lin) {
-    if (diag[lin] <= 0.0f) {
-      out[lin] = 0.0f;
-      return;
-    }
-    float sum = 0.0f;
+  const float* diag = matrix_.diag().data();
+  const int nx = spec_.res[0];
+  forEachRow<D>(spec_.res, [&](std::size_t row, const IVec<D>& c) {
+    float* o = out.data() + row * nx;
+    std::fill(o, o + nx, 0.0f);
     for (int a = 0; a < D; ++a) {
       const auto& w = weights_.component(a);
       const auto& u = velocity.component(a);
       const auto& us = solidVelocity_.component(a);
       IVec<D> up = c;
-      up[a] += 1;
-      const float fluxUp = w(up) * u(up) + (1.0f - w(up)) * us(up);
-      const float fluxLow = w(c) * u(c) + (1.0f - w(c)) * us(c);
-      sum += fluxUp - fluxLow;
+      up[a] += a > 0;
+      // Faces below and above the cells of the row (on axis 0 the same row, shifted by one).
+      const std::size_t lo = rowStart(w, c), hi = a == 0 ? lo + 1 : rowStart(w, up);
+      for (int i = 0; i < nx; ++i) {
+        const float fluxUp = w[hi + i] * u[hi + i] + (1.0f - w[hi + i]) * us[hi + i];
+        const float fluxLow = w[lo + i] * u[lo + i] + (1.0f - w[lo + i]) * us[lo + i];
+        o[i] += fluxUp - fluxLow;
+      }
     }
-    out[lin] = sum;
+    const float* d = diag + row * nx;
+    for (int i = 0; i < nx; ++i) o[i] = d[i] > 0.0f ? o[i] : 0.0f;
   });
 }
 
@@ -101,21 +139,32 @@ PcgStats PressureProjection<D>::project(MacGrid<D>& velocity, double dt, double 
   const float toPressure = 1.0f / toScaled;
   parallelFor(0, rhs_.size(), [&](std::size_t i) { pressure_[i] = scaledPressure_[i] * toPressure; });
   const Grid<float, D>& cells = pressure_;
+  const float* p = scaledPressure_.data();
   for (int a = 0; a < D; ++a) {
     auto& u = velocity.component(a);
     const auto& w = weights_.component(a);
     const auto& us = solidVelocity_.component(a);
-    parallelForCells(u, [&](const IVec<D>& f, std::size_t lin) {
-      if (w[lin] <= 0.0f) {
-        u[lin] = us[lin];
-        return;
-      }
+    const int nx = u.size()[0];
+    forEachRow<D>(u.size(), [&](std::size_t row, const IVec<D>& f) {
+      const std::size_t base = row * nx;
+      float* ur = u.data().data() + base;
+      const float* wr = w.data().data() + base;
+      const float* usr = us.data().data() + base;
+      // Cells above and below each face of the row. A missing one (ghost beyond an open side,
+      // p = 0) reads the other row times 0; on walls w = 0 and the face takes the solid velocity.
       IVec<D> low = f;
-      low[a] -= 1;
-      // Ghost cells beyond an open side hold p = 0.
-      const float pUp = f[a] < spec_.res[a] ? scaledPressure_[cells.index(f)] : 0.0f;
-      const float pLow = f[a] > 0 ? scaledPressure_[cells.index(low)] : 0.0f;
-      u[lin] -= pUp - pLow;
+      low[a] -= a > 0;
+      const bool hasUp = a == 0 || f[a] < spec_.res[a], hasLow = a == 0 || f[a] > 0;
+      const float* pUp = p + rowStart(cells, hasUp ? f : low);
+      const float* pLow = p + rowStart(cells, hasLow ? low : f);
+      const float kUp = hasUp ? 1.0f : 0.0f, kLow = hasLow ? 1.0f : 0.0f;
+      const int shift = a == 0;  // along x, the cell below face i is cell i - 1 of the same row
+      auto update = [&](int i, float up, float lo) { ur[i] = wr[i] > 0.0f ? ur[i] - (up - lo) : usr[i]; };
+      if (a == 0) {  // the row's ends face the ghosts of the x sides
+        update(0, pUp[0], 0.0f);
+        update(nx - 1, 0.0f, pLow[nx - 2]);
+      }
+      for (int i = shift; i < nx - shift; ++i) update(i, kUp * pUp[i], kLow * pLow[i - shift]);
     });
   }
   return stats;
