@@ -2,11 +2,13 @@
 // Parallel loops over grids and index ranges on oneTBB. Loops over a grid split the slowest axis
 // so each task walks contiguous memory. Reductions go through fixed-size blocks combined in a fixed
 // order, so a sum is the same whatever the thread count (deterministic reruns).
+#include <algorithm>
 #include <cstddef>
 #include <vector>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include "msim/core/grid.hpp"
 
@@ -68,6 +70,19 @@ double parallelSum(std::size_t n, F&& f) {
   double total = 0.0;
   for (double p : partial) total += p;
   return total;
+}
+
+// Parallel max of f(i) over [0, n) (0 for an empty range; f is expected to be >= 0). The max does
+// not depend on the order of combination, so the plain parallel reduction is deterministic.
+template <typename F>
+double parallelMax(std::size_t n, F&& f) {
+  return tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, n, 4096), 0.0,
+      [&](const tbb::blocked_range<std::size_t>& r, double m) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) m = std::max(m, static_cast<double>(f(i)));
+        return m;
+      },
+      [](double a, double b) { return std::max(a, b); });
 }
 
 }  // namespace msim

@@ -4,8 +4,6 @@
 #include <cmath>
 #include <limits>
 
-#include <tbb/parallel_reduce.h>
-
 #include "msim/core/error.hpp"
 #include "msim/core/parallel.hpp"
 #include "msim/numerics/pressure/face_fractions.hpp"
@@ -13,18 +11,6 @@
 namespace msim::fluid {
 
 namespace {
-
-// max over i of f(i) (f >= 0), in parallel.
-template <typename F>
-double parallelMax(std::size_t n, F&& f) {
-  return tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, n, 4096), 0.0,
-      [&](const tbb::blocked_range<std::size_t>& r, double m) {
-        for (std::size_t i = r.begin(); i != r.end(); ++i) m = std::max(m, static_cast<double>(f(i)));
-        return m;
-      },
-      [](double a, double b) { return std::max(a, b); });
-}
 
 bool allFinite(const std::vector<float>& v) {
   return parallelMax(v.size(), [&](std::size_t i) { return std::isfinite(v[i]) ? 0.0 : 1.0; }) == 0.0;

@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include <tbb/parallel_reduce.h>
-
 #include "msim/core/parallel.hpp"
 
 namespace msim::fluid {
@@ -54,13 +52,7 @@ struct FaceStencil {
 };
 
 double maxAbs(const std::vector<float>& v, std::size_t n) {
-  return tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, n, 4096), 0.0,
-      [&](const tbb::blocked_range<std::size_t>& r, double m) {
-        for (std::size_t i = r.begin(); i != r.end(); ++i) m = std::max(m, static_cast<double>(std::abs(v[i])));
-        return m;
-      },
-      [](double a, double b) { return std::max(a, b); });
+  return parallelMax(n, [&](std::size_t i) { return std::abs(v[i]); });
 }
 
 }  // namespace
