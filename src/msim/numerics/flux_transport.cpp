@@ -36,6 +36,7 @@ FluxTransport<D>::FluxTransport(const GridSpec<D>& spec, const TransportBoundari
       velocity_(spec),
       openVelocity_(spec),
       netOutflow_(spec),
+      courantSum_(spec),
       stage_(spec),
       rate_(spec) {}
 
@@ -62,7 +63,6 @@ void FluxTransport<D>::updateOpenVelocity() {
   }
   // Per fluid cell: the Courant sum (over axes, the larger |u| of its two faces) for the stable
   // step, and the net outflow sum_a (u_upper - u_lower) = dx div(u) for the advective form.
-  std::vector<float> courant(spec_.cellCount(), 0.0f);
   parallelForCells<D>(spec_.res, [&](const IVec<D>& c, std::size_t lin) {
     float sum = 0.0f, outflow = 0.0f;
     for (int a = 0; a < D; ++a) {
@@ -72,10 +72,10 @@ void FluxTransport<D>::updateOpenVelocity() {
       sum += std::max(std::abs(u(c)), std::abs(u(upper)));
       outflow += u(upper) - u(c);
     }
-    courant[lin] = sum;
+    courantSum_[lin] = sum;
     netOutflow_[lin] = outflow;
   });
-  maxCourantSum_ = *std::max_element(courant.begin(), courant.end());
+  maxCourantSum_ = parallelMax(courantSum_.count(), [&](std::size_t i) { return courantSum_[i]; });
 }
 
 template <int D>

@@ -75,6 +75,7 @@ class FluxTransport {
   MacGrid<D> velocity_;      // as given
   MacGrid<D> openVelocity_;  // velocity_ where the face is open, 0 elsewhere
   Grid<float, D> netOutflow_;   // dx div(u) per cell, from the open face velocities
+  Grid<float, D> courantSum_;   // per cell: sum_a max(|u| on its two a-faces) [m/s]
   double maxCourantSum_ = 0.0;  // max over cells of sum_a max(|u| on its two a-faces) [m/s]
   Grid<float, D> stage_;     // RK intermediate state
   Grid<float, D> rate_;

@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 
 #include "msim/core/parallel.hpp"
+#include "msim/render/blackbody.hpp"
 
 namespace msim::render {
 
@@ -24,8 +26,34 @@ struct Radiance {
 
 inline bool isSolid(const float* solid, std::size_t i) { return solid && solid[i] > 0.5f; }
 
+// Emitted radiance of cell i over a path of `length` metres (zero without an emitter).
+template <int D>
+class CellEmission {
+ public:
+  CellEmission(const PreviewEmission<D>& e, const PreviewSettings& s, double length)
+      : emitter_(e.emitter ? e.emitter->data().data() : nullptr),
+        temperature_(e.temperature ? e.temperature->data().data() : nullptr),
+        scale_(static_cast<float>(s.emissionScale * length)) {
+    if (emitter_ && temperature_) table_.emplace(s.emissionReference);
+  }
+  bool active() const { return table_.has_value(); }
+  Rgb operator()(std::size_t i) const {
+    const float amount = scale_ * std::max(emitter_[i], 0.0f);
+    if (!(amount > 0.0f)) return {0, 0, 0};
+    const auto c = (*table_)(temperature_[i]);
+    return {amount * c[0], amount * c[1], amount * c[2]};
+  }
+
+ private:
+  const float* emitter_;
+  const float* temperature_;
+  float scale_;
+  std::optional<BlackbodyTable> table_;
+};
+
 // 3D: light marches down upAxis accumulating optical depth; the view ray marches along -viewAxis.
-Radiance project(const Grid<float, 3>& rho, const float* solid, const PreviewSettings& s) {
+Radiance project(const Grid<float, 3>& rho, const float* solid, const PreviewSettings& s,
+                 const PreviewEmission<3>& emission) {
   const int view = s.viewAxis, up = s.upAxis;
   int across = 0;
   while (across == view || across == up) ++across;
@@ -54,6 +82,7 @@ Radiance project(const Grid<float, 3>& rho, const float* solid, const PreviewSet
   r.colour.assign(static_cast<std::size_t>(r.width) * r.height, Rgb{0, 0, 0});
   r.alpha.assign(r.colour.size(), 0.0f);
   const float albedo = static_cast<float>(s.albedo), ambient = static_cast<float>(s.ambient);
+  const CellEmission<3> emit(emission, s, rho.spec().dx);
   parallelFor(0, r.colour.size(), [&](std::size_t p) {
     IVec3 c;
     c[across] = static_cast<int>(p % r.width);
@@ -70,6 +99,10 @@ Radiance project(const Grid<float, 3>& rho, const float* solid, const PreviewSet
       }
       const float a = 1.0f - std::exp(-k * std::max(rho[i], 0.0f));
       for (int ch = 0; ch < 3; ++ch) L[ch] += T * a * albedo * kGasColour[ch] * (lightT[i] + ambient);
+      if (emit.active()) {
+        const Rgb e = emit(i);
+        for (int ch = 0; ch < 3; ++ch) L[ch] += T * e[ch];
+      }
       T *= 1.0f - a;
     }
     r.colour[p] = L;
@@ -79,9 +112,11 @@ Radiance project(const Grid<float, 3>& rho, const float* solid, const PreviewSet
 }
 
 // A 2D field seen face-on, as a slab of thickness depth2D; the light still comes from +y.
-Radiance project(const Grid<float, 2>& rho, const float* solid, const PreviewSettings& s) {
+Radiance project(const Grid<float, 2>& rho, const float* solid, const PreviewSettings& s,
+                 const PreviewEmission<2>& emission) {
   const double dx = rho.spec().dx;
   const double depth = s.depth2D > 0.0 ? s.depth2D : 8.0 * dx;
+  const CellEmission<2> emit(emission, s, depth);
   const float kView = static_cast<float>(s.extinction * depth), kLight = static_cast<float>(s.extinction * dx);
   const IVec2 n = rho.size();
   Radiance r;
@@ -105,7 +140,10 @@ Radiance project(const Grid<float, 2>& rho, const float* solid, const PreviewSet
       const float lightT = std::exp(-lightDepth - 0.5f * kLight * rhoi);
       lightDepth += kLight * rhoi;
       const float a = 1.0f - std::exp(-kView * rhoi);
-      for (int ch = 0; ch < 3; ++ch) r.colour[i][ch] = a * albedo * kGasColour[ch] * (lightT + ambient);
+      // Emission through half the slab's smoke, on average.
+      const Rgb e = emit.active() ? emit(i) : Rgb{0, 0, 0};
+      const float seen = std::exp(-0.5f * kView * rhoi);
+      for (int ch = 0; ch < 3; ++ch) r.colour[i][ch] = a * albedo * kGasColour[ch] * (lightT + ambient) + seen * e[ch];
       r.alpha[i] = a;
     }
   }, 16);
@@ -132,8 +170,8 @@ std::uint8_t toByte(float linear) {
 
 template <int D>
 io::Image renderDensityPreview(const Grid<float, D>& density, const PreviewSettings& settings,
-                               const Grid<float, D>* solid) {
-  const Radiance r = project(density, solid ? solid->data().data() : nullptr, settings);
+                               const Grid<float, D>* solid, const PreviewEmission<D>& emission) {
+  const Radiance r = project(density, solid ? solid->data().data() : nullptr, settings, emission);
   const int scale = std::max(1, (settings.minWidth + r.width - 1) / r.width);
   io::Image img(r.width * scale, r.height * scale);
   // Bilinear upscaling of the pixel lattice; the background is a dark blue-grey gradient.
@@ -165,7 +203,9 @@ io::Image renderDensityPreview(const Grid<float, D>& density, const PreviewSetti
   return img;
 }
 
-template io::Image renderDensityPreview<2>(const Grid<float, 2>&, const PreviewSettings&, const Grid<float, 2>*);
-template io::Image renderDensityPreview<3>(const Grid<float, 3>&, const PreviewSettings&, const Grid<float, 3>*);
+template io::Image renderDensityPreview<2>(const Grid<float, 2>&, const PreviewSettings&, const Grid<float, 2>*,
+                                           const PreviewEmission<2>&);
+template io::Image renderDensityPreview<3>(const Grid<float, 3>&, const PreviewSettings&, const Grid<float, 3>*,
+                                           const PreviewEmission<3>&);
 
 }  // namespace msim::render

@@ -17,11 +17,21 @@ struct PreviewSettings {
   double ambient = 0.25;      // sky light reaching every voxel, relative to the key light
   int minWidth = 480;         // images are upscaled by an integer factor to at least this width
   double depth2D = 0.0;       // optical depth thickness of a 2D grid [m]; 0 means 8 cells
+  double emissionScale = 1.0;          // radiance per metre per unit emitter density at the reference
+  double emissionReference = 1500.0;   // temperature [K] whose black body has unit luminance
+};
+
+// Fire: cells emit emitter * B(T) (black-body colour, brightness ~ T^4; render/blackbody.hpp),
+// seen through the smoke in front of them.
+template <int D>
+struct PreviewEmission {
+  const Grid<float, D>* emitter = nullptr;      // e.g. flame density [kg/m^3]
+  const Grid<float, D>* temperature = nullptr;  // [K]
 };
 
 // `solid` (optional, same layout as density): cells > 0.5 are opaque obstacles.
 template <int D>
 io::Image renderDensityPreview(const Grid<float, D>& density, const PreviewSettings& settings,
-                               const Grid<float, D>* solid = nullptr);
+                               const Grid<float, D>* solid = nullptr, const PreviewEmission<D>& emission = {});
 
 }  // namespace msim::render

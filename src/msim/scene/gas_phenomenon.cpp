@@ -9,9 +9,8 @@
 #include "msim/core/parallel.hpp"
 #include "msim/fluid/gas/gas_solver.hpp"
 #include "msim/geometry/occupancy.hpp"
-#include "msim/geometry/shape_factory.hpp"
 #include "msim/io/vdb.hpp"
-#include "msim/render/density_preview.hpp"
+#include "msim/scene/phenomenon_support.hpp"
 #include "msim/scene/scene_file.hpp"
 #include "msim/scene/schema/shape_schema.hpp"
 
@@ -66,8 +65,6 @@ double gasBytesPerCell(int dimensions) {
   return 4.0 * (6 + 3 * dimensions + 3);
 }
 
-int axisIndex(const json& name) { return name.get<std::string>()[0] - 'x'; }
-
 fluid::MotionField motionField(const json& fields) {
   std::vector<fluid::MotionFieldInstance> instances;
   for (const json& f : fields) {
@@ -111,8 +108,7 @@ class GasPhenomenon final : public Phenomenon {
     const json& obstacles = r.at("obstacles");
     for (std::size_t i = 0; i < obstacles.size(); ++i) {
       const std::string key = fmt::format("obstacles[{}].shape", i);
-      const auto shape = geometry::buildShape<D>(obstacles[i].at("shape"), scene.directory(), source_ + ": " + key);
-      const Grid<float, D> cover = geometry::occupancy(*shape, spec);
+      const Grid<float, D> cover = geometry::occupancy(*sceneShape<D>(scene, obstacles[i].at("shape"), key), spec);
       std::size_t inside = 0;
       for (std::size_t c = 0; c < cover.count(); ++c)
         if (cover[c] > 0.5f) solid[c] = 1.0f, ++inside;
@@ -123,27 +119,13 @@ class GasPhenomenon final : public Phenomenon {
     const json& sources = r.at("sources");
     for (std::size_t i = 0; i < sources.size(); ++i) {
       const std::string key = fmt::format("sources[{}].shape", i);
-      const auto shape = geometry::buildShape<D>(sources[i].at("shape"), scene.directory(), source_ + ": " + key);
-      const Grid<float, D> cover = geometry::occupancy(*shape, spec);
       fluid::GasSource s;
       s.densityRate = sources[i].at("density_rate").get<double>();
       s.temperature = sources[i].at("temperature").get<double>();
-      for (std::size_t c = 0; c < cover.count(); ++c)
-        if (cover[c] > 0.0f && solid[c] < 0.5f) s.cells.emplace_back(c, cover[c]);
-      if (s.cells.empty())
-        throw InputError(fmt::format("{}: '{}' covers no open cell of the domain (outside it, or inside an obstacle)",
-                                     source_, key));
+      s.cells = coveredOpenCells<D>(scene, *sceneShape<D>(scene, sources[i].at("shape"), key), solid, key);
       solver_.addSource(std::move(s));
     }
-
-    const json& p = r.at("outputs").at("preview");
-    preview_.viewAxis = axisIndex(p.at("view_axis"));
-    preview_.upAxis = axisIndex(p.at("up_axis"));
-    if (D == 3 && preview_.viewAxis == preview_.upAxis)
-      throw InputError(source_ + ": 'outputs.preview.view_axis' and 'outputs.preview.up_axis' must differ");
-    preview_.extinction = p.at("extinction").get<double>();
-    preview_.albedo = p.at("albedo").get<double>();
-    preview_.minWidth = p.at("width").get<int>();
+    preview_ = previewSettings(scene);
   }
 
   double stableTimestep() const override { return solver_.stableTimestep(); }
@@ -154,8 +136,8 @@ class GasPhenomenon final : public Phenomenon {
   }
 
   void checkFinite(long stepIndex, double time) const override {
-    check(solver_.density(), "density", stepIndex, time);
-    check(solver_.temperature(), "temperature", stepIndex, time);
+    requireFinite(solver_.density(), "density", stepIndex, time);
+    requireFinite(solver_.temperature(), "temperature", stepIndex, time);
   }
 
   void writeVolume(const std::filesystem::path& vdbFile) const override {
@@ -169,9 +151,10 @@ class GasPhenomenon final : public Phenomenon {
     return render::renderDensityPreview(solver_.density(), preview_, &solver_.solid());
   }
 
-  void restore(const std::filesystem::path& vdbFile) override {
-    load(vdbFile, "density", solver_.density());
-    load(vdbFile, "temperature", solver_.temperature());
+  // The motion fields are steady, so the state is the two grids whatever the time.
+  void restore(const std::filesystem::path& vdbFile, double /*time*/) override {
+    restoreGrid(vdbFile, "density", solver_.density(), source_);
+    restoreGrid(vdbFile, "temperature", solver_.temperature(), source_);
   }
 
   json statistics() const override {
@@ -196,25 +179,6 @@ class GasPhenomenon final : public Phenomenon {
     p.cooling = g.at("temperature").at("cooling").get<double>();
     p.cfl = r.at("time").at("cfl").get<double>();
     return p;
-  }
-
-  static void check(const Grid<float, D>& g, const char* name, long stepIndex, double time) {
-    for (std::size_t i = 0; i < g.count(); ++i) {
-      if (std::isfinite(g[i])) continue;
-      const IVec<D> c = g.coord(i);
-      throw SimulationError(fmt::format("step {} (t = {:.4g} s): field '{}' became {} at cell ({}); the run is unstable",
-                                        stepIndex, time, name, g[i], fmt::join(c.data(), c.data() + D, ", ")));
-    }
-  }
-
-  void load(const std::filesystem::path& file, const char* name, Grid<float, D>& target) const {
-    const Grid<float, 3> saved = io::readFloatGrid(file, name);
-    bool same = saved.spec().dx == target.spec().dx;
-    for (int a = 0; a < D; ++a) same = same && saved.size()[a] == target.size()[a];
-    if (!same || saved.count() != target.count())
-      throw InputError(fmt::format("{}: cannot resume from '{}': its grid '{}' does not match the scene's domain",
-                                   source_, file.string(), name));
-    std::copy(saved.data().begin(), saved.data().end(), target.data().begin());
   }
 
   std::string source_;

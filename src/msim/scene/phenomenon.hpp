@@ -27,8 +27,8 @@ class Phenomenon {
   // Frame outputs. Each call writes one complete file (the runner makes it atomic).
   virtual void writeVolume(const std::filesystem::path& vdbFile) const = 0;
   virtual io::Image preview() const = 0;
-  // Restores the state saved by writeVolume (for --resume).
-  virtual void restore(const std::filesystem::path& vdbFile) = 0;
+  // Restores the state saved by writeVolume at simulated time `time` [s] (for --resume).
+  virtual void restore(const std::filesystem::path& vdbFile, double time) = 0;
   // Summary numbers of the current state, one JSON object of named numbers.
   virtual nlohmann::json statistics() const = 0;
 };

@@ -1,10 +1,11 @@
 #include "msim/scene/gas_phenomenon.hpp"
 #include "msim/scene/phenomenon.hpp"
+#include "msim/scene/smoke_phenomenon.hpp"
 
 namespace msim::scene {
 
 const std::vector<PhenomenonType>& phenomenonTypes() {
-  static const std::vector<PhenomenonType> types = {gasPhenomenonType()};
+  static const std::vector<PhenomenonType> types = {gasPhenomenonType(), smokePhenomenonType()};
   return types;
 }
 

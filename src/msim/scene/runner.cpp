@@ -170,7 +170,7 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
     while (done < lastFrame && frameComplete(layout, done + 1)) ++done;
     if (done > 0) {
       ScopedStage stage(timers, "resume: read frame");
-      phenomenon->restore(frameFile(layout.vdbDir, layout.name, done, "vdb"));
+      phenomenon->restore(frameFile(layout.vdbDir, layout.name, done, "vdb"), done / scene.fps);
       record.adoptPreviousFrames(done);
     }
     firstFrame = done + 1;
@@ -191,7 +191,8 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
       int substeps = 0;
       while (remaining > 1e-12 * frameDt) {
         const double stable = phenomenon->stableTimestep();
-        const double needed = std::ceil(remaining / stable);
+        // A fluid at rest has no CFL limit (stable = inf): the rest of the frame is one step.
+        const double needed = std::max(1.0, std::ceil(remaining / stable));
         if (!(stable > 0.0) || substeps + needed > maxSubsteps)
           throw SimulationError(fmt::format(
               "step {} (t = {:.4g} s): frame {} needs more than time.max_substeps = {} substeps (stable step {:.3g} s "

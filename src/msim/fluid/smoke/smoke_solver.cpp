@@ -27,10 +27,17 @@ SmokeSolver<D>::SmokeSolver(const GridSpec<D>& spec, const SmokeParams<D>& param
       temperature_(spec, static_cast<float>(params.buoyancy.ambientTemperature)),
       solid_(spec, 0.0f),
       divergence_(spec, 0.0f),
+      sealed_(spec, 0.0f),
       advector_(spec, params.advection),
       projection_(spec, params.sides, params.projection),
       confinement_(spec),
-      viscosity_(spec) {}
+      viscosity_(spec) {
+  // The normal part of a wall's velocity feeds or drains the domain (Selle ch. 2.9's tunnel); the
+  // tangential part drags the fluid through the viscous term (a cavity lid).
+  for (int a = 0; a < D; ++a)
+    for (int side = 0; side < 2; ++side) projection_.setWallNormalVelocity(a, side, params.wallVelocity[a][side][a]);
+  updateSealed();
+}
 
 template <int D>
 void SmokeSolver<D>::setObstacles(const Grid<float, D>& nodalSolidPhi) {
@@ -47,6 +54,9 @@ void SmokeSolver<D>::setObstacles(const Grid<float, D>& nodalSolidPhi) {
     solid_[lin] = phi < 0.0 ? 1.0f : 0.0f;
   });
   advector_.setSolid(solid_);
+  updateSealed();
+  findCutFaces();
+  if (conservative_) conservative_->transport.setSolid(sealed_);
   hasObstacles_ = true;
   borderCells_.clear();
   borderStart_.assign(1, 0);
@@ -66,6 +76,65 @@ void SmokeSolver<D>::setObstacles(const Grid<float, D>& nodalSolidPhi) {
       borderStart_.push_back(borderNeighbours_.size());
     }
   }
+}
+
+template <int D>
+void SmokeSolver<D>::findCutFaces() {
+  const MacGrid<D>& weights = projection_.faceWeights();
+  for (int a = 0; a < D; ++a) {
+    CutFaces& cut = cutFaces_[a];
+    cut.faces.clear();
+    cut.start.assign(1, 0);
+    cut.neighbours.clear();
+    const Grid<float, D>& w = weights.component(a);
+    // The advector's rule: a face of a solid cell is solid (kept as it is).
+    auto advectorSolid = [&](const IVec<D>& f) {
+      IVec<D> below = f;
+      below[a] -= 1;
+      return (solid_.inside(f) && solid_(f) > 0.5f) || (solid_.inside(below) && solid_(below) > 0.5f);
+    };
+    for (std::size_t i = 0; i < w.count(); ++i) {
+      const IVec<D> f = w.coord(i);
+      if (!(w[i] > 0.0f) || !advectorSolid(f)) continue;
+      cut.faces.push_back(i);
+      for (int b = 0; b < D; ++b)
+        for (int step : {-1, 1}) {
+          IVec<D> nb = f;
+          nb[b] += step;
+          if (w.inside(nb) && w(nb) > 0.0f && !advectorSolid(nb)) cut.neighbours.push_back(w.index(nb));
+        }
+      cut.start.push_back(cut.neighbours.size());
+    }
+  }
+}
+
+template <int D>
+void SmokeSolver<D>::extrapolateIntoCutFaces() {
+  for (int a = 0; a < D; ++a) {
+    const CutFaces& cut = cutFaces_[a];
+    Grid<float, D>& u = velocity_.component(a);
+    const Grid<float, D>& us = projection_.solidVelocity().component(a);
+    parallelFor(0, cut.faces.size(), [&](std::size_t k) {
+      const std::size_t begin = cut.start[k], end = cut.start[k + 1];
+      double sum = 0.0;
+      for (std::size_t j = begin; j < end; ++j) sum += u[cut.neighbours[j]];
+      u[cut.faces[k]] = end > begin ? static_cast<float>(sum / static_cast<double>(end - begin)) : us[cut.faces[k]];
+    }, 256);
+  }
+}
+
+template <int D>
+void SmokeSolver<D>::updateSealed() {
+  const MacGrid<D>& w = projection_.faceWeights();
+  parallelForCells(sealed_, [&](const IVec<D>& c, std::size_t lin) {
+    bool open = false;
+    for (int a = 0; a < D && !open; ++a) {
+      IVec<D> upper = c;
+      upper[a] += 1;
+      open = w.component(a)(c) > 0.0f || w.component(a)(upper) > 0.0f;
+    }
+    sealed_[lin] = open ? 0.0f : 1.0f;
+  });
 }
 
 template <int D>
@@ -106,12 +175,17 @@ void SmokeSolver<D>::step(double dt) {
   const Grid<float, D>* solid = hasObstacles_ ? &solid_ : nullptr;
   {
     ScopedStage s(timers_, "sources");
+    if (params_.scalarTransport == ScalarTransport::Advector) resetInflowCells();
     applyScalarSources(dt);
   }
   {
     // Self-advection of the momentum, the (u.grad) u term of eq. 3.1.
     ScopedStage s(timers_, "advect velocity");
     advector_.advect(velocity_, velocity_, dt);
+    // Faces the projection treats as (partly) fluid but the advector as solid keep their old value
+    // there; refresh them from the fluid beside them, or the pressure correction would pile up on
+    // them step after step and the velocity would grow without bound.
+    if (hasObstacles_) extrapolateIntoCutFaces();
   }
   {
     ScopedStage s(timers_, "forces");
@@ -135,14 +209,10 @@ void SmokeSolver<D>::step(double dt) {
   }
   {
     ScopedStage s(timers_, "advect scalars");
-    for (Grid<float, D>* f : {&density_, &temperature_}) {
-      extendIntoSolid(*f);
-      advector_.advect(*f, velocity_, dt);
-    }
-    for (auto& sc : scalars_) {
-      extendIntoSolid(sc.field);
-      advector_.advect(sc.field, velocity_, dt);
-    }
+    if (params_.scalarTransport == ScalarTransport::Conservative)
+      transportScalarsConservatively(dt);
+    else
+      advectScalars(dt);
     dissipate(dt);
   }
   ++steps_;
@@ -150,17 +220,142 @@ void SmokeSolver<D>::step(double dt) {
 }
 
 template <int D>
+void SmokeSolver<D>::advectScalars(double dt) {
+  for (Grid<float, D>* f : {&density_, &temperature_}) {
+    extendIntoSolid(*f);
+    advector_.advect(*f, velocity_, dt);
+  }
+  for (auto& sc : scalars_) {
+    extendIntoSolid(sc.field);
+    advector_.advect(sc.field, velocity_, dt);
+  }
+}
+
+template <int D>
+void SmokeSolver<D>::transportScalarsConservatively(double dt) {
+  if (!conservative_) {
+    // Open domain sides, and walls that move fluid in or out (normal wall velocity), let the
+    // scalars out with their upwind value and bring in the background (see below); other walls
+    // are closed.
+    numerics::TransportBoundaries<D> boundaries;
+    for (int a = 0; a < D; ++a)
+      for (int side = 0; side < 2; ++side)
+        boundaries.side[a][side] = params_.sides.side[a][side] == numerics::DomainSide::Open ||
+                                           params_.wallVelocity[a][side][a] != 0.0
+                                       ? numerics::BoundaryKind::Open
+                                       : numerics::BoundaryKind::Closed;
+    conservative_ = std::make_unique<Conservative>(
+        Conservative{numerics::FluxTransport<D>(spec_, boundaries), MacGrid<D>(spec_, 0.0f)});
+    conservative_->transport.setSolid(sealed_);
+  }
+  // The carrying velocity is the fluid volume flux w_f u_f of the projection (Batty et al. 2007;
+  // PressureProjection's F_f less the solid part (1 - w_f) u_solid), not u_f itself:
+  //  - for static obstacles sum_faces w_f u_f = dx div(u) = 0 in every cell with an open face, to
+  //    the PCG tolerance, so in flux form a uniform field stays uniform and the limited MUSCL
+  //    scheme keeps the maximum principle up to the obstacle surface. The bare u_f is not
+  //    divergence free in cut cells (it over-counts the area of partly covered faces) and would
+  //    pile smoke up against obstacles.
+  //  - a fully covered face (w = 0) carries nothing even where the projection gave it the
+  //    obstacle's velocity: smoke never passes through a solid. Domain walls are the exception:
+  //    their faces (w = 0) hold the wall's normal velocity, the volume that enters or leaves
+  //    there, and carry it, so an outflow wall lets smoke out instead of piling it up.
+  //  - cells without an open face (sealed_) are the transport's solids; cells whose centre is in
+  //    the obstacle but that have open faces hold smoke like any other cell. Masking them by the
+  //    centre test (solid_) would zero their faces and break div = 0 in their neighbours.
+  // Conservation holds whatever the velocity: each interior face moves what one cell loses into
+  // its neighbour, and walls and sealed cells have no flux. Moving obstacles change the fluid
+  // volume of cut cells, which fixed cell volumes cannot follow: there sum w u != 0 and uniform
+  // fields are kept only approximately (the total still exactly).
+  Conservative& c = *conservative_;
+  for (int a = 0; a < D; ++a) {
+    const auto& u = velocity_.component(a);
+    const auto& w = projection_.faceWeights().component(a);
+    auto& flux = c.faceVelocity.component(a);
+    const int last = spec_.res[a];
+    const auto& side = params_.sides.side[a];
+    parallelForCells(flux, [&](const IVec<D>& f, std::size_t i) {
+      const bool wall = (f[a] == 0 && side[0] == numerics::DomainSide::Wall) ||
+                        (f[a] == last && side[1] == numerics::DomainSide::Wall);
+      flux[i] = wall ? u[i] : w[i] * u[i];
+    });
+  }
+  c.transport.setVelocity(c.faceVelocity);
+  // FluxTransport is positivity preserving for sum_a |u_a| dt / dx <= 1/2 (MUSCL + SSP-RK2), up
+  // to 2 D times stricter than the step's CFL limit: sub-cycle in equal steps.
+  const double limit = c.transport.maxStableDt(0.0);
+  const int n = std::max(1, static_cast<int>(std::ceil(dt / limit)));
+  const double h = dt / n;
+  const numerics::TransportSettings zeroBackground{numerics::TransportForm::Conservative, 0.0, 0.0};
+  auto transport = [&](Grid<float, D>& field) {
+    for (int k = 0; k < n; ++k) c.transport.step(field, zeroBackground, h);
+  };
+  // Every field is moved as its excess over a background that is 0 at open-side inflow: density
+  // and the extra scalars (which dissipate towards 0) as they are, temperature as T - T_ambient.
+  // In flux form a constant c changes at the rate -c div u, and div u is zero only to the PCG
+  // tolerance: moving the excess keeps ambient air exactly ambient (and spends float precision
+  // on the excess, not on the ~300 K offset). The offset is affine, so the total of T is still
+  // conserved and inflowing air is at ambient temperature.
+  transport(density_);
+  const float ambient = static_cast<float>(params_.buoyancy.ambientTemperature);
+  parallelFor(0, temperature_.count(), [&](std::size_t i) { temperature_[i] -= ambient; });
+  transport(temperature_);
+  parallelFor(0, temperature_.count(), [&](std::size_t i) { temperature_[i] += ambient; });
+  for (auto& sc : scalars_) transport(sc.field);
+}
+
+template <int D>
+void SmokeSolver<D>::resetInflowCells() {
+  // The back-traces of cells on the domain boundary that leave the grid read the boundary cell
+  // itself (clamped). Where air flows in, that would keep whatever smoke once touched the side
+  // there forever; instead the cell holds the incoming air's values (no smoke, ambient
+  // temperature), a first-order inflow condition. Sources applied after this still set theirs.
+  const float ambient = static_cast<float>(params_.buoyancy.ambientTemperature);
+  for (int a = 0; a < D; ++a) {
+    const Grid<float, D>& u = velocity_.component(a);
+    IVec<D> across = spec_.res;
+    across[a] = 1;
+    std::size_t count = 1;
+    for (int b = 0; b < D; ++b) count *= static_cast<std::size_t>(across[b]);
+    for (int side = 0; side < 2; ++side) {
+      parallelFor(0, count, [&](std::size_t k) {
+        IVec<D> c;
+        std::size_t rest = k;
+        for (int b = 0; b < D; ++b) {
+          c[b] = static_cast<int>(rest % static_cast<std::size_t>(across[b]));
+          rest /= static_cast<std::size_t>(across[b]);
+        }
+        c[a] = side == 0 ? 0 : spec_.res[a] - 1;
+        IVec<D> face = c;
+        face[a] += side;
+        const float inward = side == 0 ? u(face) : -u(face);
+        if (!(inward > 0.0f)) return;
+        const std::size_t cell = density_.index(c);
+        density_[cell] = 0.0f;
+        temperature_[cell] = ambient;
+        for (auto& sc : scalars_) sc.field[cell] = 0.0f;
+      }, 64);
+    }
+  }
+}
+
+template <int D>
 void SmokeSolver<D>::applyScalarSources(double dt) {
   for (const auto& src : sources_) {
+    if (!src.active) continue;
     const bool set = src.mode == SmokeSource<D>::Mode::Set;
     parallelFor(0, src.cells.size(), [&](std::size_t k) {
       const auto [cell, w] = src.cells[k];
       if (set) {
         density_[cell] += static_cast<float>(w * (src.density - density_[cell]));
         if (src.temperature > 0.0) temperature_[cell] += static_cast<float>(w * (src.temperature - temperature_[cell]));
+        for (const auto& [index, value] : src.scalars) {
+          float& v = scalars_[index].field[cell];
+          v += static_cast<float>(w * (value - v));
+        }
       } else {
         density_[cell] += static_cast<float>(w * src.density * dt);
         temperature_[cell] += static_cast<float>(w * src.temperature * dt);
+        for (const auto& [index, rate] : src.scalars) scalars_[index].field[cell] += static_cast<float>(w * rate * dt);
       }
     }, 256);
   }
@@ -178,7 +373,7 @@ void SmokeSolver<D>::extendIntoSolid(Grid<float, D>& field) const {
 template <int D>
 void SmokeSolver<D>::applyInflow() {
   for (const auto& src : sources_) {
-    if (!src.velocity) continue;
+    if (!src.active || !src.velocity) continue;
     const Vec<D> v = *src.velocity;
     // Two cells of one source share faces; blending one face twice with the same target is
     // harmless, so the loop stays sequential only to keep the result independent of scheduling.
@@ -242,8 +437,11 @@ SmokeStatistics SmokeSolver<D>::statistics() const {
     });
     s.maxSpeed = std::max(s.maxSpeed, parallelMax(u.count(), [&](std::size_t i) { return std::abs(u[i]); }));
   }
+  // The cells each transport keeps scalars in: the Advector overwrites solid cells with their
+  // neighbours' mean every step, the conservative transport owns every cell with an open face.
+  const Grid<float, D>& excluded = params_.scalarTransport == ScalarTransport::Conservative ? sealed_ : solid_;
   s.totalDensity = dV * parallelSum(density_.count(), [&](std::size_t i) {
-    return solid_[i] > 0.5f ? 0.0 : double(density_[i]);
+    return excluded[i] > 0.5f ? 0.0 : double(density_[i]);
   });
   s.maxDivergence = maxDivergence_;
   s.pressureIterations = pressureIterations_;

@@ -7,12 +7,15 @@
 //   2. advect u in itself (Advector: semi-Lagrangian, BFECC or MacCormack)   -> u*
 //   3. forces: buoyancy, vorticity confinement (epsilon), then viscosity (optional, nu)
 //   4. impose source inflow velocities, project: solve lap p = (rho/dt) div u*, u = u* - dt/rho grad p
-//   5. advect density, temperature and extra scalars in the divergence-free u, then dissipate
+//   5. advect density, temperature and extra scalars in the divergence-free u (with the Advector,
+//      or conservatively with numerics::FluxTransport, see ScalarTransport), then dissipate
 // Obstacles are static solids given by a signed distance (face fractions in the projection, cell
 // mask for advection and forces) that may carry a velocity (moving-obstacle boundary condition).
 // Storage is float, reductions double; every work array lives in the object (no allocation per
 // step).
+#include <array>
 #include <cstddef>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -25,13 +28,21 @@
 #include "msim/fluid/smoke/viscosity.hpp"
 #include "msim/fluid/smoke/vorticity_confinement.hpp"
 #include "msim/numerics/advection/advector.hpp"
+#include "msim/numerics/flux_transport.hpp"
 #include "msim/numerics/pressure/projection.hpp"
 
 namespace msim::fluid {
 
+// How step 5 moves density, temperature and the extra scalars.
+enum class ScalarTransport {
+  Advector,      // the velocity's scheme (params.advection): sharpest, not conservative
+  Conservative   // finite-volume flux form (numerics::FluxTransport): conserves the total to round-off
+};
+
 template <int D>
 struct SmokeParams {
-  numerics::AdvectionSettings advection;     // scheme for velocity and every scalar
+  numerics::AdvectionSettings advection;     // scheme for velocity (and scalars with Advector)
+  ScalarTransport scalarTransport = ScalarTransport::Advector;
   numerics::ProjectionSettings projection;   // MG-PCG by default
   numerics::DomainSides<D> sides;            // walls by default
   double fluidDensity = 1.0;                 // rho in the pressure equation [kg/m^3]
@@ -41,7 +52,9 @@ struct SmokeParams {
   ViscosityMode viscosityMode = ViscosityMode::Implicit;
   ViscositySolveSettings viscositySolve;
   WallSlip wallSlip = WallSlip::NoSlip;      // tangential wall condition of the viscous term
-  WallVelocities<D> wallVelocity = zeroWallVelocities<D>();  // e.g. a cavity lid
+  // Velocity of each wall: tangential parts drag (a cavity lid, viscous term), normal parts make
+  // inflow and outflow walls (the projection's Neumann condition).
+  WallVelocities<D> wallVelocity = zeroWallVelocities<D>();
   double densityDissipation = 0.0;           // rho *= exp(-rate dt) [1/s]
   double temperatureDissipation = 0.0;       // T - T_ambient *= exp(-rate dt) [1/s]
   double cfl = 1.0;                          // cells a face velocity may cross per substep
@@ -59,12 +72,16 @@ struct SmokeSource {
   double density = 0.0;      // Set: value [kg/m^3]; Add: rate [kg/(m^3 s)]
   double temperature = 0.0;  // Set: value [K]; Add: rate [K/s]; ignored when <= 0 in Set mode
   std::optional<Vec<D>> velocity;  // inflow [m/s]
+  // Extra scalars (addScalar index, value or rate as for density), e.g. fuel for fire.
+  std::vector<std::pair<std::size_t, double>> scalars;
+  bool active = true;  // an inactive source does nothing (emitters switched on and off in time)
 };
 
 struct SmokeStatistics {
   double kineticEnergy = 0.0;   // 1/2 rho sum_faces w_f u_f^2 dV [J per unit depth in 2D]
   double maxDivergence = 0.0;   // max |div u| after the last projection [1/s]
-  double totalDensity = 0.0;    // integral of density over fluid cells [kg]
+  double totalDensity = 0.0;    // integral of density over the cells that carry scalars [kg]
+                                // (Advector: centre outside obstacles; Conservative: any open face)
   double maxSpeed = 0.0;        // max |u_f| over faces [m/s]
   int pressureIterations = 0;   // last projection
   int viscosityIterations = 0;  // last implicit viscosity solve
@@ -79,11 +96,15 @@ class SmokeSolver {
   SmokeSolver& operator=(const SmokeSolver&) = delete;
 
   // Static obstacle from a signed distance sampled at the grid nodes (res+1 per axis, negative
-  // inside; numerics::sampleNodes). Cells whose centre lies inside are solid for advection/forces.
+  // inside; numerics::sampleNodes). Cells whose centre lies inside are solid for advection/forces;
+  // the conservative transport excludes only cells without an open face. May be called again
+  // (moving obstacles): every mask and the projection are rebuilt.
   void setObstacles(const Grid<float, D>& nodalSolidPhi);
   // Velocity of the obstacles on each face [m/s] (moving-obstacle boundary condition).
   void setObstacleVelocity(const MacGrid<D>& solidVelocity);
   void addSource(SmokeSource<D> source) { sources_.push_back(std::move(source)); }
+  SmokeSource<D>& source(std::size_t i) { return sources_[i]; }
+  std::size_t sourceCount() const { return sources_.size(); }
   // A further advected cell-centred scalar (e.g. fuel), dissipating as rho does; returns its index.
   std::size_t addScalar(std::string name, double dissipation = 0.0, float initial = 0.0f);
 
@@ -110,6 +131,9 @@ class SmokeSolver {
   std::size_t scalarCount() const { return scalars_.size(); }
   const Grid<float, D>& solid() const { return solid_; }
   const numerics::PressureProjection<D>& projection() const { return projection_; }
+  // The last pressure [Pa]; it warm-starts the next projection, so a resumed run restores it.
+  Grid<float, D>& pressure() { return projection_.pressure(); }
+  const Grid<float, D>& pressure() const { return projection_.pressure(); }
   const GridSpec<D>& spec() const { return spec_; }
   const SmokeParams<D>& params() const { return params_; }
   SmokeParams<D>& params() { return params_; }
@@ -123,8 +147,19 @@ class SmokeSolver {
     double dissipation;
     Grid<float, D> field;
   };
+  // The FluxTransport and its carrying face velocities, built by the first Conservative step.
+  struct Conservative {
+    numerics::FluxTransport<D> transport;
+    MacGrid<D> faceVelocity;  // w_f u_f: the fluid volume flux per unit face area
+  };
+  void resetInflowCells();
   void applyScalarSources(double dt);
   void extendIntoSolid(Grid<float, D>& field) const;
+  void advectScalars(double dt);
+  void transportScalarsConservatively(double dt);
+  void updateSealed();
+  void findCutFaces();
+  void extrapolateIntoCutFaces();
   void applyInflow();
   void dissipate(double dt);
   void checkFinite() const;
@@ -134,13 +169,23 @@ class SmokeSolver {
   SmokeParams<D> params_;
   MacGrid<D> velocity_;
   Grid<float, D> density_, temperature_, solid_, divergence_;
+  // Cells with no open face (projection weight 0 on all 2D faces): no pressure, no flux; the
+  // conservative transport's solid mask.
+  Grid<float, D> sealed_;
   std::vector<Scalar> scalars_;
   std::vector<SmokeSource<D>> sources_;
   bool hasObstacles_ = false;
   // Solid cells with a fluid face neighbour and those neighbours (CSR): the scalars are extended
   // into them before advection so back-traces that end inside an obstacle read fluid values.
   std::vector<std::size_t> borderCells_, borderStart_, borderNeighbours_;
+  // Per velocity component: faces open in the projection (weight > 0) that the advector keeps
+  // fixed because they border a solid cell, with their advected same-component neighbours (CSR).
+  struct CutFaces {
+    std::vector<std::size_t> faces, start, neighbours;
+  };
+  std::array<CutFaces, D> cutFaces_;
   numerics::Advector<float, D> advector_;
+  std::unique_ptr<Conservative> conservative_;
   numerics::PressureProjection<D> projection_;
   VorticityConfinement<D> confinement_;
   ViscousDiffusion<D> viscosity_;

@@ -48,13 +48,24 @@ void PressureProjection<D>::setSolids(const MacGrid<D>& openFraction) {
 template <int D>
 void PressureProjection<D>::setSolidVelocity(const MacGrid<D>& solidVelocity) {
   solidVelocity_ = solidVelocity;
-  // Domain walls do not move, whatever the obstacle velocity field says there.
+  applyWallVelocities();
+}
+
+template <int D>
+void PressureProjection<D>::setWallNormalVelocity(int axis, int side, double velocity) {
+  wallNormalVelocity_[axis][side] = static_cast<float>(velocity);
+  applyWallVelocities();
+}
+
+template <int D>
+void PressureProjection<D>::applyWallVelocities() {
+  // A domain wall moves with its own normal velocity, whatever the obstacle velocity field says.
   for (int a = 0; a < D; ++a) {
     auto& us = solidVelocity_.component(a);
     parallelForCells(us, [&](const IVec<D>& f, std::size_t lin) {
-      if ((f[a] == 0 && sides_.side[a][0] == DomainSide::Wall) ||
-          (f[a] == spec_.res[a] && sides_.side[a][1] == DomainSide::Wall))
-        us[lin] = 0.0f;
+      for (int s = 0; s < 2; ++s)
+        if (f[a] == (s == 0 ? 0 : spec_.res[a]) && sides_.side[a][s] == DomainSide::Wall)
+          us[lin] = wallNormalVelocity_[a][s];
     });
   }
 }

@@ -63,8 +63,13 @@ class PressureProjection {
   // its null space and the preconditioner (multigrid hierarchy). Without a call all faces are open.
   void setSolids(const MacGrid<D>& openFraction);
   // Velocity of the solid on each face [m/s]; used where faces are (partly) solid. Default 0;
-  // faces on domain walls stay 0.
+  // faces on domain walls take the wall's normal velocity instead.
   void setSolidVelocity(const MacGrid<D>& solidVelocity);
+  // Normal velocity [m/s, positive along +axis] of the wall on side 0 (lower) or 1 (upper) of
+  // `axis`; default 0. A wall that moves fluid in or out is an inflow or outflow boundary with a
+  // Neumann pressure condition (the wind tunnel of Selle ch. 2.9). Where every side is a wall the
+  // caller must keep the net inflow zero, or no divergence-free field exists. Ignored on open sides.
+  void setWallNormalVelocity(int axis, int side, double velocity);
 
   // Makes `velocity` divergence free; the pressure [Pa] is kept (pressure()) and warm-starts
   // the next call.
@@ -77,6 +82,8 @@ class PressureProjection {
   Grid<float, D>& pressure() { return pressure_; }
   // Effective face weights: open fractions after thresholding, 0 on domain walls.
   const MacGrid<D>& faceWeights() const { return weights_; }
+  // Velocity of the solids on every face (setSolidVelocity, with the wall velocities applied).
+  const MacGrid<D>& solidVelocity() const { return solidVelocity_; }
   const PoissonMatrix<D>& matrix() const { return matrix_; }
   const FloatingRegions<D>& floatingRegions() const { return floating_; }
   // Levels of the multigrid hierarchy (1 when the MIC(0) preconditioner is used).
@@ -86,12 +93,15 @@ class PressureProjection {
  private:
   // dx * divergence per cell (the negated right-hand side of A p^ = b).
   void netOutflow(const MacGrid<D>& velocity, std::vector<float>& out) const;
+  // Writes the wall normal velocities onto the wall faces of solidVelocity_.
+  void applyWallVelocities();
 
   GridSpec<D> spec_;
   DomainSides<D> sides_;
   ProjectionSettings settings_;
   MacGrid<D> weights_;
   MacGrid<D> solidVelocity_;
+  std::array<std::array<float, 2>, D> wallNormalVelocity_{};
   PoissonMatrix<D> matrix_;
   FloatingRegions<D> floating_;
   std::unique_ptr<Mic0Preconditioner<D>> mic0_;

@@ -1,0 +1,82 @@
+#include "msim/scene/phenomenon_support.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "msim/core/error.hpp"
+#include "msim/geometry/occupancy.hpp"
+#include "msim/geometry/shape_factory.hpp"
+#include "msim/io/vdb.hpp"
+#include "msim/scene/scene_file.hpp"
+
+namespace msim::scene {
+
+template <int D>
+void requireFinite(const Grid<float, D>& g, const std::string& field, long stepIndex, double time) {
+  for (std::size_t i = 0; i < g.count(); ++i) {
+    if (std::isfinite(g[i])) continue;
+    const IVec<D> c = g.coord(i);
+    throw SimulationError(fmt::format("step {} (t = {:.4g} s): field '{}' became {} at cell ({}); the run is unstable",
+                                      stepIndex, time, field, g[i], fmt::join(c.data(), c.data() + D, ", ")));
+  }
+}
+
+template <int D>
+void restoreGrid(const std::filesystem::path& file, const std::string& name, Grid<float, D>& target,
+                 const std::string& sceneSource) {
+  const Grid<float, 3> saved = io::readFloatGrid(file, name);
+  bool same = saved.spec().dx == target.spec().dx && saved.count() == target.count();
+  for (int a = 0; a < D; ++a) same = same && saved.size()[a] == target.size()[a];
+  if (!same)
+    throw InputError(fmt::format("{}: cannot resume from '{}': its grid '{}' does not match the scene's domain",
+                                 sceneSource, file.string(), name));
+  std::copy(saved.data().begin(), saved.data().end(), target.data().begin());
+}
+
+render::PreviewSettings previewSettings(const Scene& scene) {
+  const nlohmann::json& p = scene.resolved.at("outputs").at("preview");
+  auto axis = [](const nlohmann::json& name) { return name.get<std::string>()[0] - 'x'; };
+  render::PreviewSettings s;
+  s.viewAxis = axis(p.at("view_axis"));
+  s.upAxis = axis(p.at("up_axis"));
+  if (scene.dimensions == 3 && s.viewAxis == s.upAxis)
+    throw InputError(scene.file.string() + ": 'outputs.preview.view_axis' and 'outputs.preview.up_axis' must differ");
+  s.extinction = p.at("extinction").get<double>();
+  s.albedo = p.at("albedo").get<double>();
+  s.minWidth = p.at("width").get<int>();
+  return s;
+}
+
+template <int D>
+std::unique_ptr<geometry::Shape<D>> sceneShape(const Scene& scene, const nlohmann::json& shapeJson,
+                                               const std::string& key) {
+  return geometry::buildShape<D>(shapeJson, scene.directory(), scene.file.string() + ": " + key);
+}
+
+template <int D>
+std::vector<std::pair<std::size_t, float>> coveredOpenCells(const Scene& scene, const geometry::Shape<D>& shape,
+                                                            const Grid<float, D>& solid, const std::string& key) {
+  const Grid<float, D> cover = geometry::occupancy(shape, solid.spec());
+  std::vector<std::pair<std::size_t, float>> cells;
+  for (std::size_t c = 0; c < cover.count(); ++c)
+    if (cover[c] > 0.0f && solid[c] < 0.5f) cells.emplace_back(c, cover[c]);
+  if (cells.empty())
+    throw InputError(fmt::format("{}: '{}' covers no open cell of the domain (outside it, or inside an obstacle)",
+                                 scene.file.string(), key));
+  return cells;
+}
+
+#define MSIM_INSTANTIATE(D)                                                                                        \
+  template void requireFinite<D>(const Grid<float, D>&, const std::string&, long, double);                          \
+  template void restoreGrid<D>(const std::filesystem::path&, const std::string&, Grid<float, D>&,                    \
+                               const std::string&);                                                              \
+  template std::unique_ptr<geometry::Shape<D>> sceneShape<D>(const Scene&, const nlohmann::json&,                  \
+                                                             const std::string&);                                 \
+  template std::vector<std::pair<std::size_t, float>> coveredOpenCells<D>(const Scene&, const geometry::Shape<D>&, \
+                                                                          const Grid<float, D>&, const std::string&);
+MSIM_INSTANTIATE(2)
+MSIM_INSTANTIATE(3)
+#undef MSIM_INSTANTIATE
+
+}  // namespace msim::scene

@@ -1,0 +1,45 @@
+#pragma once
+// Machinery every grid phenomenon needs between its solver and the scene: the finite-state check
+// that names step and field, resuming a grid from a saved frame, the preview settings from
+// outputs.preview, and shapes from scene keys with "outside the domain" errors.
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "msim/core/grid.hpp"
+#include "msim/geometry/shape.hpp"
+#include "msim/render/density_preview.hpp"
+
+namespace msim::scene {
+
+struct Scene;
+
+// SimulationError naming the step, time, field and first bad cell when `grid` holds NaN or inf.
+template <int D>
+void requireFinite(const Grid<float, D>& grid, const std::string& field, long stepIndex, double time);
+
+// Copies grid `name` of a saved frame into `target` (a cell or face grid); InputError naming the
+// scene and file when the grid is missing or its size differs.
+template <int D>
+void restoreGrid(const std::filesystem::path& vdbFile, const std::string& name, Grid<float, D>& target,
+                 const std::string& sceneSource);
+
+// outputs.preview of a resolved scene.
+render::PreviewSettings previewSettings(const Scene& scene);
+
+// Shape at scene key `key` (e.g. "sources[0].shape").
+template <int D>
+std::unique_ptr<geometry::Shape<D>> sceneShape(const Scene& scene, const nlohmann::json& shapeJson,
+                                               const std::string& key);
+
+// Cells covered by `shape` (coverage in (0,1]) that are not solid; InputError naming `key` when
+// there is none (the shape lies outside the domain or inside an obstacle).
+template <int D>
+std::vector<std::pair<std::size_t, float>> coveredOpenCells(const Scene& scene, const geometry::Shape<D>& shape,
+                                                            const Grid<float, D>& solid, const std::string& key);
+
+}  // namespace msim::scene

@@ -1,0 +1,124 @@
+#include "msim/scene/scene_obstacles.hpp"
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include <fmt/format.h>
+
+#include "msim/core/error.hpp"
+#include "msim/core/parallel.hpp"
+#include "msim/numerics/pressure/face_fractions.hpp"
+#include "msim/scene/json_vectors.hpp"
+#include "msim/scene/phenomenon_support.hpp"
+#include "msim/scene/scene_file.hpp"
+
+namespace msim::scene {
+
+namespace {
+
+template <int D>
+Vec<D> firstComponents(const nlohmann::json& v) {
+  const Vec3 p = paddedVec3(v);
+  Vec<D> out;
+  for (int a = 0; a < D; ++a) out[a] = p[a];
+  return out;
+}
+
+}  // namespace
+
+template <int D>
+Vec<D> SceneObstacles<D>::Obstacle::offset(double t) const {
+  return velocity * t + amplitude * std::sin(2.0 * std::numbers::pi * frequency * t);
+}
+
+template <int D>
+Vec<D> SceneObstacles<D>::Obstacle::velocityAt(double t) const {
+  const double w = 2.0 * std::numbers::pi * frequency;
+  return velocity + amplitude * (w * std::cos(w * t));
+}
+
+template <int D>
+SceneObstacles<D>::SceneObstacles(const Scene& scene, const GridSpec<D>& spec) : spec_(spec) {
+  const nlohmann::json& list = scene.resolved.at("obstacles");
+  const double duration = scene.frameCount / scene.fps;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string key = fmt::format("obstacles[{}]", i);
+    Obstacle o;
+    o.shape = sceneShape<D>(scene, list[i].at("shape"), key + ".shape");
+    o.velocity = firstComponents<D>(list[i].at("velocity"));
+    o.amplitude = firstComponents<D>(list[i].at("oscillation"));
+    o.frequency = list[i].at("frequency").get<double>();
+    // An obstacle must cut the domain at some frame of the run, or it is a typo.
+    const auto bounds = o.shape->bounds();
+    const Vec<D> lo = spec.origin, hi = spec.origin + spec.extent();
+    bool seen = false;
+    for (int frame = 0; frame <= scene.frameCount && !seen; ++frame) {
+      const Vec<D> shift = o.offset(frame / scene.fps);
+      bool overlaps = true;
+      for (int a = 0; a < D; ++a)
+        overlaps = overlaps && bounds.min[a] + shift[a] < hi[a] && bounds.max[a] + shift[a] > lo[a];
+      seen = overlaps;
+      if (!o.moving()) break;
+    }
+    if (!seen)
+      throw InputError(fmt::format("{}: '{}.shape' lies outside the domain{}", scene.file.string(), key,
+                                   o.moving() ? fmt::format(" during the whole run (0 to {:.3g} s)", duration) : ""));
+    obstacles_.push_back(std::move(o));
+  }
+}
+
+template <int D>
+bool SceneObstacles<D>::moving() const {
+  for (const auto& o : obstacles_)
+    if (o.moving()) return true;
+  return false;
+}
+
+template <int D>
+double SceneObstacles<D>::distance(const Vec<D>& x, double t, std::size_t* nearest) const {
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < obstacles_.size(); ++i) {
+    const double d = obstacles_[i].shape->distance(x - obstacles_[i].offset(t));
+    if (d < best) {
+      best = d;
+      if (nearest) *nearest = i;
+    }
+  }
+  return best;
+}
+
+template <int D>
+Grid<float, D> SceneObstacles<D>::nodalDistance(double time) const {
+  // Far from every solid the exact distance does not matter: cap it so an empty list is finite.
+  const double cap = 1e3 * spec_.dx * spec_.res.maxCoeff();
+  return numerics::sampleNodes<D>(spec_, [&](const Vec<D>& x) { return std::min(distance(x, time), cap); });
+}
+
+template <int D>
+MacGrid<D> SceneObstacles<D>::faceVelocity(double time) const {
+  MacGrid<D> v(spec_, 0.0f);
+  if (!moving()) return v;
+  for (int a = 0; a < D; ++a) {
+    auto& u = v.component(a);
+    parallelForCells(u, [&](const IVec<D>& f, std::size_t lin) {
+      std::size_t nearest = 0;
+      // Only faces the solid touches use this value; beyond a cell from every solid it is unused.
+      if (distance(u.position(f), time, &nearest) < spec_.dx)
+        u[lin] = static_cast<float>(obstacles_[nearest].velocityAt(time)[a]);
+    });
+  }
+  return v;
+}
+
+template <int D>
+double SceneObstacles<D>::maxSpeed(double time) const {
+  double speed = 0.0;
+  for (const auto& o : obstacles_) speed = std::max(speed, o.velocityAt(time).norm());
+  return speed;
+}
+
+template class SceneObstacles<2>;
+template class SceneObstacles<3>;
+
+}  // namespace msim::scene

@@ -1,0 +1,242 @@
+#include "msim/scene/smoke_phenomenon.hpp"
+
+#include <cmath>
+#include <optional>
+
+#include <fmt/format.h>
+
+#include "msim/core/error.hpp"
+#include "msim/core/parallel.hpp"
+#include "msim/fluid/smoke/combustion.hpp"
+#include "msim/fluid/smoke/smoke_solver.hpp"
+#include "msim/io/vdb.hpp"
+#include "msim/render/density_preview.hpp"
+#include "msim/scene/json_vectors.hpp"
+#include "msim/scene/phenomenon_support.hpp"
+#include "msim/scene/scene_file.hpp"
+#include "msim/scene/scene_obstacles.hpp"
+#include "msim/scene/smoke_scene_keys.hpp"
+
+namespace msim::scene {
+
+namespace {
+
+using nlohmann::json;
+
+double smokeBytesPerCell(int /*dimensions*/) {
+  // Measured growth of the peak RSS with the cell count (docs/PERFORMANCE.md): 346 B/cell in 3D
+  // (plume_3d at 118k and 1.83M cells), 353 B/cell in 2D. It covers the solver state and scratch
+  // (velocity, scalars, advection stages and traced feet, projection matrix, PCG and multigrid
+  // vectors, confinement), the fire fields and the VDB and preview copies at frame time.
+  return 360.0;
+}
+
+template <int D>
+Vec<D> firstComponents(const json& v) {
+  const Vec3 p = paddedVec3(v);
+  Vec<D> out;
+  for (int a = 0; a < D; ++a) out[a] = p[a];
+  return out;
+}
+
+template <int D>
+class SmokePhenomenon final : public Phenomenon {
+ public:
+  SmokePhenomenon(const Scene& scene, StageTimers& timers)
+      : source_(scene.file.string()),
+        timers_(timers),
+        obstacles_(scene, scene.gridSpec<D>()),
+        solver_(scene.gridSpec<D>(), smokeParams<D>(scene)),
+        timeCfl_(scene.resolved.at("time").at("cfl").get<double>()) {
+    const json& r = scene.resolved;
+    if (!obstacles_.empty()) placeObstacles(0.0);
+    const Vec<D> u0 = firstComponents<D>(r.at("smoke").at("initial_velocity"));
+    for (int a = 0; a < D; ++a) solver_.velocity().component(a).fill(static_cast<float>(u0[a]));
+
+    if (r.at("fire").at("enabled").get<bool>()) {
+      combustion_ = combustionParams(r);
+      fuel_ = solver_.addScalar("fuel", r.at("fire").at("fuel_dissipation").get<double>());
+      flame_ = solver_.addScalar("flame");
+    }
+    addSources(scene);
+    preview_ = previewSettings(scene);
+    preview_.emissionScale = r.at("fire").at("emission").get<double>();
+  }
+
+  double stableTimestep() const override {
+    // Bridson's bound: the fastest face plus the speed forces can add within one step,
+    // dt (u_max + sqrt(dx a_max)) <= cfl dx, so a plume starting from rest is not overshot.
+    const auto& p = solver_.params();
+    const double dx = solver_.spec().dx;
+    const double cflDt = solver_.cflTimestep();
+    double speed = std::isfinite(cflDt) ? p.cfl * dx / cflDt : 0.0;
+    speed = std::max({speed, inflowSpeed_, obstacles_.maxSpeed(time_)});
+    const double hottest = maxValue(solver_.temperature()) - p.buoyancy.ambientTemperature;
+    const double accel = p.buoyancy.beta * std::max(hottest, 0.0) + p.buoyancy.alpha * maxValue(solver_.density());
+    speed += std::sqrt(dx * accel);
+    return speed > 0.0 ? timeCfl_ * p.cfl * dx / speed : std::numeric_limits<double>::infinity();
+  }
+
+  void step(double dt) override {
+    for (std::size_t i = 0; i < windows_.size(); ++i)
+      solver_.source(i).active = time_ >= windows_[i].first && (windows_[i].second <= 0.0 || time_ < windows_[i].second);
+    if (obstacles_.moving()) {
+      ScopedStage stage(timers_, "smoke: move obstacles");
+      placeObstacles(time_ + 0.5 * dt);
+    }
+    {
+      ScopedStage stage(timers_, "smoke: step");
+      try {
+        solver_.step(dt);
+      } catch (const SimulationError& e) {
+        throw SimulationError(fmt::format("t = {:.4g} s: {}", time_, e.what()));
+      }
+    }
+    if (combustion_) {
+      ScopedStage stage(timers_, "fire: reactions");
+      const Grid<float, D>* solid = obstacles_.empty() ? nullptr : &solver_.solid();
+      fluid::react<D>(*combustion_, dt, solver_.scalar(fuel_), solver_.scalar(flame_), solver_.density(),
+                      solver_.temperature(), solid);
+    }
+    time_ += dt;
+  }
+
+  void checkFinite(long stepIndex, double time) const override {
+    static const char* axes[] = {"velocity x", "velocity y", "velocity z"};
+    for (int a = 0; a < D; ++a) requireFinite(solver_.velocity().component(a), axes[a], stepIndex, time);
+    requireFinite(solver_.density(), "density", stepIndex, time);
+    requireFinite(solver_.temperature(), "temperature", stepIndex, time);
+    for (std::size_t i = 0; i < solver_.scalarCount(); ++i)
+      requireFinite(solver_.scalar(i), solver_.scalarName(i), stepIndex, time);
+  }
+
+  // density, temperature (and fuel, flame) for users; "vel" at cell centres in 3D for tools; the
+  // face velocities vel_face_x.. and the pressure (the next solve's warm start) make --resume exact.
+  void writeVolume(const std::filesystem::path& vdbFile) const override {
+    io::VdbWriter writer;
+    writer.addFloatGrid("density", solver_.density());
+    writer.addFloatGrid("temperature", solver_.temperature());
+    for (std::size_t i = 0; i < solver_.scalarCount(); ++i) writer.addFloatGrid(solver_.scalarName(i), solver_.scalar(i));
+    if constexpr (D == 3) writer.addVectorGrid("vel", solver_.velocity());
+    for (int a = 0; a < D; ++a) writer.addFloatGrid(faceGridName(a), faceAsCells(solver_.velocity().component(a)));
+    writer.addFloatGrid("pressure", solver_.pressure());
+    writer.write(vdbFile);
+  }
+
+  io::Image preview() const override {
+    const Grid<float, D>* solid = obstacles_.empty() ? nullptr : &solver_.solid();
+    render::PreviewEmission<D> emission;
+    if (combustion_) emission = {&solver_.scalar(flame_), &solver_.temperature()};
+    return render::renderDensityPreview(solver_.density(), preview_, solid, emission);
+  }
+
+  void restore(const std::filesystem::path& vdbFile, double time) override {
+    time_ = time;
+    if (obstacles_.moving()) placeObstacles(time_);
+    restoreGrid(vdbFile, "density", solver_.density(), source_);
+    restoreGrid(vdbFile, "temperature", solver_.temperature(), source_);
+    for (std::size_t i = 0; i < solver_.scalarCount(); ++i)
+      restoreGrid(vdbFile, solver_.scalarName(i), solver_.scalar(i), source_);
+    for (int a = 0; a < D; ++a) restoreGrid(vdbFile, faceGridName(a), solver_.velocity().component(a), source_);
+    restoreGrid(vdbFile, "pressure", solver_.pressure(), source_);
+  }
+
+  json statistics() const override {
+    const fluid::SmokeStatistics s = solver_.statistics();
+    json j = {{"smoke_mass_kg", s.totalDensity},
+              {"kinetic_energy_J", s.kineticEnergy},
+              {"max_speed_m_s", s.maxSpeed},
+              {"max_divergence_1_s", s.maxDivergence},
+              {"pressure_iterations", s.pressureIterations},
+              {"max_temperature_K", maxValue(solver_.temperature())}};
+    if (combustion_) {
+      const double dV = solver_.spec().cellVolume();
+      j["fuel_kg"] = dV * total(solver_.scalar(fuel_));
+      j["flame_kg"] = dV * total(solver_.scalar(flame_));
+    }
+    return j;
+  }
+
+ private:
+  static std::string faceGridName(int axis) { return std::string("vel_face_") + "xyz"[axis]; }
+  // A face component as a cell grid of its own size (one more sample along its axis): VDB files
+  // hold cell grids. Only --resume reads it back; tools should use "vel".
+  static Grid<float, D> faceAsCells(const Grid<float, D>& face) {
+    GridSpec<D> spec = face.spec();
+    spec.res = face.size();
+    Grid<float, D> cells(spec);
+    std::copy(face.data().begin(), face.data().end(), cells.data().begin());
+    return cells;
+  }
+
+  static double maxValue(const Grid<float, D>& g) {
+    return parallelMax(g.count(), [&](std::size_t i) { return double(g[i]); });
+  }
+  static double total(const Grid<float, D>& g) {
+    return parallelSum(g.count(), [&](std::size_t i) { return double(g[i]); });
+  }
+
+  void placeObstacles(double time) {
+    solver_.setObstacles(obstacles_.nodalDistance(time));
+    if (obstacles_.moving()) solver_.setObstacleVelocity(obstacles_.faceVelocity(time));
+  }
+
+  void addSources(const Scene& scene) {
+    const json& list = scene.resolved.at("sources");
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const json& s = list[i];
+      const std::string key = fmt::format("sources[{}]", i);
+      fluid::SmokeSource<D> src;
+      const auto shape = sceneShape<D>(scene, s.at("shape"), key + ".shape");
+      src.cells = coveredOpenCells<D>(scene, *shape, solver_.solid(), key + ".shape");
+      src.mode = s.at("mode") == "set" ? fluid::SmokeSource<D>::Mode::Set : fluid::SmokeSource<D>::Mode::Add;
+      src.density = s.at("density").get<double>();
+      src.temperature = s.at("temperature").get<double>();
+      const double fuel = s.at("fuel").get<double>();
+      if (fuel > 0.0) {
+        if (!combustion_)
+          throw InputError(fmt::format("{}: '{}.fuel' is {} but 'fire.enabled' is false; nothing would burn it",
+                                       source_, key, fuel));
+        src.scalars.emplace_back(fuel_, fuel);
+      }
+      if (s.at("inflow").get<bool>()) {
+        src.velocity = firstComponents<D>(s.at("velocity"));
+        inflowSpeed_ = std::max(inflowSpeed_, src.velocity->norm());
+      }
+      const double start = s.at("start").get<double>(), stop = s.at("stop").get<double>();
+      if (stop > 0.0 && stop <= start)
+        throw InputError(fmt::format("{}: '{}.stop' ({} s) must come after '{}.start' ({} s), or be 0 for 'to the end'",
+                                     source_, key, stop, key, start));
+      windows_.emplace_back(start, stop);
+      solver_.addSource(std::move(src));
+    }
+  }
+
+  std::string source_;
+  StageTimers& timers_;
+  SceneObstacles<D> obstacles_;
+  fluid::SmokeSolver<D> solver_;
+  double timeCfl_;
+  double time_ = 0.0;
+  double inflowSpeed_ = 0.0;
+  std::vector<std::pair<double, double>> windows_;  // (start, stop) of each source [s]
+  std::optional<fluid::CombustionParams> combustion_;
+  std::size_t fuel_ = 0, flame_ = 0;
+  render::PreviewSettings preview_;
+};
+
+std::unique_ptr<Phenomenon> createSmoke(const Scene& scene, StageTimers& timers) {
+  if (scene.dimensions == 2) return std::make_unique<SmokePhenomenon<2>>(scene, timers);
+  return std::make_unique<SmokePhenomenon<3>>(scene, timers);
+}
+
+}  // namespace
+
+PhenomenonType smokePhenomenonType() {
+  return {"smoke",
+          "incompressible smoke and fire on a MAC grid: high-order advection, pressure projection, buoyancy, "
+          "vorticity confinement, combustion (Selle ch. 2-3, Stam ch. 6.4)",
+          &declareSmokeKeys, &smokeBytesPerCell, &createSmoke};
+}
+
+}  // namespace msim::scene

@@ -1,0 +1,56 @@
+#pragma once
+// Running the msim program from a test: a scratch folder per test, the program's exit code and
+// output, and scene text written to disk.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int exitCode = -1;
+  std::string output;  // stdout and stderr
+};
+
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::path(MSIM_TEST_TMP) / "app" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+Result runMsim(const std::string& args) {
+  // One log per test: ctest runs the tests of this program in parallel processes.
+  const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  const fs::path log = fs::path(MSIM_TEST_TMP) / "app" / (test + ".log");
+  fs::create_directories(log.parent_path());
+  const std::string cmd = std::string(MSIM_APP_PATH) + " " + args + " > " + log.string() + " 2>&1";
+  const int status = std::system(cmd.c_str());
+  Result r;
+  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream in(log);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  r.output = ss.str();
+  return r;
+}
+
+void writeText(const fs::path& path, const std::string& text) {
+  std::ofstream(path) << text;
+}
+
+bool noFramesIn(const fs::path& out) {
+  if (!fs::exists(out)) return true;
+  for (const auto& e : fs::recursive_directory_iterator(out))
+    if (e.is_regular_file()) return false;
+  return true;
+}
+
+}  // namespace
