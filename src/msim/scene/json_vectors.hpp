@@ -13,4 +13,13 @@ inline Vec3 paddedVec3(const nlohmann::json& v, double fill = 0.0) {
   return p;
 }
 
+// The first D numbers of a resolved scene vector (2D scenes ignore a z given in a 3-vector).
+template <int D>
+Vec<D> sceneVector(const nlohmann::json& v) {
+  const Vec3 p = paddedVec3(v);
+  Vec<D> out;
+  for (int a = 0; a < D; ++a) out[a] = p[a];
+  return out;
+}
+
 }  // namespace msim::scene

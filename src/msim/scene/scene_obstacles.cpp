@@ -15,18 +15,6 @@
 
 namespace msim::scene {
 
-namespace {
-
-template <int D>
-Vec<D> firstComponents(const nlohmann::json& v) {
-  const Vec3 p = paddedVec3(v);
-  Vec<D> out;
-  for (int a = 0; a < D; ++a) out[a] = p[a];
-  return out;
-}
-
-}  // namespace
-
 template <int D>
 Vec<D> SceneObstacles<D>::Obstacle::offset(double t) const {
   return velocity * t + amplitude * std::sin(2.0 * std::numbers::pi * frequency * t);
@@ -46,8 +34,8 @@ SceneObstacles<D>::SceneObstacles(const Scene& scene, const GridSpec<D>& spec) :
     const std::string key = fmt::format("obstacles[{}]", i);
     Obstacle o;
     o.shape = sceneShape<D>(scene, list[i].at("shape"), key + ".shape");
-    o.velocity = firstComponents<D>(list[i].at("velocity"));
-    o.amplitude = firstComponents<D>(list[i].at("oscillation"));
+    o.velocity = sceneVector<D>(list[i].at("velocity"));
+    o.amplitude = sceneVector<D>(list[i].at("oscillation"));
     o.frequency = list[i].at("frequency").get<double>();
     // An obstacle must cut the domain at some frame of the run, or it is a typo.
     const auto bounds = o.shape->bounds();

@@ -32,14 +32,6 @@ double smokeBytesPerCell(int /*dimensions*/) {
 }
 
 template <int D>
-Vec<D> firstComponents(const json& v) {
-  const Vec3 p = paddedVec3(v);
-  Vec<D> out;
-  for (int a = 0; a < D; ++a) out[a] = p[a];
-  return out;
-}
-
-template <int D>
 class SmokePhenomenon final : public Phenomenon {
  public:
   SmokePhenomenon(const Scene& scene, StageTimers& timers)
@@ -50,7 +42,7 @@ class SmokePhenomenon final : public Phenomenon {
         timeCfl_(scene.resolved.at("time").at("cfl").get<double>()) {
     const json& r = scene.resolved;
     if (!obstacles_.empty()) placeObstacles(0.0);
-    const Vec<D> u0 = firstComponents<D>(r.at("smoke").at("initial_velocity"));
+    const Vec<D> u0 = sceneVector<D>(r.at("smoke").at("initial_velocity"));
     for (int a = 0; a < D; ++a) solver_.velocity().component(a).fill(static_cast<float>(u0[a]));
 
     if (r.at("fire").at("enabled").get<bool>()) {
@@ -200,7 +192,7 @@ class SmokePhenomenon final : public Phenomenon {
         src.scalars.emplace_back(fuel_, fuel);
       }
       if (s.at("inflow").get<bool>()) {
-        src.velocity = firstComponents<D>(s.at("velocity"));
+        src.velocity = sceneVector<D>(s.at("velocity"));
         inflowSpeed_ = std::max(inflowSpeed_, src.velocity->norm());
       }
       const double start = s.at("start").get<double>(), stop = s.at("stop").get<double>();

@@ -113,6 +113,7 @@ MultigridPreconditioner<D>::MultigridPreconditioner(const PoissonMatrix<D>& fine
       x_[l].assign(n, 0.0f);
     }
   }
+  findBands();
 }
 
 template <int D>
@@ -124,6 +125,68 @@ template <int D>
 void MultigridPreconditioner<D>::smooth(int level, const std::vector<float>& b, std::vector<float>& x, int first,
                                         int sweeps) {
   for (int s = 0; s < sweeps; ++s) matrices_[level]->gaussSeidelPair(b, x, first);
+}
+
+template <int D>
+void MultigridPreconditioner<D>::smoothBand(int level, const std::vector<float>& b, std::vector<float>& x, int first) {
+  const auto& band = band_[level];
+  if (band[0].empty() && band[1].empty()) return;
+  for (int s = 0; s < settings_.boundarySweeps; ++s) {
+    matrices_[level]->relaxCells(b, x, band[first]);
+    matrices_[level]->relaxCells(b, x, band[1 - first]);
+  }
+}
+
+template <int D>
+void MultigridPreconditioner<D>::findBands() {
+  band_.assign(matrices_.size() - 1, {});
+  for (std::size_t l = 0; l + 1 < matrices_.size(); ++l) {
+    const PoissonMatrix<D>& A = *matrices_[l];
+    const IVec<D> res = A.res();
+    const std::size_t n = A.size();
+    // Distance in face steps from a fluid cell with a partly or fully closed interior face
+    // (domain walls do not count: plain multigrid handles them).
+    std::vector<int> distance(n, -1);
+    std::vector<std::size_t> front;
+    auto coords = [&](std::size_t i) {
+      IVec<D> c;
+      for (int a = 0; a < D; ++a) {
+        c[a] = static_cast<int>(i % static_cast<std::size_t>(res[a]));
+        i /= static_cast<std::size_t>(res[a]);
+      }
+      return c;
+    };
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!(A.diag()[i] > 0.0f)) continue;
+      const IVec<D> c = coords(i);
+      bool near = false;
+      for (int a = 0; a < D && !near; ++a) {
+        near = (c[a] > 0 && A.lowerWeight(a)[i] < 1.0f) ||
+               (c[a] + 1 < res[a] && A.lowerWeight(a)[i + A.stride(a)] < 1.0f);
+      }
+      if (near) distance[i] = 0, front.push_back(i);
+    }
+    for (int d = 1; d <= settings_.boundaryBand; ++d) {
+      std::vector<std::size_t> next;
+      for (const std::size_t i : front) {
+        const IVec<D> c = coords(i);
+        for (int a = 0; a < D; ++a)
+          for (int step : {-1, 1}) {
+            if (c[a] + step < 0 || c[a] + step >= res[a]) continue;
+            const std::size_t j = step < 0 ? i - A.stride(a) : i + A.stride(a);
+            if (distance[j] >= 0 || !(A.diag()[j] > 0.0f)) continue;
+            distance[j] = d;
+            next.push_back(j);
+          }
+      }
+      front = std::move(next);
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      if (distance[i] < 0) continue;
+      const IVec<D> c = coords(i);
+      band_[l][c.sum() & 1].push_back(i);
+    }
+  }
 }
 
 template <int D>
@@ -139,11 +202,15 @@ void MultigridPreconditioner<D>::vcycle(int level, const std::vector<float>& b, 
     }
     return;
   }
+  // Interior then band before the coarse correction, band then interior after it, each with the
+  // colours reversed: the mirror image, so the V-cycle stays symmetric.
   smooth(level, b, x, 0, settings_.smoothingSweeps);
+  smoothBand(level, b, x, 0);
   A.residual(b, x, r_[level]);
   restrictResidual(level);
   vcycle(level + 1, b_[level + 1], x_[level + 1]);
   prolongAdd(level, x);
+  smoothBand(level, b, x, 1);
   smooth(level, b, x, 1, settings_.smoothingSweeps);
 }
 

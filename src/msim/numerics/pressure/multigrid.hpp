@@ -23,6 +23,12 @@ struct MultigridSettings {
   int smoothingSweeps = 2;    // red-black sweeps before and after each coarse correction
   int coarsestSweeps = 30;    // red-black sweep pairs on the coarsest level
   int coarsestMinCells = 4;   // stop coarsening before an axis would drop below this many cells
+  // Extra red-black sweeps over the cells near solids (McAdams, Sifakis & Teran 2010, "boundary
+  // smoothing"): the coarse levels see an obstacle only through averaged face fractions, so the
+  // error near it is smoothed worst; without them the iterations grew from 5 to 9-10 between
+  // 32^3 and 128^3 with a ball in the box.
+  int boundarySweeps = 2;
+  int boundaryBand = 2;       // cells within this many face steps of a partly or fully closed face
 };
 
 // Face weights of the grid with half the resolution (res must be even on every axis).
@@ -43,6 +49,9 @@ class MultigridPreconditioner final : public Preconditioner {
  private:
   void vcycle(int level, const std::vector<float>& b, std::vector<float>& x);
   void smooth(int level, const std::vector<float>& b, std::vector<float>& x, int first, int sweeps);
+  // Red-black sweeps over the band of level `level` starting with colour `first`.
+  void smoothBand(int level, const std::vector<float>& b, std::vector<float>& x, int first);
+  void findBands();
   void restrictResidual(int fineLevel);                                // r_[l] -> b_[l+1]
   void prolongAdd(int fineLevel, std::vector<float>& fineX);           // fineX += P x_[l+1]
 
@@ -61,6 +70,8 @@ class MultigridPreconditioner final : public Preconditioner {
   std::vector<PoissonMatrix<D>> coarse_;           // levels 1..L-1
   std::vector<const PoissonMatrix<D>*> matrices_;  // all levels, finest first
   std::vector<std::vector<float>> b_, x_, r_;      // per level (b_ and x_ unused on level 0)
+  // Per level below the coarsest: the cells near solids, split by colour (coordinate-sum parity).
+  std::vector<std::array<std::vector<std::size_t>, 2>> band_;
 };
 
 }  // namespace msim::numerics

@@ -81,6 +81,24 @@ void PoissonMatrix<D>::gaussSeidel(const std::vector<float>& b, std::vector<floa
   parallelForRows<D>(res_, [&](std::size_t row) { relaxRow(b, x, colour, row); });
 }
 
+template <int D>
+void PoissonMatrix<D>::relaxCells(const std::vector<float>& b, std::vector<float>& x,
+                                  const std::vector<std::size_t>& cells) const {
+  parallelFor(0, cells.size(), [&](std::size_t k) {
+    const std::size_t i = cells[k];
+    std::size_t rest = i;
+    float sum = 0.0f;
+    for (int a = 0; a < D; ++a) {
+      const int c = static_cast<int>(rest % static_cast<std::size_t>(res_[a]));
+      rest /= static_cast<std::size_t>(res_[a]);
+      // Beyond the domain the ghost value is 0 (open) or the weight is 0 (wall): no term.
+      if (c > 0) sum += lower_[a][i] * x[i - stride_[a]];
+      if (c + 1 < res_[a]) sum += lower_[a][i + stride_[a]] * x[i + stride_[a]];
+    }
+    x[i] = invDiag_[i] * (b[i] + sum);
+  }, 256);
+}
+
 // Same updates in the same order per cell as gaussSeidel(first) then gaussSeidel(1 - first), but
 // in one pass over memory: in each slab of planes (last axis), plane p gets its first colour and
 // then plane p - 1 its second, whose neighbours are all final by then. A slab's first and last

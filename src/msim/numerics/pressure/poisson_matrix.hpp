@@ -45,6 +45,9 @@ class PoissonMatrix {
   // gaussSeidel(colour first) followed by gaussSeidel(1 - first), with the same result, in one
   // pass over memory.
   void gaussSeidelPair(const std::vector<float>& b, std::vector<float>& x, int first) const;
+  // One Gauss-Seidel update of each listed cell. The cells must not couple to each other (one
+  // colour of a red-black split), so the updates run in parallel and their order is irrelevant.
+  void relaxCells(const std::vector<float>& b, std::vector<float>& x, const std::vector<std::size_t>& cells) const;
 
  private:
   void relaxRow(const std::vector<float>& b, std::vector<float>& x, int colour, std::size_t row) const;
