@@ -42,6 +42,8 @@ class SmokePhenomenon final : public Phenomenon {
         timeCfl_(scene.resolved.at("time").at("cfl").get<double>()) {
     const json& r = scene.resolved;
     if (!obstacles_.empty()) placeObstacles(0.0);
+    for (const auto& axis : solver_.params().wallVelocity)
+      for (const auto& wall : axis) boundarySpeed_ = std::max(boundarySpeed_, wall.norm());
     const Vec<D> u0 = sceneVector<D>(r.at("smoke").at("initial_velocity"));
     for (int a = 0; a < D; ++a) solver_.velocity().component(a).fill(static_cast<float>(u0[a]));
 
@@ -62,7 +64,7 @@ class SmokePhenomenon final : public Phenomenon {
     const double dx = solver_.spec().dx;
     const double cflDt = solver_.cflTimestep();
     double speed = std::isfinite(cflDt) ? p.cfl * dx / cflDt : 0.0;
-    speed = std::max({speed, inflowSpeed_, obstacles_.maxSpeed(time_)});
+    speed = std::max({speed, boundarySpeed_, obstacles_.maxSpeed(time_)});
     const double hottest = maxValue(solver_.temperature()) - p.buoyancy.ambientTemperature;
     const double accel = p.buoyancy.beta * std::max(hottest, 0.0) + p.buoyancy.alpha * maxValue(solver_.density());
     speed += std::sqrt(dx * accel);
@@ -193,7 +195,7 @@ class SmokePhenomenon final : public Phenomenon {
       }
       if (s.at("inflow").get<bool>()) {
         src.velocity = sceneVector<D>(s.at("velocity"));
-        inflowSpeed_ = std::max(inflowSpeed_, src.velocity->norm());
+        boundarySpeed_ = std::max(boundarySpeed_, src.velocity->norm());
       }
       const double start = s.at("start").get<double>(), stop = s.at("stop").get<double>();
       if (stop > 0.0 && stop <= start)
@@ -210,7 +212,7 @@ class SmokePhenomenon final : public Phenomenon {
   fluid::SmokeSolver<D> solver_;
   double timeCfl_;
   double time_ = 0.0;
-  double inflowSpeed_ = 0.0;
+  double boundarySpeed_ = 0.0;  // fastest wall or source inflow: the flow will reach it [m/s]
   std::vector<std::pair<double, double>> windows_;  // (start, stop) of each source [s]
   std::optional<fluid::CombustionParams> combustion_;
   std::size_t fuel_ = 0, flame_ = 0;
