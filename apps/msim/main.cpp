@@ -1,4 +1,4 @@
-// msim: the command-line program. run / info / validate a scene.
+// msim: the command-line program. run / info / validate a scene; render saved frames.
 // Exit codes: 0 success, 2 bad input (scene, command line, files), 3 simulation failure,
 // 130 interrupted by the user (the last frame written is complete; --resume continues).
 #include <cstdio>
@@ -17,6 +17,7 @@
 #include "msim/core/system_memory.hpp"
 #include "msim/scene/interrupt.hpp"
 #include "msim/scene/runner.hpp"
+#include "msim/scene/saved_frames.hpp"
 #include "msim/scene/scene_file.hpp"
 #include "msim/scene/schema/describe.hpp"
 #include "msim/version.hpp"
@@ -75,6 +76,12 @@ int main(int argc, char** argv) {
   validate->add_option("scene", scenePath, "scene file (.json)")->required();
   validate->add_option("--set", overrides, "override a scene key: key.path=value (repeatable)");
 
+  std::string renderInput, renderOutput;
+  auto* render = app.add_subcommand("render", "render saved frames (a run folder or one .vdb file) without simulating");
+  render->add_option("input", renderInput, "a folder written by 'msim run', or a .vdb file")->required();
+  render->add_option("--out", renderOutput, "output folder (run; default <run>/render) or file (.vdb; default <file>.png)");
+  render->add_option("--set", overrides, "override a render key: render.key.path=value (repeatable)");
+
   std::string phenomenonName;
   auto* schema = app.add_subcommand("schema", "print the Markdown reference of every scene key of a phenomenon");
   schema->add_option("phenomenon", phenomenonName, "phenomenon name, e.g. gas")->required();
@@ -96,6 +103,17 @@ int main(int argc, char** argv) {
       const scene::PhenomenonType* type = scene::findPhenomenonType(phenomenonName);
       if (!type) throw InputError(fmt::format("unknown phenomenon '{}'", phenomenonName));
       std::printf("%s", scene::markdownReference(scene::sceneSchema(*type)).c_str());
+      return 0;
+    }
+    if (*render) {
+      scene::RenderJob job;
+      job.input = renderInput;
+      job.output = renderOutput;
+      job.overrides = overrides;
+      job.showProgress = !quiet;
+      const auto written = scene::renderSavedFrames(job);
+      logger().info("rendered {} frame{} -> {}", written.size(), written.size() == 1 ? "" : "s",
+                    written.size() == 1 ? written.front().string() : written.front().parent_path().string());
       return 0;
     }
     const scene::Scene s = scene::loadScene(scenePath, overrides);

@@ -12,21 +12,20 @@
 
 namespace fs = std::filesystem;
 
-namespace {
-
+// inline: each test file uses only some of these.
 struct Result {
   int exitCode = -1;
   std::string output;  // stdout and stderr
 };
 
-fs::path scratch(const std::string& name) {
+inline fs::path scratch(const std::string& name) {
   const fs::path dir = fs::path(MSIM_TEST_TMP) / "app" / name;
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
 }
 
-Result runMsim(const std::string& args) {
+inline Result runMsim(const std::string& args) {
   // One log per test: ctest runs the tests of this program in parallel processes.
   const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
   const fs::path log = fs::path(MSIM_TEST_TMP) / "app" / (test + ".log");
@@ -42,15 +41,14 @@ Result runMsim(const std::string& args) {
   return r;
 }
 
-void writeText(const fs::path& path, const std::string& text) {
+inline void writeText(const fs::path& path, const std::string& text) {
   std::ofstream(path) << text;
 }
 
-bool noFramesIn(const fs::path& out) {
+inline bool noFramesIn(const fs::path& out) {
   if (!fs::exists(out)) return true;
   for (const auto& e : fs::recursive_directory_iterator(out))
     if (e.is_regular_file()) return false;
   return true;
 }
 
-}  // namespace

@@ -17,6 +17,7 @@
 #include "msim/io/video.hpp"
 #include "msim/scene/interrupt.hpp"
 #include "msim/scene/progress_bar.hpp"
+#include "msim/scene/saved_frames.hpp"
 #include "msim/version.hpp"
 
 namespace msim::scene {
@@ -31,8 +32,9 @@ fs::path frameFile(const fs::path& dir, const std::string& name, int frame, cons
 namespace {
 
 struct Layout {
-  fs::path root, vdbDir, pngDir;
+  fs::path root, vdbDir, pngDir, renderDir;
   bool vdb = false, png = false, mp4 = false;
+  RenderKeys render;  // render.enabled: each saved frame is also rendered into renderDir
   std::string name;
 };
 
@@ -46,19 +48,26 @@ Layout layoutFor(const Scene& scene, const fs::path& outDir) {
   l.png = o.at("png").get<bool>();
   l.mp4 = o.at("mp4").get<bool>() && l.png;
   l.name = scene.name();
+  l.renderDir = outDir / "render";
+  l.render = renderKeys(scene.resolved.at("render"), scene.file.string());
+  if (l.render.enabled && scene.dimensions != 3)
+    throw InputError(scene.file.string() + ": 'render.enabled' needs a 3D scene (2D scenes have their preview)");
+  if (l.render.enabled && !l.vdb)
+    throw InputError(scene.file.string() + ": 'render.enabled' renders the saved VDB frames; set 'outputs.vdb' to true");
   return l;
 }
 
 bool frameComplete(const Layout& l, int frame) {
   if (l.vdb && !fs::exists(frameFile(l.vdbDir, l.name, frame, "vdb"))) return false;
   if (l.png && !fs::exists(frameFile(l.pngDir, l.name, frame, "png"))) return false;
+  if (l.render.enabled && !fs::exists(frameFile(l.renderDir, l.name, frame, "png"))) return false;
   return l.vdb || l.png;
 }
 
 // Removes frame files of an earlier run with the same name so a fresh run never mixes with them.
 void clearFrames(const Layout& l) {
   const std::regex pattern(fmt::format("{}_[0-9]{{4,}}\\.(vdb|png)", l.name));
-  for (const fs::path& dir : {l.vdbDir, l.pngDir}) {
+  for (const fs::path& dir : {l.vdbDir, l.pngDir, l.renderDir}) {
     if (!fs::exists(dir)) continue;
     for (const auto& entry : fs::directory_iterator(dir))
       if (std::regex_match(entry.path().filename().string(), pattern)) fs::remove(entry.path());
@@ -161,7 +170,8 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
   fs::create_directories(layout.root);
   if (layout.vdb) fs::create_directories(layout.vdbDir);
   if (layout.png) fs::create_directories(layout.pngDir);
-  for (const fs::path& dir : {layout.root, layout.vdbDir, layout.pngDir}) io::removeStaleTemporaries(dir);
+  if (layout.render.enabled) fs::create_directories(layout.renderDir);
+  for (const fs::path& dir : {layout.root, layout.vdbDir, layout.pngDir, layout.renderDir}) io::removeStaleTemporaries(dir);
   RunRecord record(scene, options, layout);
 
   int firstFrame = 1;
@@ -213,6 +223,12 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
         ScopedStage stage(timers, "write vdb");
         phenomenon->writeVolume(frameFile(layout.vdbDir, layout.name, frame, "vdb"));
       }
+      if (layout.render.enabled) {
+        // From the file just written, exactly as 'msim render' would make it later.
+        ScopedStage stage(timers, "render frame");
+        io::writePng(frameFile(layout.renderDir, layout.name, frame, "png"),
+                     renderSavedFrame(frameFile(layout.vdbDir, layout.name, frame, "vdb"), layout.render));
+      }
       if (layout.png) {
         ScopedStage stage(timers, "write png");
         io::writePng(frameFile(layout.pngDir, layout.name, frame, "png"), phenomenon->preview());
@@ -243,6 +259,11 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
     if (!video.written) {
       logger().warn("{}", video.note);
       record.note("mp4", video.note);
+    }
+    if (layout.render.enabled && video.written) {
+      std::vector<fs::path> rendered;
+      for (int f = 1; f <= lastFrame; ++f) rendered.push_back(frameFile(layout.renderDir, layout.name, f, "png"));
+      io::encodeMp4(rendered, scene.fps, layout.root / (layout.name + "_render.mp4"));
     }
   }
   record.save(status == RunStatus::Complete ? "complete" : "interrupted", timers, wall());

@@ -6,6 +6,7 @@
 
 #include "msim/core/error.hpp"
 #include "msim/scene/json_vectors.hpp"
+#include "msim/scene/render_keys.hpp"
 #include "msim/core/system_memory.hpp"
 #include "msim/scene/schema/json_file.hpp"
 #include "msim/scene/schema/key_suggestion.hpp"
@@ -81,6 +82,7 @@ Schema sceneSchema(const PhenomenonType& type) {
   root.field("domain", domainSchema());
   root.field("time", timeSchema());
   root.field("outputs", outputsSchema());
+  root.field("render", renderSchema());
   type.declare(root);
   return root;
 }

@@ -1,0 +1,61 @@
+// The physically based volume renderer (Stam ch. 5, single scattering) on a 128^3 smoke-like
+// density (Gaussian puffs modulated by a few sine octaves, exactly zero away from the puffs as a
+// simulation's density is) at 640 x 480 with one shadowing directional light and sky light.
+// Counters: seconds spent on the light transmittance grid and on the camera rays, rays/s and
+// density samples per second of the march.
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+
+#include "msim/render/volume_renderer.hpp"
+
+using namespace msim;
+
+namespace {
+
+Grid<float, 3> smokePuffs(int n) {
+  const GridSpec<3> spec(Vec3::Zero(), 1.0 / n, IVec3::Constant(n));
+  Grid<float, 3> rho(spec);
+  const Vec3 centres[] = {{0.5, 0.35, 0.5}, {0.38, 0.5, 0.45}, {0.62, 0.55, 0.55}, {0.5, 0.7, 0.5}, {0.45, 0.82, 0.58}};
+  const double radii[] = {0.14, 0.12, 0.12, 0.11, 0.08};
+  for (std::size_t i = 0; i < rho.count(); ++i) {
+    const Vec3 x = rho.position(rho.coord(i));
+    double d = 0.0;
+    for (int k = 0; k < 5; ++k) d += std::exp(-(x - centres[k]).squaredNorm() / (2.0 * radii[k] * radii[k]));
+    const double detail = std::sin(23.0 * x[0] + 3.0 * std::sin(17.0 * x[1])) * std::sin(19.0 * x[1] + 2.0 * x[2]) *
+                          std::sin(29.0 * x[2] + 5.0 * x[0]);
+    const double value = 2.0 * d * (0.7 + 0.3 * detail) - 0.05;
+    rho[i] = value > 0.0 ? static_cast<float>(value) : 0.0f;
+  }
+  return rho;
+}
+
+void BM_RenderVolume(benchmark::State& state) {
+  const Grid<float, 3> rho = smokePuffs(static_cast<int>(state.range(0)));
+  const render::Camera camera = render::frameBox(rho.spec().origin, rho.spec().upper(), 640, 480);
+  render::Light sun;
+  sun.type = render::Light::Type::Directional;
+  sun.direction = Vec3(0.5, -1.0, -0.3);
+  sun.intensity = 10.0;
+  const render::Medium medium;
+  const render::VolumeRenderSettings settings;
+  render::RenderStats total;
+  for (auto _ : state) {
+    const render::RenderResult r = render::renderVolume({&rho}, camera, {sun}, medium, settings);
+    total.secondsLightGrids += r.stats.secondsLightGrids;
+    total.secondsMarch += r.stats.secondsMarch;
+    total.primaryRays += r.stats.primaryRays;
+    total.samples += r.stats.samples;
+    benchmark::DoNotOptimize(r.image.rgb.data());
+  }
+  const double iterations = static_cast<double>(state.iterations());
+  state.counters["s_light_grids"] = total.secondsLightGrids / iterations;
+  state.counters["s_march"] = total.secondsMarch / iterations;
+  state.counters["rays_per_s"] = static_cast<double>(total.primaryRays) / (total.secondsLightGrids + total.secondsMarch);
+  state.counters["samples_per_s"] = static_cast<double>(total.samples) / total.secondsMarch;
+  state.counters["samples_per_ray"] = static_cast<double>(total.samples) / static_cast<double>(total.primaryRays);
+}
+
+}  // namespace
+
+BENCHMARK(BM_RenderVolume)->Arg(128)->Unit(benchmark::kMillisecond)->Iterations(5);

@@ -1,0 +1,562 @@
+#include "msim/render/volume_renderer.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+#include "msim/core/parallel.hpp"
+#include "msim/render/blackbody.hpp"
+#include "msim/render/phase_function.hpp"
+
+namespace msim::render {
+
+namespace {
+
+constexpr double kInv4Pi = 0.25 / std::numbers::pi;
+constexpr double kMinTransmittance = 1e-4;  // early ray termination: what is left cannot show in 8 bits
+constexpr int kBrick = 8;                   // cells per side of an empty-space-skipping brick
+constexpr int kSweepSlices = 8;             // slices a directional light's path is marched between interpolations
+
+bool finiteNonNegative(const Vec3& v) { return v.allFinite() && (v.array() >= 0.0).all(); }
+
+void checkCellCentred(const Grid<float, 3>& g, const char* name) {
+  if (g.count() == 0) throw std::invalid_argument(std::string("volume renderer: the ") + name + " grid is empty");
+  if (g.offset() != Vec3::Constant(0.5) || g.size() != g.spec().res)
+    throw std::invalid_argument(std::string("volume renderer: the ") + name + " grid must be cell-centred");
+}
+
+void checkSameLayout(const Grid<float, 3>& density, const Grid<float, 3>* g, const char* name) {
+  if (g && !g->sameLayout(density))
+    throw std::invalid_argument(std::string("volume renderer: the ") + name +
+                                " grid does not have the density grid's layout (spec, size, offset)");
+}
+
+// Trilinear interpolation weights of one point, shared by every grid of one layout.
+struct Trilinear {
+  std::size_t base = 0;
+  std::ptrdiff_t ox = 0, oy = 0, oz = 0;  // memory offsets to the upper neighbour on each axis
+  float tx = 0, ty = 0, tz = 0;
+
+  float operator()(const float* g) const {
+    const float* p = g + base;
+    const auto lerp = [](float a, float b, float t) { return a + t * (b - a); };
+    const float c00 = lerp(p[0], p[ox], tx), c10 = lerp(p[oy], p[oy + ox], tx);
+    const float c01 = lerp(p[oz], p[oz + ox], tx), c11 = lerp(p[oz + oy], p[oz + oy + ox], tx);
+    return lerp(lerp(c00, c10, ty), lerp(c01, c11, ty), tz);
+  }
+};
+
+// Trilinear sampling of cell-centred grids of one layout: cell centre c sits at sample coordinate
+// c; positions beyond the outer centres clamp onto them (the border value extends to the faces).
+class Sampler {
+ public:
+  explicit Sampler(const Grid<float, 3>& g)
+      : origin_(g.spec().origin), invDx_(1.0 / g.spec().dx), n_(g.size()) {
+    for (int a = 0; a < 3; ++a) stride_[a] = g.stride(a);
+  }
+
+  Trilinear at(const Vec3& x) const {
+    Trilinear w;
+    std::ptrdiff_t* offset[3] = {&w.ox, &w.oy, &w.oz};
+    float* t[3] = {&w.tx, &w.ty, &w.tz};
+    for (int a = 0; a < 3; ++a) {
+      if (n_[a] < 2) continue;  // a single layer: constant along this axis
+      const double hi = n_[a] - 1;
+      double s = (x[a] - origin_[a]) * invDx_ - 0.5;
+      s = s > 0.0 ? (s < hi ? s : hi) : 0.0;  // a NaN lands on 0 and can never index outside
+      const int i0 = std::min(static_cast<int>(s), n_[a] - 2);
+      w.base += static_cast<std::size_t>(i0 * stride_[a]);
+      *offset[a] = stride_[a];
+      *t[a] = static_cast<float>(s - i0);
+    }
+    return w;
+  }
+
+ private:
+  Vec3 origin_;
+  double invDx_;
+  IVec3 n_;
+  std::ptrdiff_t stride_[3];
+};
+
+// Distance along the unit direction d from x (inside the box) to the box's boundary.
+double exitDistance(const Vec3& x, const Vec3& d, const Vec3& lo, const Vec3& hi) {
+  double t = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    if (d[a] > 0.0) t = std::min(t, (hi[a] - x[a]) / d[a]);
+    if (d[a] < 0.0) t = std::min(t, (lo[a] - x[a]) / d[a]);
+  }
+  return std::max(t, 0.0);
+}
+
+// Parameter interval [t0, t1] of a ray inside the box (slab method); false if it misses.
+bool intersectBox(const Ray& r, const Vec3& lo, const Vec3& hi, double& t0, double& t1) {
+  t0 = 0.0;
+  t1 = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    if (r.direction[a] == 0.0) {
+      if (r.origin[a] < lo[a] || r.origin[a] > hi[a]) return false;
+      continue;
+    }
+    const double inv = 1.0 / r.direction[a];
+    double ta = (lo[a] - r.origin[a]) * inv, tb = (hi[a] - r.origin[a]) * inv;
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+  }
+  return t0 < t1;
+}
+
+// Interpolation of the optical depth towards a directional light along one lateral axis of a slice
+// at sample coordinate s (cell centres at 0..n-1, box faces at -0.5 and n - 0.5): linear between
+// centres, and beyond the outer centre linear down to 0 at the face, where the path leaves the box.
+// (Clamping instead would hand each border cell the depth of the border cell nearer the light, and
+// paths along the sides would never leave the box.) The sweep only looks beyond the face the
+// light's path heads for, so the depth there is indeed 0.
+struct LateralStencil {
+  int index[2];
+  double depthWeight[2];
+};
+
+LateralStencil lateralStencil(double s, int n) {
+  if (s >= 0.0 && s <= n - 1.0 && n >= 2) {
+    const int i0 = std::min(static_cast<int>(s), n - 2);
+    const double f = s - i0;
+    return {{i0, i0 + 1}, {1.0 - f, f}};
+  }
+  const int edge = s < 0.0 ? 0 : n - 1;
+  const double beyond = std::abs(s - edge);  // cells past the outer centre, at most 0.5 here
+  return {{edge, edge}, {std::max(1.0 - 2.0 * beyond, 0.0), 0.0}};
+}
+
+// Integral of the density along x + t dir for t in [0, length]: midpoint rule with equal steps of
+// at most ds.
+double densityIntegral(const Sampler& sampler, const float* rho, const Vec3& x, const Vec3& dir, double length,
+                       double ds) {
+  if (!(length > 0.0)) return 0.0;
+  const int steps = std::max(1, static_cast<int>(std::ceil(length / ds)));
+  const double h = length / steps;
+  double sum = 0.0;
+  for (int m = 0; m < steps; ++m) sum += std::max(sampler.at(x + (m + 0.5) * h * dir)(rho), 0.0f);
+  return h * sum;
+}
+
+// densityIntegral over the path from a cell centre along dir for `length` as fixed weights on
+// neighbouring cells: the samples sit at the same place relative to every cell centre, so the
+// trilinear weights are the same for all cells whose neighbours all exist. Summing ~50 weighted
+// cells costs a fraction of the per-sample weight computation. (Negative densities are clamped
+// per cell here and per sample in densityIntegral: the two differ only at undershoots a
+// simulation may leave.)
+class PathStencil {
+ public:
+  PathStencil(const Grid<float, 3>& rho, const Vec3& dir, double length, double ds) : n_(rho.size()) {
+    const int steps = std::max(1, static_cast<int>(std::ceil(length / ds)));
+    const double h = length / steps, invDx = 1.0 / rho.spec().dx;
+    std::vector<std::pair<IVec3, double>> weights;
+    for (int m = 0; m < steps; ++m) {
+      const Vec3 o = (m + 0.5) * h * invDx * dir;  // sample offset from the cell centre [cells]
+      const IVec3 f(static_cast<int>(std::floor(o[0])), static_cast<int>(std::floor(o[1])),
+                    static_cast<int>(std::floor(o[2])));
+      const Vec3 t = o - f.cast<double>();
+      for (int corner = 0; corner < 8; ++corner) {
+        IVec3 delta = f;
+        double w = h;
+        for (int a = 0; a < 3; ++a) {
+          const bool upper = (corner >> a) & 1;
+          delta[a] += upper;
+          w *= upper ? t[a] : 1.0 - t[a];
+        }
+        if (w == 0.0) continue;
+        const auto same = std::find_if(weights.begin(), weights.end(), [&](const auto& e) { return e.first == delta; });
+        if (same != weights.end())
+          same->second += w;
+        else
+          weights.emplace_back(delta, w);
+      }
+    }
+    lo_ = hi_ = weights.front().first;
+    for (const auto& [delta, w] : weights) {
+      lo_ = lo_.cwiseMin(delta);
+      hi_ = hi_.cwiseMax(delta);
+      entries_.push_back({delta[0] * rho.stride(0) + delta[1] * rho.stride(1) + delta[2] * rho.stride(2), w});
+    }
+  }
+
+  bool fits(const IVec3& cell) const {
+    return (cell + lo_).minCoeff() >= 0 && ((cell + hi_).array() < n_.array()).all();
+  }
+  double operator()(const float* rho, std::size_t i) const {
+    double sum = 0.0;
+    for (const Entry& e : entries_) sum += e.weight * std::max(rho[static_cast<std::ptrdiff_t>(i) + e.offset], 0.0f);
+    return sum;
+  }
+
+ private:
+  struct Entry {
+    std::ptrdiff_t offset;
+    double weight;
+  };
+  IVec3 n_, lo_, hi_;
+  std::vector<Entry> entries_;
+};
+
+// Optical depth from every cell centre towards a directional light (see lightTransmittance),
+// returned as transmittance. Slices across the axis closest to the light are done in order from
+// the light's side; each cell marches its path exactly over kSweepSlices slices and adds the depth
+// interpolated where the path crosses that earlier slice. The crossing is at the same offset from
+// every cell, so the stencil is fixed. Interpolating at every slice would be cheapest, but each
+// interpolation smears the depth like upwind advection does, and shadow edges (a box edge's
+// included) would blur by sqrt(slices) cells; marching kSweepSlices slices per interpolation cuts
+// that by sqrt(kSweepSlices) at kSweepSlices / stepCells samples per cell, which PathStencil makes
+// cheap away from the borders.
+Grid<float, 3> sweepDirectional(const Grid<float, 3>& rho, const Vec3& toLight, double sigmaT, double stepCells) {
+  Grid<float, 3> depth(rho.spec(), rho.size(), rho.offset());
+  const IVec3 n = rho.size();
+  const double dx = rho.spec().dx, ds = stepCells * dx;
+  const Vec3 lo = rho.spec().origin, hi = rho.spec().upper();
+  int a = 0;
+  for (int q = 1; q < 3; ++q)
+    if (std::abs(toLight[q]) > std::abs(toLight[a])) a = q;
+  const int b = (a + 1) % 3, c = (a + 2) % 3;
+  const double la = std::abs(toLight[a]);
+  const int towardsLight = toLight[a] > 0.0 ? 1 : -1;
+  const int jump = std::min(kSweepSlices, n[a]);
+  const double tJump = jump * dx / la;  // path length to the slice `jump` slices closer to the light
+  const double shiftB = jump * toLight[b] / la, shiftC = jump * toLight[c] / la;  // its lateral offset [cells]
+  const Sampler sampler(rho);
+  const PathStencil path(rho, toLight, tJump, ds);
+  const float* r = rho.data().data();
+  float* d = depth.data().data();
+
+  // Cells `jump` or fewer slices apart do not depend on each other: one parallel loop per block.
+  for (int first = 0; first < n[a]; first += jump) {
+    const int slices = std::min(jump, n[a] - first);
+    parallelFor(0, static_cast<std::size_t>(slices) * n[c], [&](std::size_t row) {
+      const int step = first + static_cast<int>(row / n[c]);
+      IVec3 cell;
+      cell[a] = towardsLight > 0 ? n[a] - 1 - step : step;
+      cell[c] = static_cast<int>(row % n[c]);
+      for (int ib = 0; ib < n[b]; ++ib) {
+        cell[b] = ib;
+        const Vec3 x = rho.position(cell);
+        const double tExit = exitDistance(x, toLight, lo, hi);
+        double tau;
+        if (tExit <= tJump * (1.0 + 1e-9)) {
+          tau = sigmaT * densityIntegral(sampler, r, x, toLight, tExit, ds);  // leaves the box first
+        } else {
+          const LateralStencil sb = lateralStencil(ib + shiftB, n[b]), sc = lateralStencil(cell[c] + shiftC, n[c]);
+          IVec3 p = cell;
+          p[a] = cell[a] + jump * towardsLight;
+          double depthThere = 0.0;
+          for (int u = 0; u < 2; ++u)
+            for (int v = 0; v < 2; ++v) {
+              p[b] = sb.index[u];
+              p[c] = sc.index[v];
+              depthThere += sb.depthWeight[u] * sc.depthWeight[v] * d[rho.index(p)];
+            }
+          const double segment =
+              path.fits(cell) ? path(r, rho.index(cell)) : densityIntegral(sampler, r, x, toLight, tJump, ds);
+          tau = depthThere + sigmaT * segment;
+        }
+        d[rho.index(cell)] = static_cast<float>(tau);
+      }
+    }, 1);
+  }
+  parallelFor(0, depth.count(), [&](std::size_t i) { d[i] = std::exp(-d[i]); });
+  return depth;
+}
+
+// Transmittance from every cell centre to a point or spot light by a shadow ray per cell.
+Grid<float, 3> shadowRays(const Grid<float, 3>& rho, const Light& light, double sigmaT, double stepCells) {
+  Grid<float, 3> out(rho.spec(), rho.size(), rho.offset());
+  const Vec3 lo = rho.spec().origin, hi = rho.spec().upper();
+  const Sampler sampler(rho);
+  const float* r = rho.data().data();
+  parallelForCells(rho, [&](const IVec3& cell, std::size_t i) {
+    const Vec3 x = rho.position(cell);
+    const Vec3 toLight = light.position - x;
+    const double distance = toLight.norm();
+    if (!(distance > 0.0)) {
+      out[i] = 1.0f;
+      return;
+    }
+    const Vec3 dir = toLight / distance;
+    const double length = std::min(distance, exitDistance(x, dir, lo, hi));  // no medium outside the box
+    out[i] = static_cast<float>(std::exp(-sigmaT * densityIntegral(sampler, r, x, dir, length, stepCells * rho.spec().dx)));
+  });
+  return out;
+}
+
+void checkLights(const std::vector<Light>& lights) {
+  for (std::size_t l = 0; l < lights.size(); ++l) {
+    try {
+      lights[l].validate();
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument("volume renderer: light " + std::to_string(l) + ": " + e.what());
+    }
+  }
+}
+
+// Bricks of kBrick^3 cells that hold any density or emitter, dilated by one cell so that every
+// trilinear sample of a point inside a brick whose 8 corners are not all empty finds it occupied.
+class Occupancy {
+ public:
+  Occupancy(const Grid<float, 3>& rho, const Grid<float, 3>* emitter) : n_(rho.size()) {
+    for (int a = 0; a < 3; ++a) bricks_[a] = (n_[a] + kBrick - 1) / kBrick;
+    origin_ = rho.spec().origin;
+    brickSize_ = kBrick * rho.spec().dx;
+    occupied_.assign(static_cast<std::size_t>(bricks_[0]) * bricks_[1] * bricks_[2], 0);
+    parallelForCells<3>(bricks_, [&](const IVec3& brick, std::size_t bi) {
+      IVec3 from, to;
+      for (int a = 0; a < 3; ++a) {
+        from[a] = std::max(brick[a] * kBrick - 1, 0);
+        to[a] = std::min((brick[a] + 1) * kBrick + 1, n_[a]);
+      }
+      IVec3 c;
+      for (c[2] = from[2]; c[2] < to[2]; ++c[2])
+        for (c[1] = from[1]; c[1] < to[1]; ++c[1])
+          for (c[0] = from[0]; c[0] < to[0]; ++c[0]) {
+            const std::size_t i = rho.index(c);
+            if (rho[i] != 0.0f || (emitter && (*emitter)[i] > 0.0f)) {
+              occupied_[bi] = 1;
+              return;
+            }
+          }
+    });
+  }
+
+  // If x lies in an empty brick, the ray parameter where the ray leaves it; otherwise nothing.
+  bool emptyExit(const Vec3& x, const Vec3& dir, double tx, double& tExit) const {
+    IVec3 b;
+    for (int a = 0; a < 3; ++a)
+      b[a] = std::clamp(static_cast<int>(std::floor((x[a] - origin_[a]) / brickSize_)), 0, bricks_[a] - 1);
+    if (occupied_[(static_cast<std::size_t>(b[2]) * bricks_[1] + b[1]) * bricks_[0] + b[0]]) return false;
+    const Vec3 lo = origin_ + b.cast<double>() * brickSize_;
+    tExit = tx + exitDistance(x, dir, lo, lo + Vec3::Constant(brickSize_));
+    return true;
+  }
+
+ private:
+  IVec3 n_, bricks_;
+  Vec3 origin_;
+  double brickSize_;
+  std::vector<unsigned char> occupied_;
+};
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+void Medium::validate() const {
+  if (!std::isfinite(extinction) || extinction < 0.0)
+    throw std::invalid_argument("medium: extinction must be finite and >= 0, got " + std::to_string(extinction));
+  if (!(albedo >= 0.0 && albedo <= 1.0))
+    throw std::invalid_argument("medium: albedo must be in [0, 1], got " + std::to_string(albedo));
+  if (!(phaseG > -1.0 && phaseG < 1.0))
+    throw std::invalid_argument("medium: phaseG must be in (-1, 1), got " + std::to_string(phaseG));
+  if (!std::isfinite(emissionScale) || emissionScale < 0.0)
+    throw std::invalid_argument("medium: emissionScale must be finite and >= 0, got " + std::to_string(emissionScale));
+  if (!std::isfinite(emissionReference) || !(emissionReference > 0.0))
+    throw std::invalid_argument("medium: emissionReference must be a positive temperature, got " +
+                                std::to_string(emissionReference));
+}
+
+void VolumeRenderSettings::validate() const {
+  if (!std::isfinite(stepCells) || !(stepCells > 0.0))
+    throw std::invalid_argument("volume render settings: stepCells must be positive, got " + std::to_string(stepCells));
+  if (!std::isfinite(exposure) || !(exposure > 0.0))
+    throw std::invalid_argument("volume render settings: exposure must be positive, got " + std::to_string(exposure));
+  if (!std::isfinite(gamma) || !(gamma > 0.0))
+    throw std::invalid_argument("volume render settings: gamma must be positive, got " + std::to_string(gamma));
+  if (!finiteNonNegative(background))
+    throw std::invalid_argument("volume render settings: background must be finite and non-negative");
+  if (!finiteNonNegative(ambient))
+    throw std::invalid_argument("volume render settings: ambient must be finite and non-negative");
+}
+
+void VolumeInput::validate() const {
+  if (!density) throw std::invalid_argument("volume renderer: the density grid is required (got null)");
+  checkCellCentred(*density, "density");
+  checkSameLayout(*density, temperature, "temperature");
+  checkSameLayout(*density, emitter, "emitter");
+  checkSameLayout(*density, fluence, "fluence");
+  if (transmittances)
+    for (const auto& t : *transmittances) checkSameLayout(*density, &t, "transmittance");
+  if (emitter && !temperature)
+    throw std::invalid_argument("volume renderer: an emitter grid needs a temperature grid for its colour");
+}
+
+Grid<float, 3> lightTransmittance(const Grid<float, 3>& density, const Light& light, const Medium& medium,
+                                  double stepCells) {
+  checkCellCentred(density, "density");
+  light.validate();
+  medium.validate();
+  if (!std::isfinite(stepCells) || !(stepCells > 0.0))
+    throw std::invalid_argument("lightTransmittance: stepCells must be positive, got " + std::to_string(stepCells));
+  if (light.type == Light::Type::Directional)
+    return sweepDirectional(density, -light.direction.normalized(), medium.extinction, stepCells);
+  return shadowRays(density, light, medium.extinction, stepCells);
+}
+
+Grid<float, 3> firstScatterSource(const Grid<float, 3>& density, const std::vector<Light>& lights,
+                                  const Medium& medium, const std::vector<Grid<float, 3>>& transmittances) {
+  checkCellCentred(density, "density");
+  medium.validate();
+  checkLights(lights);
+  if (transmittances.size() != lights.size())
+    throw std::invalid_argument("firstScatterSource: " + std::to_string(transmittances.size()) +
+                                " transmittance grids for " + std::to_string(lights.size()) + " lights");
+  for (const auto& t : transmittances) checkSameLayout(density, &t, "transmittance");
+  Grid<float, 3> out(density.spec(), density.size(), density.offset());
+  const double sigmaS = medium.albedo * medium.extinction;
+  const double minDistance = 0.5 * density.spec().dx;
+  parallelForCells(density, [&](const IVec3& cell, std::size_t i) {
+    const double rho = std::max(density[i], 0.0f);
+    if (!(rho > 0.0)) return;
+    const Vec3 x = density.position(cell);
+    double e = 0.0;
+    for (std::size_t l = 0; l < lights.size(); ++l)
+      e += luminance(illuminate(lights[l], x, minDistance).irradiance) * transmittances[l][i];
+    out[i] = static_cast<float>(sigmaS * rho * e);
+  });
+  return out;
+}
+
+RenderResult renderVolume(const VolumeInput& input, const Camera& camera, const std::vector<Light>& lights,
+                          const Medium& medium, const VolumeRenderSettings& settings) {
+  input.validate();
+  medium.validate();
+  settings.validate();
+  checkLights(lights);
+  const CameraRays rays(camera);
+  const Grid<float, 3>& density = *input.density;
+  RenderResult result;
+
+  auto start = std::chrono::steady_clock::now();
+  std::vector<Grid<float, 3>> computed;
+  if (!input.transmittances) {
+    computed.reserve(lights.size());
+    for (const Light& l : lights) computed.push_back(lightTransmittance(density, l, medium, settings.stepCells));
+  } else if (input.transmittances->size() != lights.size()) {
+    throw std::invalid_argument("volume renderer: " + std::to_string(input.transmittances->size()) +
+                                " transmittance grids for " + std::to_string(lights.size()) + " lights");
+  }
+  const std::vector<Grid<float, 3>>& transmittance = input.transmittances ? *input.transmittances : computed;
+  result.stats.secondsLightGrids = secondsSince(start);
+
+  start = std::chrono::steady_clock::now();
+  const Occupancy occupancy(density, input.emitter);
+  const Sampler sampler(density);
+  const Vec3 lo = density.spec().origin, hi = density.spec().upper();
+  const double dx = density.spec().dx, ds = settings.stepCells * dx;
+  const double sigmaT = medium.extinction, sigmaS = medium.albedo * medium.extinction;
+  const HenyeyGreenstein phase(medium.phaseG);
+  const float* rhoData = density.data().data();
+  const float* temperature = input.temperature ? input.temperature->data().data() : nullptr;
+  const float* emitter = input.emitter ? input.emitter->data().data() : nullptr;
+  const float* fluence = input.fluence ? input.fluence->data().data() : nullptr;
+  const std::optional<BlackbodyTable> blackbody =
+      temperature ? std::optional<BlackbodyTable>(BlackbodyTable(medium.emissionReference)) : std::nullopt;
+  // Emitter form: emissionScale * emitter * B; Stam's form: sigma_t rho (1 - Omega) emissionScale B.
+  const double emissionWeight = emitter ? medium.emissionScale : sigmaT * (1.0 - medium.albedo) * medium.emissionScale;
+  // Chromaticity given to the (luminance) fluence: the lights' summed colour at unit luminance.
+  Vec3 fluenceTint = Vec3::Ones();
+  {
+    Vec3 sum = Vec3::Zero();
+    for (const Light& l : lights) sum += l.intensity * l.colour;
+    if (luminance(sum) > 0.0) fluenceTint = sum / luminance(sum);
+  }
+  std::vector<const float*> lightT(lights.size());
+  for (std::size_t l = 0; l < lights.size(); ++l) lightT[l] = transmittance[l].data().data();
+  const double minDistance = 0.5 * dx;
+
+  result.radiance = FloatImage(camera.width, camera.height);
+  std::atomic<long long> samples{0};
+  parallelFor(0, static_cast<std::size_t>(camera.height), [&](std::size_t row) {
+    // Per ray: irradiance * phase / 4 pi of each directional light (constant along a ray).
+    std::vector<Vec3> directional(lights.size(), Vec3::Zero());
+    long long rowSamples = 0;
+    for (int px = 0; px < camera.width; ++px) {
+      const Ray ray = rays.ray(px + 0.5, static_cast<double>(row) + 0.5);
+      Vec3 radiance = Vec3::Zero();
+      double T = 1.0;
+      double t0, t1;
+      if (intersectBox(ray, lo, hi, t0, t1)) {
+        for (std::size_t l = 0; l < lights.size(); ++l)
+          if (lights[l].type == Light::Type::Directional)
+            // mu between the light's and the seen light's directions of travel (towards the camera).
+            directional[l] = lights[l].intensity * lights[l].colour *
+                             (phase(lights[l].direction.normalized().dot(-ray.direction)) * kInv4Pi);
+        const long long steps = static_cast<long long>(std::ceil((t1 - t0) / ds));
+        for (long long k = 0; k < steps;) {
+          const double a = t0 + k * ds, b = std::min(a + ds, t1), len = b - a, tm = 0.5 * (a + b);
+          const Vec3 x = ray.origin + tm * ray.direction;
+          double tExit;
+          if (occupancy.emptyExit(x, ray.direction, tm, tExit)) {
+            // Next step whose midpoint is past the brick (samples in it add exactly nothing).
+            k = std::max(k + 1, static_cast<long long>(std::ceil((tExit - t0) / ds - 0.5)));
+            continue;
+          }
+          ++k;
+          ++rowSamples;
+          const Trilinear w = sampler.at(x);
+          const double rho = std::max(w(rhoData), 0.0f);
+          Vec3 source = Vec3::Zero();  // sigma_t rho J of eq. 5.9, per metre
+          if (blackbody) {
+            const double amount = emissionWeight * (emitter ? std::max(w(emitter), 0.0f) : rho);
+            if (amount > 0.0) {
+              const auto bb = (*blackbody)(w(temperature));
+              source += amount * Vec3(bb[0], bb[1], bb[2]);
+            }
+          }
+          if (rho > 0.0 && sigmaS > 0.0) {
+            Vec3 inScatter = settings.ambient;
+            for (std::size_t l = 0; l < lights.size(); ++l) {
+              const double Tl = w(lightT[l]);
+              if (lights[l].type == Light::Type::Directional) {
+                inScatter += Tl * directional[l];
+              } else if (Tl > 0.0) {
+                const LightSample s = illuminate(lights[l], x, minDistance);
+                inScatter += (Tl * phase(s.toLight.dot(ray.direction)) * kInv4Pi) * s.irradiance;
+              }
+            }
+            if (fluence) inScatter += (w(fluence) * kInv4Pi) * fluenceTint;
+            source += sigmaS * rho * inScatter;
+          }
+          // Exact integral over the step of a constant medium: int_0^len exp(-sigma_t rho u) du.
+          const double tau = sigmaT * rho * len;
+          const double segmentT = std::exp(-tau);
+          const double weight = tau > 1e-6 ? (1.0 - segmentT) / (sigmaT * rho) : len * (1.0 - 0.5 * tau);
+          radiance += (T * weight) * source;
+          T *= segmentT;
+          if (T < kMinTransmittance) break;
+        }
+      }
+      radiance += T * settings.background;
+      float* out = result.radiance.pixel(px, static_cast<int>(row));
+      for (int ch = 0; ch < 3; ++ch) out[ch] = static_cast<float>(radiance[ch]);
+    }
+    samples += rowSamples;
+  }, 1);
+
+  FloatImage display = result.radiance;
+  for (float& v : display.rgb) {
+    const float x = static_cast<float>(settings.exposure) * v;
+    v = settings.toneMap ? x / (1.0f + x) : x;
+  }
+  result.image = display.toImage8(settings.gamma);
+  result.stats.secondsMarch = secondsSince(start);
+  result.stats.primaryRays = static_cast<long long>(camera.width) * camera.height;
+  result.stats.samples = samples.load();
+  return result;
+}
+
+}  // namespace msim::render

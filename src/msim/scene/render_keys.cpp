@@ -1,0 +1,140 @@
+#include "msim/scene/render_keys.hpp"
+
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "msim/core/error.hpp"
+#include "msim/scene/json_vectors.hpp"
+
+namespace msim::scene {
+
+namespace {
+
+using nlohmann::json;
+
+Schema cameraSchema() {
+  Schema camera = Schema::object("the pinhole camera");
+  camera.boolean("auto", true, "frame the whole domain, looking along -z; position, target and up are then ignored");
+  camera.vector("position", "m", {0.0, 0.0, 5.0}, "eye point").lengths({3});
+  camera.vector("target", "m", {0.0, 0.0, 0.0}, "point at the image centre").lengths({3});
+  camera.vector("up", "", {0.0, 1.0, 0.0}, "image up direction").lengths({3});
+  camera.number("fov", "deg", 40.0, "vertical field of view").min(0.0, Bound::Exclusive).max(180.0, Bound::Exclusive);
+  camera.integer("width", 640, "image width [pixels]").min(1).max(16384);
+  camera.integer("height", 480, "image height [pixels]").min(1).max(16384);
+  return camera;
+}
+
+Schema lightSchema() {
+  Schema light = Schema::object("a light source (Stam's reduced incident light, eq. 5.5)");
+  light.string("type", "directional", "directional: parallel beam (sun); point; spot: a point light in a cone")
+      .choices({"directional", "point", "spot"});
+  light.vector("direction", "", {-1.0, -0.7, -0.3}, "direction the light travels (directional, spot)").lengths({3});
+  light.vector("position", "m", {0.0, 0.0, 0.0}, "where it is (point, spot)").lengths({3});
+  light.vector("colour", "", {1.0, 1.0, 1.0}, "linear RGB").lengths({3}).min(0.0);
+  light.number("intensity", "W/m^2 or W/sr", 10.0, "irradiance (directional) or radiant intensity (point, spot)").min(0.0);
+  light.number("spot_angle", "deg", 30.0, "cone half-angle (spot)").min(0.0, Bound::Exclusive).max(90.0);
+  light.number("spot_softness", "", 0.2, "fraction of the cone fading to zero at its edge (spot)").min(0.0).max(1.0);
+  return light;
+}
+
+Schema mediumSchema() {
+  Schema medium = Schema::object("optical properties of the density field (Stam ch. 5.1)");
+  medium.number("extinction", "m^2/kg", 10.0, "sigma_t: extinction per unit density").min(0.0);
+  medium.number("albedo", "", 0.9, "Omega: scattered fraction of the extinguished light").min(0.0).max(1.0);
+  medium.number("phase_g", "", 0.0, "Henyey-Greenstein asymmetry g (Stam's mu_bar / 3); > 0 scatters forward")
+      .min(-1.0, Bound::Exclusive)
+      .max(1.0, Bound::Exclusive);
+  medium.number("emission", "", 1.0, "fire brightness: radiance per m per unit emitter at the reference temperature")
+      .min(0.0);
+  medium.number("emission_reference", "K", 1500.0, "temperature whose black body has unit brightness")
+      .min(0.0, Bound::Exclusive);
+  return medium;
+}
+
+}  // namespace
+
+Schema renderSchema() {
+  Schema r = Schema::object("the physically based picture of each frame (3D scenes; Stam ch. 5)");
+  r.boolean("enabled", false, "render every frame into render/<name>_NNNN.png (needs outputs.vdb)");
+  r.field("camera", cameraSchema());
+  r.array("lights", lightSchema(), "light sources; none: one key light from above and in front");
+  r.field("medium", mediumSchema());
+  r.vector("background", "", {0.02, 0.02, 0.03}, "radiance behind the medium, linear RGB").lengths({3}).min(0.0);
+  r.vector("ambient", "", {0.1, 0.1, 0.12}, "sky radiance scattered by the medium, linear RGB").lengths({3}).min(0.0);
+  r.number("exposure", "", 1.0, "radiance multiplier before tone mapping").min(0.0, Bound::Exclusive);
+  r.boolean("multiple_scattering", true, "add multiple scattering by the diffusion approximation (ch. 5.5)");
+  r.number("step", "cells", 0.5, "ray-march step").min(0.05).max(4.0);
+  Schema grids = Schema::object("names of the grids in the saved frames");
+  grids.string("density", "density", "scattering and absorbing density");
+  grids.string("temperature", "temperature", "temperature [K] for fire emission; '' for none");
+  grids.string("emitter", "flame", "emission weight (flame density); '' for none");
+  r.field("grids", grids);
+  return r;
+}
+
+RenderKeys renderKeys(const json& r, const std::string& source) {
+  RenderKeys k;
+  k.enabled = r.at("enabled").get<bool>();
+  render::FrameRenderConfig& c = k.config;
+  const json& cam = r.at("camera");
+  c.width = cam.at("width").get<int>();
+  c.height = cam.at("height").get<int>();
+  if (!cam.at("auto").get<bool>()) {
+    render::Camera camera;
+    camera.position = paddedVec3(cam.at("position"));
+    camera.target = paddedVec3(cam.at("target"));
+    camera.up = paddedVec3(cam.at("up"));
+    camera.fovDegrees = cam.at("fov").get<double>();
+    camera.width = c.width;
+    camera.height = c.height;
+    c.camera = camera;
+  }
+  const json& lights = r.at("lights");
+  for (std::size_t i = 0; i < lights.size(); ++i) {
+    const json& l = lights[i];
+    render::Light light;
+    const std::string type = l.at("type");
+    light.type = type == "point"  ? render::Light::Type::Point
+                 : type == "spot" ? render::Light::Type::Spot
+                                  : render::Light::Type::Directional;
+    light.direction = paddedVec3(l.at("direction"));
+    light.position = paddedVec3(l.at("position"));
+    light.colour = paddedVec3(l.at("colour"));
+    light.intensity = l.at("intensity").get<double>();
+    light.spotAngleDegrees = l.at("spot_angle").get<double>();
+    light.spotSoftness = l.at("spot_softness").get<double>();
+    try {
+      light.validate();
+    } catch (const std::invalid_argument& e) {
+      throw InputError(fmt::format("{}: 'render.lights[{}]': {}", source, i, e.what()));
+    }
+    c.lights.push_back(light);
+  }
+  const json& m = r.at("medium");
+  c.medium.extinction = m.at("extinction").get<double>();
+  c.medium.albedo = m.at("albedo").get<double>();
+  c.medium.phaseG = m.at("phase_g").get<double>();
+  c.medium.emissionScale = m.at("emission").get<double>();
+  c.medium.emissionReference = m.at("emission_reference").get<double>();
+  c.settings.background = paddedVec3(r.at("background"));
+  c.settings.ambient = paddedVec3(r.at("ambient"));
+  c.settings.exposure = r.at("exposure").get<double>();
+  c.settings.stepCells = r.at("step").get<double>();
+  c.multipleScattering = r.at("multiple_scattering").get<bool>();
+  if (c.camera) {
+    try {
+      c.camera->validate();
+    } catch (const std::invalid_argument& e) {
+      throw InputError(fmt::format("{}: 'render.camera': {}", source, e.what()));
+    }
+  }
+  const json& g = r.at("grids");
+  k.densityGrid = g.at("density");
+  k.temperatureGrid = g.at("temperature");
+  k.emitterGrid = g.at("emitter");
+  if (k.densityGrid.empty()) throw InputError(source + ": 'render.grids.density' must name a grid");
+  return k;
+}
+
+}  // namespace msim::scene

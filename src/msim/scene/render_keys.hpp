@@ -1,0 +1,27 @@
+#pragma once
+// The render.* keys every scene has: camera, lights, medium, sky and exposure of the physically
+// based renderer (render/frame_renderer.hpp, Stam ch. 5), and the names of the saved grids it
+// reads. `msim run` renders each frame with them when render.enabled is true; `msim render`
+// renders saved frames with the keys stored in their run.json.
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "msim/render/frame_renderer.hpp"
+#include "msim/scene/schema/schema.hpp"
+
+namespace msim::scene {
+
+Schema renderSchema();
+
+struct RenderKeys {
+  bool enabled = false;
+  render::FrameRenderConfig config;
+  std::string densityGrid, temperatureGrid, emitterGrid;  // "" = not used
+};
+
+// From the resolved "render" object; InputError naming `source` and the key for values the
+// renderer refuses (a camera at its target, a zero light direction, ...).
+RenderKeys renderKeys(const nlohmann::json& resolvedRender, const std::string& source);
+
+}  // namespace msim::scene

@@ -1,0 +1,113 @@
+#include "msim/scene/saved_frames.hpp"
+
+#include <algorithm>
+#include <fstream>
+
+#include <fmt/format.h>
+
+#include "msim/core/error.hpp"
+#include "msim/core/log.hpp"
+#include "msim/io/atomic_file.hpp"
+#include "msim/io/vdb.hpp"
+#include "msim/io/video.hpp"
+#include "msim/scene/progress_bar.hpp"
+#include "msim/scene/schema/json_file.hpp"
+#include "msim/scene/schema/override.hpp"
+#include "msim/scene/schema/resolve.hpp"
+
+namespace msim::scene {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+bool hasGrid(const std::vector<std::string>& grids, const std::string& name) {
+  return !name.empty() && std::find(grids.begin(), grids.end(), name) != grids.end();
+}
+
+// The render.* keys of a run (or the defaults), with the job's overrides applied.
+RenderKeys jobKeys(const nlohmann::json& storedRender, const std::vector<std::string>& overrides,
+                   const std::string& source) {
+  nlohmann::json doc = {{"render", storedRender}};
+  for (const auto& o : overrides) {
+    if (o.rfind("render.", 0) != 0)
+      throw InputError(fmt::format("--set {}: only render.* keys can change when rendering saved frames", o));
+    applyOverride(doc, o);
+  }
+  // Resolved as the scene's own "render" key, so errors name 'render.camera.fov', not 'camera.fov'.
+  Schema root = Schema::object("the render keys of saved frames");
+  root.field("render", renderSchema());
+  return renderKeys(resolve(root, doc, source).at("render"), source);
+}
+
+}  // namespace
+
+io::Image renderSavedFrame(const fs::path& vdbFile, const RenderKeys& keys, render::FrameTimings* timings) {
+  const std::vector<std::string> grids = io::listVdbGrids(vdbFile);
+  if (!hasGrid(grids, keys.densityGrid))
+    throw InputError(fmt::format("{}: no grid '{}' to render (the file has: {}); set render.grids.density",
+                                 vdbFile.string(), keys.densityGrid, fmt::join(grids, ", ")));
+  const Grid<float, 3> density = io::readFloatGrid(vdbFile, keys.densityGrid);
+  std::optional<Grid<float, 3>> temperature, emitter;
+  if (hasGrid(grids, keys.temperatureGrid)) temperature = io::readFloatGrid(vdbFile, keys.temperatureGrid);
+  if (temperature && hasGrid(grids, keys.emitterGrid)) emitter = io::readFloatGrid(vdbFile, keys.emitterGrid);
+  const render::FrameResult r =
+      render::renderFrame(keys.config, density, temperature ? &*temperature : nullptr, emitter ? &*emitter : nullptr);
+  if (timings) *timings = r.timings;
+  return r.render.image;
+}
+
+std::vector<fs::path> renderSavedFrames(const RenderJob& job) {
+  std::vector<fs::path> frames;
+  fs::path outDir;
+  RenderKeys keys;
+  const std::string source = job.input.string();
+  if (fs::is_directory(job.input)) {
+    const fs::path runFile = job.input / "run.json";
+    if (!fs::exists(runFile))
+      throw InputError(source + ": not a run folder (no run.json); give a folder written by 'msim run' or a .vdb file");
+    const nlohmann::json run = loadJsonFile(runFile);
+    const nlohmann::json params = run.value("parameters", nlohmann::json::object());
+    keys = jobKeys(params.value("render", nlohmann::json::object()), job.overrides, runFile.string());
+    if (fs::is_directory(job.input / "vdb"))
+      for (const auto& e : fs::directory_iterator(job.input / "vdb"))
+        if (e.path().extension() == ".vdb") frames.push_back(e.path());
+    std::sort(frames.begin(), frames.end());
+    if (frames.empty()) throw InputError(source + ": the run has no VDB frames (was outputs.vdb false?)");
+    outDir = job.output.empty() ? job.input / "render" : job.output;
+  } else if (job.input.extension() == ".vdb") {
+    if (!fs::exists(job.input)) throw InputError(source + ": no such file");
+    keys = jobKeys(nlohmann::json::object(), job.overrides, source);
+    frames.push_back(job.input);
+  } else {
+    throw InputError(source + ": expected a run folder (with run.json) or a .vdb file");
+  }
+
+  std::vector<fs::path> written;
+  ProgressBar progress(1, static_cast<int>(frames.size()));
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    const io::Image image = renderSavedFrame(frames[i], keys);
+    fs::path target;
+    if (outDir.empty()) {
+      target = job.output.empty() ? fs::path(job.input).replace_extension(".png") : job.output;
+    } else {
+      fs::create_directories(outDir);
+      target = outDir / frames[i].filename().replace_extension(".png");
+    }
+    io::writePng(target, image);
+    written.push_back(target);
+    if (job.showProgress) progress.update(static_cast<int>(i) + 1, 1);
+  }
+  if (job.showProgress) progress.finish();
+  if (!outDir.empty() && written.size() > 1) {
+    // Frames are 1/fps apart in the run; without it in run.json the movie plays at 24 fps.
+    double fps = 24.0;
+    const nlohmann::json run = loadJsonFile(job.input / "run.json");
+    if (run.contains("fps")) fps = run.at("fps").get<double>();
+    const io::VideoResult video = io::encodeMp4(written, fps, outDir / "render.mp4");
+    if (!video.written) logger().warn("{}", video.note);
+  }
+  return written;
+}
+
+}  // namespace msim::scene

@@ -1,0 +1,31 @@
+#pragma once
+// Rendering frames that were saved as VDB files, without simulating again: `msim render` on a run
+// folder (its run.json holds the scene's render.* keys) or on one .vdb file, and the runner when a
+// scene sets render.enabled. Every picture is made from the file, so a re-render matches the run's.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "msim/io/png.hpp"
+#include "msim/render/frame_renderer.hpp"
+#include "msim/scene/render_keys.hpp"
+
+namespace msim::scene {
+
+// The picture of one saved frame. InputError naming the file for a missing or unreadable file or a
+// missing density grid; the temperature and emitter grids are used when the file has them.
+io::Image renderSavedFrame(const std::filesystem::path& vdbFile, const RenderKeys& keys,
+                           render::FrameTimings* timings = nullptr);
+
+struct RenderJob {
+  std::filesystem::path input;   // a run folder (with run.json and vdb/) or one .vdb file
+  std::filesystem::path output;  // folder for a run (default <input>/render), file for a .vdb (default <input>.png)
+  std::vector<std::string> overrides;  // "render.key=value" changes to the stored keys
+  bool showProgress = true;
+};
+
+// Renders every frame of the job; returns the pictures written. InputError for a path that is
+// neither, a run folder without run.json or frames, or bad keys.
+std::vector<std::filesystem::path> renderSavedFrames(const RenderJob& job);
+
+}  // namespace msim::scene

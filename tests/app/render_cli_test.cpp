@@ -1,0 +1,77 @@
+// `msim render` and render.enabled end to end: saved frames become pictures without simulating
+// again; bad input (missing or corrupt VDB, a grid that is not in the file, a bad camera) is one
+// clear message with exit code 2.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "cli_harness.hpp"
+#include "msim/io/png.hpp"
+
+namespace {
+
+// A small 3D smoke scene whose frames the tests render.
+std::string tinyRun(const std::string& extra = "") {
+  return R"({
+  "name": "tiny3d",
+  "phenomenon": "smoke",
+  "domain": {"min": [0, 0, 0], "max": [1, 1, 1], "resolution": 16,
+             "boundaries": {"y_max": "open", "x_min": "closed", "x_max": "closed", "y_min": "closed",
+                            "z_min": "closed", "z_max": "closed"}},
+  "time": {"duration": 0.25, "fps": 8},
+  "smoke": {"buoyancy": {"beta": 0.02}},
+  "sources": [{"shape": {"type": "sphere", "center": [0.5, 0.3, 0.5], "radius": 0.2}, "mode": "set",
+               "density": 1.0, "temperature": 400.0}],
+  "outputs": {"mp4": false}
+  )" + extra + "}\n";
+}
+
+fs::path simulate(const std::string& name, const std::string& extra = "") {
+  const fs::path dir = scratch(name);
+  writeText(dir / "s.json", tinyRun(extra));
+  const Result r = runMsim("run " + (dir / "s.json").string() + " -q --out " + (dir / "out").string());
+  EXPECT_EQ(r.exitCode, 0) << r.output;
+  return dir;
+}
+
+}  // namespace
+
+TEST(RenderCli, RendersEveryFrameOfARunAndOneFile) {
+  const fs::path dir = simulate("render_run");
+  const Result r = runMsim("render " + (dir / "out").string() + " -q --set render.camera.width=64 "
+                           "--set render.camera.height=48");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  for (const char* frame : {"tiny3d_0001.png", "tiny3d_0002.png"}) {
+    ASSERT_TRUE(fs::exists(dir / "out" / "render" / frame)) << frame;
+  }
+  const Result one = runMsim("render " + (dir / "out" / "vdb" / "tiny3d_0002.vdb").string() + " -q --out " +
+                             (dir / "one.png").string() + " --set render.camera.width=32 --set render.camera.height=32");
+  ASSERT_EQ(one.exitCode, 0) << one.output;
+  EXPECT_TRUE(fs::exists(dir / "one.png"));
+}
+
+TEST(RenderCli, RunWithRenderEnabledWritesPictures) {
+  const fs::path dir = simulate("render_enabled", R"(, "render": {"enabled": true, "camera": {"width": 48, "height": 48}})");
+  EXPECT_TRUE(fs::exists(dir / "out" / "render" / "tiny3d_0002.png"));
+}
+
+TEST(RenderCli, BadInputIsOneClearMessage) {
+  const fs::path dir = simulate("render_bad");
+  const std::string vdb = (dir / "out" / "vdb" / "tiny3d_0001.vdb").string();
+  struct Case {
+    std::string args, needle;
+  };
+  writeText(dir / "corrupt.vdb", "this is not a VDB file");
+  for (const Case& c : {Case{(dir / "missing.vdb").string(), "no such file"},
+                        Case{(dir / "corrupt.vdb").string(), "corrupt.vdb"},
+                        Case{vdb + " --set render.grids.density=smoke", "no grid 'smoke'"},
+                        Case{vdb + " --set render.camera.fov=0", "render.camera.fov"},
+                        Case{vdb + " --set render.camera.auto=false --set render.camera.position=[0,0,0]",
+                             "render.camera"},
+                        Case{(dir / "s.json").string(), "run folder"}}) {
+    const Result r = runMsim("render " + c.args + " -q --out " + (dir / "bad.png").string());
+    EXPECT_EQ(r.exitCode, 2) << c.args << "\n" << r.output;
+    EXPECT_NE(r.output.find(c.needle), std::string::npos) << c.args << "\n" << r.output;
+    EXPECT_FALSE(fs::exists(dir / "bad.png")) << c.args;
+  }
+}
