@@ -7,6 +7,7 @@
 
 #include <cmath>
 
+#include "msim/render/frame_renderer.hpp"
 #include "msim/render/volume_renderer.hpp"
 
 using namespace msim;
@@ -56,6 +57,32 @@ void BM_RenderVolume(benchmark::State& state) {
   state.counters["samples_per_ray"] = static_cast<double>(total.samples) / static_cast<double>(total.primaryRays);
 }
 
+// Issue #4's figure: the whole picture with multiple scattering (light grid, first-scatter source,
+// diffusion solve, march), as `msim render` makes it.
+void BM_RenderFrameWithMultipleScattering(benchmark::State& state) {
+  const Grid<float, 3> rho = smokePuffs(static_cast<int>(state.range(0)));
+  render::FrameRenderConfig config;
+  render::Light sun;
+  sun.direction = Vec3(0.5, -1.0, -0.3);
+  sun.intensity = 10.0;
+  config.lights = {sun};
+  render::FrameTimings total;
+  for (auto _ : state) {
+    const render::FrameResult r = render::renderFrame(config, rho);
+    total.lights += r.timings.lights;
+    total.multipleScattering += r.timings.multipleScattering;
+    total.march += r.timings.march;
+    total.diffusionCycles = r.timings.diffusionCycles;
+    benchmark::DoNotOptimize(r.render.image.rgb.data());
+  }
+  const double iterations = static_cast<double>(state.iterations());
+  state.counters["s_light_grids"] = total.lights / iterations;
+  state.counters["s_multiple_scattering"] = total.multipleScattering / iterations;
+  state.counters["s_march"] = total.march / iterations;
+  state.counters["diffusion_cycles"] = total.diffusionCycles;
+}
+
 }  // namespace
 
 BENCHMARK(BM_RenderVolume)->Arg(128)->Unit(benchmark::kMillisecond)->Iterations(5);
+BENCHMARK(BM_RenderFrameWithMultipleScattering)->Arg(128)->Unit(benchmark::kMillisecond)->Iterations(5);
