@@ -58,7 +58,7 @@ TEST(SmokeCli, RunWritesVolumesPicturesAndStatistics) {
   const Result r = runMsim("run " + (dir / "s.json").string() + " -q --out " + (dir / "out").string());
   ASSERT_EQ(r.exitCode, 0) << r.output;
   const auto grids = msim::io::listVdbGrids(dir / "out" / "vdb" / "tiny_0004.vdb");
-  for (const char* g : {"density", "temperature", "fuel", "flame", "vel_face_x", "vel_face_y", "pressure"})
+  for (const char* g : {"density", "temperature", "fuel", "flame", "vel_face_x", "vel_face_y", "pressure", "obstacle_distance"})
     EXPECT_NE(std::find(grids.begin(), grids.end(), g), grids.end()) << g;
   EXPECT_TRUE(fs::exists(dir / "out" / "png" / "tiny_0004.png"));
   std::ifstream stats(dir / "out" / "stats.csv");

@@ -84,6 +84,20 @@ Grid<float, D> SceneObstacles<D>::nodalDistance(double time) const {
 }
 
 template <int D>
+Grid<float, D> SceneObstacles<D>::cellDistance(double time) const {
+  Grid<float, D> distance(spec_, std::numeric_limits<float>::max());
+  for (const auto& o : obstacles_) {
+    // The shape moved by `offset` seen from a grid moved the other way: meshes keep their fast
+    // whole-grid distance evaluation.
+    GridSpec<D> shifted = spec_;
+    shifted.origin -= o.offset(time);
+    const Grid<float, D> d = o.shape->distanceField(shifted);
+    for (std::size_t i = 0; i < distance.count(); ++i) distance[i] = std::min(distance[i], d[i]);
+  }
+  return distance;
+}
+
+template <int D>
 MacGrid<D> SceneObstacles<D>::faceVelocity(double time) const {
   MacGrid<D> v(spec_, 0.0f);
   if (!moving()) return v;

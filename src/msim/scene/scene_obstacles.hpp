@@ -25,6 +25,9 @@ class SceneObstacles {
   bool moving() const;
   // Signed distance of all solids at the grid nodes (res+1 per axis), negative inside, at time t.
   Grid<float, D> nodalDistance(double time) const;
+  // Signed distance of all solids at the cell centres at time t [m] (saved with each frame so
+  // renderers can draw the obstacles and refuse a camera inside one).
+  Grid<float, D> cellDistance(double time) const;
   // Velocity of the nearest solid on every face at time t (0 for static solids).
   MacGrid<D> faceVelocity(double time) const;
   // Largest speed of any obstacle at time t [m/s].

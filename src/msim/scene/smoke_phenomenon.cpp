@@ -105,7 +105,8 @@ class SmokePhenomenon final : public Phenomenon {
   }
 
   // density, temperature (and fuel, flame) for users; "vel" at cell centres in 3D for tools; the
-  // face velocities vel_face_x.. and the pressure (the next solve's warm start) make --resume exact.
+  // face velocities vel_face_x.. and the pressure (the next solve's warm start) make --resume exact;
+  // "obstacle_distance" (signed, at cell centres) lets renderers draw the obstacles.
   void writeVolume(const std::filesystem::path& vdbFile) const override {
     io::VdbWriter writer;
     writer.addFloatGrid("density", solver_.density());
@@ -114,6 +115,7 @@ class SmokePhenomenon final : public Phenomenon {
     if constexpr (D == 3) writer.addVectorGrid("vel", solver_.velocity());
     for (int a = 0; a < D; ++a) writer.addFloatGrid(faceGridName(a), faceAsCells(solver_.velocity().component(a)));
     writer.addFloatGrid("pressure", solver_.pressure());
+    if (!obstacles_.empty()) writer.addFloatGrid("obstacle_distance", obstacles_.cellDistance(time_));
     writer.write(vdbFile);
   }
 
