@@ -3,9 +3,11 @@
 // clear message with exit code 2.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 
 #include "cli_harness.hpp"
+#include "msim/io/exr.hpp"
 #include "msim/io/png.hpp"
 
 namespace {
@@ -50,9 +52,24 @@ TEST(RenderCli, RendersEveryFrameOfARunAndOneFile) {
   EXPECT_TRUE(fs::exists(dir / "one.png"));
 }
 
-TEST(RenderCli, RunWithRenderEnabledWritesPictures) {
-  const fs::path dir = simulate("render_enabled", R"(, "render": {"enabled": true, "camera": {"width": 48, "height": 48}})");
+TEST(RenderCli, RunWithRenderEnabledWritesPicturesAndExr) {
+  const fs::path dir = simulate("render_enabled",
+                                R"(, "render": {"enabled": true, "exr": true, "camera": {"width": 48, "height": 48}})");
   EXPECT_TRUE(fs::exists(dir / "out" / "render" / "tiny3d_0002.png"));
+  const msim::io::ImageF radiance = msim::io::readExr(dir / "out" / "render" / "tiny3d_0002.exr");
+  EXPECT_EQ(radiance.width, 48);
+  EXPECT_GT(*std::max_element(radiance.rgb.begin(), radiance.rgb.end()), 0.0f);
+}
+
+TEST(RenderCli, CameraInsideAnObstacleIsRefused) {
+  const fs::path dir = simulate("render_inside", R"(, "obstacles": [{"shape": {"type": "sphere", "center": [0.5, 0.75, 0.5],
+      "radius": 0.15}}])");
+  const Result r = runMsim("render " + (dir / "out").string() + " -q --out " + (dir / "pictures").string() +
+                           " --set render.camera.auto=false --set render.camera.position=[0.5,0.75,0.5]"
+                           " --set render.camera.target=[0.5,0.5,0.0]");
+  EXPECT_EQ(r.exitCode, 2) << r.output;
+  EXPECT_NE(r.output.find("camera is inside an obstacle"), std::string::npos) << r.output;
+  EXPECT_TRUE(noFramesIn(dir / "pictures"));
 }
 
 TEST(RenderCli, BadInputIsOneClearMessage) {

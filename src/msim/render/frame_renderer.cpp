@@ -1,6 +1,7 @@
 #include "msim/render/frame_renderer.hpp"
 
 #include <chrono>
+#include <stdexcept>
 
 namespace msim::render {
 
@@ -22,18 +23,23 @@ std::vector<Light> defaultLights() {
 }
 
 FrameResult renderFrame(const FrameRenderConfig& config, const Grid<float, 3>& density,
-                        const Grid<float, 3>* temperature, const Grid<float, 3>* emitter) {
+                        const Grid<float, 3>* temperature, const Grid<float, 3>* emitter,
+                        const FrameSurfaces& surfaces) {
   FrameResult result;
   const std::vector<Light> lights = config.lights.empty() ? defaultLights() : config.lights;
   const GridSpec<3>& spec = density.spec();
   const Camera camera = config.camera ? *config.camera
                                       : frameBox(spec.origin, spec.upper(), config.width, config.height);
+  if (surfaces.distance && !surfaces.distance->sameLayout(density))
+    throw std::invalid_argument("frame renderer: the surface distance grid does not have the density grid's layout");
+  checkCameraOutsideSolids(camera.position, surfaces.distance, surfaces.meshes);
 
   auto start = std::chrono::steady_clock::now();
   std::vector<Grid<float, 3>> transmittances;
   transmittances.reserve(lights.size());
   for (const Light& light : lights)
-    transmittances.push_back(lightTransmittance(density, light, config.medium, config.settings.stepCells));
+    transmittances.push_back(
+        lightTransmittance(density, light, config.medium, config.settings.stepCells, surfaces.distance));
   result.timings.lights = secondsSince(start);
 
   std::optional<Grid<float, 3>> fluence;
@@ -55,6 +61,9 @@ FrameResult renderFrame(const FrameRenderConfig& config, const Grid<float, 3>& d
   input.emitter = temperature ? emitter : nullptr;
   input.fluence = fluence ? &*fluence : nullptr;
   input.transmittances = &transmittances;
+  input.surfaceDistance = surfaces.distance;
+  input.meshes = surfaces.meshes;
+  input.points = surfaces.points;
   result.render = renderVolume(input, camera, lights, config.medium, config.settings);
   result.timings.march = result.render.stats.secondsMarch;
   return result;

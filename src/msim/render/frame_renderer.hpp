@@ -39,9 +39,18 @@ struct FrameResult {
   FrameTimings timings;
 };
 
-// `temperature` and `emitter` may be null (no fire). std::invalid_argument for bad settings or
-// grids of different layouts.
+// Opaque surfaces of a frame (VolumeInput's fields of the same names): solid obstacles as a
+// cell-centred signed distance (negative inside) of the density's layout, meshes, point sets.
+struct FrameSurfaces {
+  const Grid<float, 3>* distance = nullptr;
+  std::vector<const TriangleMesh*> meshes = {};
+  std::vector<PointSet> points = {};
+};
+
+// `temperature` and `emitter` may be null (no fire). std::invalid_argument for bad settings, grids
+// of different layouts, or a camera inside a solid (checked before any light is computed).
 FrameResult renderFrame(const FrameRenderConfig& config, const Grid<float, 3>& density,
-                        const Grid<float, 3>* temperature = nullptr, const Grid<float, 3>* emitter = nullptr);
+                        const Grid<float, 3>* temperature = nullptr, const Grid<float, 3>* emitter = nullptr,
+                        const FrameSurfaces& surfaces = {});
 
 }  // namespace msim::render

@@ -10,6 +10,8 @@
 #include <stdexcept>
 #include <string>
 
+#include <fmt/format.h>
+
 #include "msim/core/parallel.hpp"
 #include "msim/render/blackbody.hpp"
 #include "msim/render/phase_function.hpp"
@@ -147,6 +149,20 @@ double densityIntegral(const Sampler& sampler, const float* rho, const Vec3& x, 
   return h * sum;
 }
 
+// Visibility of the path x + t dir, t in [0, length], past solid obstacles of the signed distance
+// `sdf` (see lightTransmittance): clamp(1 + d_min / dx, 0, 1) over samples at the midpoints of steps
+// of at most ds. dStart, the distance at x, skips paths that cannot reach a surface (a distance is
+// 1-Lipschitz; the cell of margin covers the trilinear interpolation).
+double pathVisibility(const Sampler& sampler, const float* sdf, const Vec3& x, const Vec3& dir, double length,
+                      double ds, double dx, double dStart) {
+  if (!(length > 0.0) || dStart > length + dx) return 1.0;
+  const int steps = std::max(1, static_cast<int>(std::ceil(length / ds)));
+  const double h = length / steps;
+  double least = dStart;
+  for (int m = 0; m < steps; ++m) least = std::min(least, static_cast<double>(sampler.at(x + (m + 0.5) * h * dir)(sdf)));
+  return std::clamp(1.0 + least / dx, 0.0, 1.0);
+}
+
 // densityIntegral over the path from a cell centre along dir for `length` as fixed weights on
 // neighbouring cells: the samples sit at the same place relative to every cell centre, so the
 // trilinear weights are the same for all cells whose neighbours all exist. Summing ~50 weighted
@@ -215,8 +231,15 @@ class PathStencil {
 // included) would blur by sqrt(slices) cells; marching kSweepSlices slices per interpolation cuts
 // that by sqrt(kSweepSlices) at kSweepSlices / stepCells samples per cell, which PathStencil makes
 // cheap away from the borders.
-Grid<float, 3> sweepDirectional(const Grid<float, 3>& rho, const Vec3& toLight, double sigmaT, double stepCells) {
+// With solids (sdf), each cell's visibility is carried the same way, interpolated as a visibility:
+// beyond the box faces, where lateralStencil's weights fall off, the missing weight sees V = 1.
+Grid<float, 3> sweepDirectional(const Grid<float, 3>& rho, const Grid<float, 3>* sdf, const Vec3& toLight,
+                                double sigmaT, double stepCells) {
   Grid<float, 3> depth(rho.spec(), rho.size(), rho.offset());
+  std::optional<Grid<float, 3>> visibility;
+  if (sdf) visibility.emplace(rho.spec(), rho.size(), rho.offset());
+  float* vis = visibility ? visibility->data().data() : nullptr;
+  const float* dist = sdf ? sdf->data().data() : nullptr;
   const IVec3 n = rho.size();
   const double dx = rho.spec().dx, ds = stepCells * dx;
   const Vec3 lo = rho.spec().origin, hi = rho.spec().upper();
@@ -246,38 +269,50 @@ Grid<float, 3> sweepDirectional(const Grid<float, 3>& rho, const Vec3& toLight, 
         cell[b] = ib;
         const Vec3 x = rho.position(cell);
         const double tExit = exitDistance(x, toLight, lo, hi);
+        const std::size_t i = rho.index(cell);
         double tau;
         if (tExit <= tJump * (1.0 + 1e-9)) {
           tau = sigmaT * densityIntegral(sampler, r, x, toLight, tExit, ds);  // leaves the box first
+          if (vis) vis[i] = static_cast<float>(pathVisibility(sampler, dist, x, toLight, tExit, ds, dx, dist[i]));
         } else {
           const LateralStencil sb = lateralStencil(ib + shiftB, n[b]), sc = lateralStencil(cell[c] + shiftC, n[c]);
           IVec3 p = cell;
           p[a] = cell[a] + jump * towardsLight;
-          double depthThere = 0.0;
+          double depthThere = 0.0, visThere = 1.0;
           for (int u = 0; u < 2; ++u)
             for (int v = 0; v < 2; ++v) {
               p[b] = sb.index[u];
               p[c] = sc.index[v];
-              depthThere += sb.depthWeight[u] * sc.depthWeight[v] * d[rho.index(p)];
+              const double w = sb.depthWeight[u] * sc.depthWeight[v];
+              depthThere += w * d[rho.index(p)];
+              if (vis) visThere -= w * (1.0 - vis[rho.index(p)]);
             }
           const double segment =
-              path.fits(cell) ? path(r, rho.index(cell)) : densityIntegral(sampler, r, x, toLight, tJump, ds);
+              path.fits(cell) ? path(r, i) : densityIntegral(sampler, r, x, toLight, tJump, ds);
           tau = depthThere + sigmaT * segment;
+          if (vis)
+            vis[i] = visThere > 0.0
+                         ? static_cast<float>(visThere * pathVisibility(sampler, dist, x, toLight, tJump, ds, dx, dist[i]))
+                         : 0.0f;
         }
-        d[rho.index(cell)] = static_cast<float>(tau);
+        d[i] = static_cast<float>(tau);
       }
     }, 1);
   }
-  parallelFor(0, depth.count(), [&](std::size_t i) { d[i] = std::exp(-d[i]); });
+  parallelFor(0, depth.count(), [&](std::size_t i) { d[i] = std::exp(-d[i]) * (vis ? vis[i] : 1.0f); });
   return depth;
 }
 
 // Transmittance from every cell centre to a point or spot light by a shadow ray per cell.
-Grid<float, 3> shadowRays(const Grid<float, 3>& rho, const Light& light, double sigmaT, double stepCells) {
+// With solids (sdf), times the visibility of the same path.
+Grid<float, 3> shadowRays(const Grid<float, 3>& rho, const Grid<float, 3>* sdf, const Light& light, double sigmaT,
+                          double stepCells) {
   Grid<float, 3> out(rho.spec(), rho.size(), rho.offset());
   const Vec3 lo = rho.spec().origin, hi = rho.spec().upper();
   const Sampler sampler(rho);
   const float* r = rho.data().data();
+  const float* dist = sdf ? sdf->data().data() : nullptr;
+  const double dx = rho.spec().dx, ds = stepCells * dx;
   parallelForCells(rho, [&](const IVec3& cell, std::size_t i) {
     const Vec3 x = rho.position(cell);
     const Vec3 toLight = light.position - x;
@@ -288,7 +323,9 @@ Grid<float, 3> shadowRays(const Grid<float, 3>& rho, const Light& light, double 
     }
     const Vec3 dir = toLight / distance;
     const double length = std::min(distance, exitDistance(x, dir, lo, hi));  // no medium outside the box
-    out[i] = static_cast<float>(std::exp(-sigmaT * densityIntegral(sampler, r, x, dir, length, stepCells * rho.spec().dx)));
+    const double visible = dist ? pathVisibility(sampler, dist, x, dir, length, ds, dx, dist[i]) : 1.0;
+    out[i] = visible > 0.0 ? static_cast<float>(visible * std::exp(-sigmaT * densityIntegral(sampler, r, x, dir, length, ds)))
+                           : 0.0f;
   });
   return out;
 }
@@ -349,6 +386,54 @@ class Occupancy {
   std::vector<unsigned char> occupied_;
 };
 
+// First zero crossing of the signed distance along the ray within [t0, t1]: steps of the distance
+// itself where it exceeds the march step ds (sphere tracing: no surface is nearer than the
+// distance), of ds otherwise, then bisection of the step that brackets the crossing and a linear
+// interpolation in the last bracket. Solids thinner than about ds can be stepped over, as the
+// medium's features thinner than a step are.
+bool traceDistance(const Sampler& sampler, const float* sdf, const Ray& ray, double t0, double t1, double ds,
+                   double& tHit) {
+  const auto at = [&](double t) { return static_cast<double>(sampler.at(ray.origin + t * ray.direction)(sdf)); };
+  double ta = t0, da = at(t0);
+  if (da <= 0.0) {
+    tHit = t0;
+    return true;
+  }
+  while (ta < t1) {
+    const double tb = std::min(ta + std::max(da, ds), t1), db = at(tb);
+    if (db <= 0.0) {
+      double lo = ta, hi = tb, dlo = da, dhi = db;
+      for (int k = 0; k < 10; ++k) {  // ds / 1024: a thousandth of a cell at the default step
+        const double tm = 0.5 * (lo + hi), dm = at(tm);
+        (dm > 0.0 ? lo : hi) = tm;
+        (dm > 0.0 ? dlo : dhi) = dm;
+      }
+      tHit = lo + (hi - lo) * dlo / (dlo - dhi);
+      return true;
+    }
+    ta = tb;
+    da = db;
+  }
+  return false;
+}
+
+// Outward unit normal of the box face through which the ray enters it (the slab entered last).
+Vec3 entryFaceNormal(const Ray& r, const Vec3& lo, const Vec3& hi) {
+  int face = 0;
+  double latest = -std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    if (r.direction[a] == 0.0) continue;
+    const double t = ((r.direction[a] > 0.0 ? lo[a] : hi[a]) - r.origin[a]) / r.direction[a];
+    if (t > latest) {
+      latest = t;
+      face = a;
+    }
+  }
+  Vec3 n = Vec3::Zero();
+  n[face] = r.direction[face] > 0.0 ? -1.0 : 1.0;
+  return n;
+}
+
 double secondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -380,6 +465,8 @@ void VolumeRenderSettings::validate() const {
     throw std::invalid_argument("volume render settings: background must be finite and non-negative");
   if (!finiteNonNegative(ambient))
     throw std::invalid_argument("volume render settings: ambient must be finite and non-negative");
+  if (!finiteNonNegative(surfaceAlbedo) || (surfaceAlbedo.array() > 1.0).any())
+    throw std::invalid_argument("volume render settings: surfaceAlbedo must be in [0, 1]");
 }
 
 void VolumeInput::validate() const {
@@ -392,18 +479,43 @@ void VolumeInput::validate() const {
     for (const auto& t : *transmittances) checkSameLayout(*density, &t, "transmittance");
   if (emitter && !temperature)
     throw std::invalid_argument("volume renderer: an emitter grid needs a temperature grid for its colour");
+  checkSameLayout(*density, surfaceDistance, "surface distance");
+}
+
+double signedDistanceAt(const Grid<float, 3>& distance, const Vec3& x) {
+  checkCellCentred(distance, "surface distance");
+  const Vec3 lo = distance.spec().origin, hi = distance.spec().upper();
+  if ((x.array() < lo.array()).any() || (x.array() > hi.array()).any() || !x.allFinite())
+    return std::numeric_limits<double>::infinity();
+  return Sampler(distance).at(x)(distance.data().data());
+}
+
+void checkCameraOutsideSolids(const Vec3& position, const Grid<float, 3>* surfaceDistance,
+                              const std::vector<const TriangleMesh*>& meshes) {
+  if (surfaceDistance) {
+    const double d = signedDistanceAt(*surfaceDistance, position);
+    if (d < 0.0)
+      throw std::invalid_argument(
+          fmt::format("camera is inside an obstacle (signed distance {:.2g} m at the camera position)", d));
+  }
+  int crossings = 0;
+  const int mesh = meshContaining(meshes, position, &crossings);
+  if (mesh >= 0)
+    throw std::invalid_argument(
+        fmt::format("camera is inside mesh {} (a ray from the camera crosses it {} times)", mesh, crossings));
 }
 
 Grid<float, 3> lightTransmittance(const Grid<float, 3>& density, const Light& light, const Medium& medium,
-                                  double stepCells) {
+                                  double stepCells, const Grid<float, 3>* surfaceDistance) {
   checkCellCentred(density, "density");
+  checkSameLayout(density, surfaceDistance, "surface distance");
   light.validate();
   medium.validate();
   if (!std::isfinite(stepCells) || !(stepCells > 0.0))
     throw std::invalid_argument("lightTransmittance: stepCells must be positive, got " + std::to_string(stepCells));
   if (light.type == Light::Type::Directional)
-    return sweepDirectional(density, -light.direction.normalized(), medium.extinction, stepCells);
-  return shadowRays(density, light, medium.extinction, stepCells);
+    return sweepDirectional(density, surfaceDistance, -light.direction.normalized(), medium.extinction, stepCells);
+  return shadowRays(density, surfaceDistance, light, medium.extinction, stepCells);
 }
 
 Grid<float, 3> firstScatterSource(const Grid<float, 3>& density, const std::vector<Light>& lights,
@@ -437,6 +549,8 @@ RenderResult renderVolume(const VolumeInput& input, const Camera& camera, const 
   settings.validate();
   checkLights(lights);
   const CameraRays rays(camera);
+  const SurfaceScene surfaces(input.meshes, input.points, settings.surfaceAlbedo);
+  checkCameraOutsideSolids(camera.position, input.surfaceDistance, input.meshes);
   const Grid<float, 3>& density = *input.density;
   RenderResult result;
 
@@ -444,7 +558,8 @@ RenderResult renderVolume(const VolumeInput& input, const Camera& camera, const 
   std::vector<Grid<float, 3>> computed;
   if (!input.transmittances) {
     computed.reserve(lights.size());
-    for (const Light& l : lights) computed.push_back(lightTransmittance(density, l, medium, settings.stepCells));
+    for (const Light& l : lights)
+      computed.push_back(lightTransmittance(density, l, medium, settings.stepCells, input.surfaceDistance));
   } else if (input.transmittances->size() != lights.size()) {
     throw std::invalid_argument("volume renderer: " + std::to_string(input.transmittances->size()) +
                                 " transmittance grids for " + std::to_string(lights.size()) + " lights");
@@ -477,19 +592,65 @@ RenderResult renderVolume(const VolumeInput& input, const Camera& camera, const 
   std::vector<const float*> lightT(lights.size());
   for (std::size_t l = 0; l < lights.size(); ++l) lightT[l] = transmittance[l].data().data();
   const double minDistance = 0.5 * dx;
+  const float* distance = input.surfaceDistance ? input.surfaceDistance->data().data() : nullptr;
+
+  // T_l of a surface point's light sample x' (see the header): the grid at the point where the path
+  // from x' to the light enters the box, 1 if it misses the box (no medium, no solids outside it).
+  const auto gridTransmittance = [&](std::size_t l, const Vec3& x, const Vec3& toLight, double lightDistance) {
+    double a, b;
+    if (!intersectBox({x, toLight}, lo, hi, a, b) || !(a < lightDistance)) return 1.0;
+    return static_cast<double>(sampler.at(x + a * toLight)(lightT[l]));
+  };
+  // Lambertian radiance of a surface point p (eq. 5.8's boundary radiance), see the header.
+  const double lightSampleOffset = 2.0 * dx, shadowRayOffset = 1e-4 * dx;
+  const auto shade = [&](const Vec3& p, const SurfaceHit& hit) {
+    Vec3 L = hit.albedo.cwiseProduct(settings.ambient);
+    const Vec3 lightSample = p + lightSampleOffset * hit.normal, shadowOrigin = p + shadowRayOffset * hit.offsetNormal;
+    for (std::size_t l = 0; l < lights.size(); ++l) {
+      const LightSample s = illuminate(lights[l], p, minDistance);
+      const double cosine = hit.normal.dot(s.toLight);
+      if (!(cosine > 0.0)) continue;
+      const double Tl = gridTransmittance(l, lightSample, s.toLight, s.distance);
+      if (!(Tl > 0.0) || surfaces.occluded(shadowOrigin, s.toLight, s.distance)) continue;
+      L += (cosine * Tl / std::numbers::pi) * hit.albedo.cwiseProduct(s.irradiance);
+    }
+    return L;
+  };
 
   result.radiance = FloatImage(camera.width, camera.height);
-  std::atomic<long long> samples{0};
+  std::atomic<long long> samples{0}, surfaceHits{0};
   parallelFor(0, static_cast<std::size_t>(camera.height), [&](std::size_t row) {
     // Per ray: irradiance * phase / 4 pi of each directional light (constant along a ray).
     std::vector<Vec3> directional(lights.size(), Vec3::Zero());
-    long long rowSamples = 0;
+    long long rowSamples = 0, rowHits = 0;
     for (int px = 0; px < camera.width; ++px) {
       const Ray ray = rays.ray(px + 0.5, static_cast<double>(row) + 0.5);
       Vec3 radiance = Vec3::Zero();
       double T = 1.0;
       double t0, t1;
-      if (intersectBox(ray, lo, hi, t0, t1)) {
+      const bool inBox = intersectBox(ray, lo, hi, t0, t1);
+      // The nearest opaque surface: the distance grid's solids, then anything nearer in the BVH.
+      double tSurface = std::numeric_limits<double>::infinity();
+      SurfaceHit hit;
+      if (distance && inBox && traceDistance(sampler, distance, ray, t0, t1, ds, tSurface)) {
+        const Vec3 p = ray.origin + tSurface * ray.direction;
+        Vec3 g = Vec3::Zero();  // gradient of the trilinear distance, central differences over a cell
+        for (int a = 0; a < 3; ++a) {
+          const Vec3 e = 0.5 * dx * Vec3::Unit(a);
+          g[a] = sampler.at(p + e)(distance) - sampler.at(p - e)(distance);
+        }
+        // A ray entering the box inside a solid (one that meets the domain's side) sees the box face.
+        hit.normal = tSurface == t0 && t0 > 0.0 ? entryFaceNormal(ray, lo, hi)
+                     : g.norm() > 0.0           ? Vec3(g.normalized())
+                                                : Vec3(-ray.direction);
+        if (hit.normal.dot(ray.direction) > 0.0) hit.normal = -hit.normal;
+        hit.offsetNormal = hit.normal;
+        hit.albedo = settings.surfaceAlbedo;
+        hit.t = tSurface;
+      }
+      if (!surfaces.empty() && surfaces.intersect(ray, tSurface, hit)) tSurface = hit.t;
+      if (inBox && t0 < tSurface) {
+        t1 = std::min(t1, tSurface);
         for (std::size_t l = 0; l < lights.size(); ++l)
           if (lights[l].type == Light::Type::Directional)
             // mu between the light's and the seen light's directions of travel (towards the camera).
@@ -540,11 +701,17 @@ RenderResult renderVolume(const VolumeInput& input, const Camera& camera, const 
           if (T < kMinTransmittance) break;
         }
       }
-      radiance += T * settings.background;
+      if (std::isfinite(tSurface)) {
+        ++rowHits;
+        if (T >= kMinTransmittance) radiance += T * shade(ray.origin + tSurface * ray.direction, hit);
+      } else {
+        radiance += T * settings.background;
+      }
       float* out = result.radiance.pixel(px, static_cast<int>(row));
       for (int ch = 0; ch < 3; ++ch) out[ch] = static_cast<float>(radiance[ch]);
     }
     samples += rowSamples;
+    surfaceHits += rowHits;
   }, 1);
 
   FloatImage display = result.radiance;
@@ -556,6 +723,7 @@ RenderResult renderVolume(const VolumeInput& input, const Camera& camera, const 
   result.stats.secondsMarch = secondsSince(start);
   result.stats.primaryRays = static_cast<long long>(camera.width) * camera.height;
   result.stats.samples = samples.load();
+  result.stats.surfaceHits = surfaceHits.load();
   return result;
 }
 

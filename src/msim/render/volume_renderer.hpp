@@ -28,12 +28,24 @@
 // sampled trilinearly between cell centres with the border value extended to the box faces; outside
 // the box there is no medium. Bricks of cells with no density (and no emitter) are skipped, which
 // changes nothing in the result: such samples would add exactly zero.
+//
+// Opaque surfaces end the march: obstacles given as a signed-distance grid (found by sphere
+// tracing the trilinear distance, steps of at least the march step, refined by bisection), triangle
+// meshes and point sets drawn as spheres (surfaces.hpp, through a BVH). Eq. 5.8 then holds with the
+// surface's radiance in place of I_background at the hit: the medium in front attenuates it and adds
+// its in-scattering as usual. The surfaces are Lambertian with albedo a:
+//   L = a I_d^0 + (a / pi) sum_l E_l(x) max(n . s_l, 0) T_l(x') V_l(x),
+// the first term the sky (irradiance pi I_d^0 from the open hemisphere, unshadowed as in the medium),
+// T_l the light's transmittance grid sampled at x' two cells out along the normal (the grid's soft
+// edge of the solid lies within a cell and a half of the surface, see lightTransmittance), V_l a
+// shadow ray to the light through the meshes and spheres.
 #include <vector>
 
 #include "msim/core/grid.hpp"
 #include "msim/io/png.hpp"
 #include "msim/render/camera.hpp"
 #include "msim/render/light.hpp"
+#include "msim/render/surfaces.hpp"
 
 namespace msim::render {
 
@@ -64,9 +76,10 @@ struct VolumeRenderSettings {
   double exposure = 1.0;                       // radiance multiplier before tone mapping
   double gamma = 2.2;                          // display gamma of the 8-bit image
   bool toneMap = true;                         // x / (1 + x) per channel; otherwise clamp to [0, 1]
+  Vec3 surfaceAlbedo = Vec3::Constant(0.6);    // Lambert albedo of obstacles (surfaceDistance) and meshes
 
-  // std::invalid_argument for stepCells, exposure or gamma not positive, or negative or
-  // non-finite background or ambient.
+  // std::invalid_argument for stepCells, exposure or gamma not positive, negative or non-finite
+  // background or ambient, or a surfaceAlbedo outside [0, 1].
   void validate() const;
 };
 
@@ -78,7 +91,14 @@ struct VolumeInput {
   const Grid<float, 3>* fluence = nullptr;      // optional multiple-scattering fluence phi [W/m^2], luminance
   // Optional lightTransmittance of each light, in the order of the lights, when the caller has
   // them already (the multiple-scattering source needs them too); computed here otherwise.
-  const std::vector<Grid<float, 3>>* transmittances = nullptr;
+  const std::vector<Grid<float, 3>>* transmittances = nullptr;  // (made with the same surfaceDistance)
+  // Opaque surfaces: solid obstacles as a signed distance [m] at the cell centres, negative inside
+  // (the smoke solver's "obstacle_distance"); triangle meshes; point sets drawn as spheres. Solids
+  // of the distance grid shadow the medium and the surfaces through the light grids; meshes and
+  // spheres shadow the surfaces by shadow rays but not the medium.
+  const Grid<float, 3>* surfaceDistance = nullptr;
+  std::vector<const TriangleMesh*> meshes = {};
+  std::vector<PointSet> points = {};
 
   void validate() const;
 };
@@ -86,6 +106,7 @@ struct VolumeInput {
 struct RenderStats {
   long long primaryRays = 0;
   long long samples = 0;  // density samples taken by the camera rays (skipped empty bricks not counted)
+  long long surfaceHits = 0;  // camera rays that ended on a surface
   double secondsLightGrids = 0.0, secondsMarch = 0.0;
 };
 
@@ -97,8 +118,19 @@ struct RenderResult {
   RenderStats stats;
 };
 
+// std::invalid_argument for bad inputs, and (checkCameraOutsideSolids) for a camera inside a solid.
 RenderResult renderVolume(const VolumeInput& input, const Camera& camera, const std::vector<Light>& lights,
                           const Medium& medium, const VolumeRenderSettings& settings);
+
+// The signed distance of a cell-centred distance grid at x (trilinear), +infinity outside the
+// grid's box (there are no obstacles outside the domain).
+double signedDistanceAt(const Grid<float, 3>& distance, const Vec3& x);
+
+// std::invalid_argument "camera is inside an obstacle (signed distance -0.12 m at the camera
+// position)" when the distance there is negative, or "camera is inside mesh 2 (a ray from the camera
+// crosses it 3 times)" for a closed mesh around it. Nothing can be seen from inside a solid.
+void checkCameraOutsideSolids(const Vec3& position, const Grid<float, 3>* surfaceDistance,
+                              const std::vector<const TriangleMesh*>& meshes);
 
 // Transmittance T_l(x) = exp(-sigma_t integral rho du) (Beer-Lambert, eq. 5.6) from every cell
 // centre to the light, or to where the path leaves the grid's box (there is no medium outside).
@@ -108,8 +140,13 @@ RenderResult renderVolume(const VolumeInput& input, const Camera& camera, const 
 // slice (a homogeneous slab), but it blurs sharp shadow edges over a few cells. Point and spot
 // lights: a shadow ray per cell, marched at stepCells, all cells in parallel (about 2 s for 128^3
 // on 2 cores). The spot's cone does not enter: it is part of E_l.
+// With a signed-distance grid of solid obstacles (cell-centred, the density's layout), paths
+// through a solid are blocked: T_l is multiplied by the visibility V = clamp(1 + d_min / dx, 0, 1),
+// d_min the least distance sampled along the path, so V is 1 on paths that stay outside and 0 on
+// those that go a cell deep into a solid (a one-cell soft edge, not a staircase of cells). The sweep
+// carries V across slices like the depth, interpolated as a visibility (outside the box V = 1).
 Grid<float, 3> lightTransmittance(const Grid<float, 3>& density, const Light& light, const Medium& medium,
-                                  double stepCells);
+                                  double stepCells, const Grid<float, 3>* surfaceDistance = nullptr);
 
 // The first-scatter source of the multiple-scattering problem: the power per unit volume scattered
 // out of the reduced incident light, sigma_s rho(x) sum_l Y(E_l(x)) T_l(x) [W/m^3] (Stam's J_ri of

@@ -57,11 +57,13 @@ Schema mediumSchema() {
 Schema renderSchema() {
   Schema r = Schema::object("the physically based picture of each frame (3D scenes; Stam ch. 5)");
   r.boolean("enabled", false, "render every frame into render/<name>_NNNN.png (needs outputs.vdb)");
+  r.boolean("exr", false, "also write each picture's linear radiance as a float OpenEXR file (.exr)");
   r.field("camera", cameraSchema());
   r.array("lights", lightSchema(), "light sources; none: one key light from above and in front");
   r.field("medium", mediumSchema());
   r.vector("background", "", {0.02, 0.02, 0.03}, "radiance behind the medium, linear RGB").lengths({3}).min(0.0);
   r.vector("ambient", "", {0.1, 0.1, 0.12}, "sky radiance scattered by the medium, linear RGB").lengths({3}).min(0.0);
+  r.vector("surface_albedo", "", {0.6, 0.6, 0.6}, "diffuse colour of obstacles, linear RGB").lengths({3}).min(0.0).max(1.0);
   r.number("exposure", "", 1.0, "radiance multiplier before tone mapping").min(0.0, Bound::Exclusive);
   r.boolean("multiple_scattering", true, "add multiple scattering by the diffusion approximation (ch. 5.5)");
   r.number("step", "cells", 0.5, "ray-march step").min(0.05).max(4.0);
@@ -69,6 +71,7 @@ Schema renderSchema() {
   grids.string("density", "density", "scattering and absorbing density");
   grids.string("temperature", "temperature", "temperature [K] for fire emission; '' for none");
   grids.string("emitter", "flame", "emission weight (flame density); '' for none");
+  grids.string("obstacle_distance", "obstacle_distance", "signed distance of opaque obstacles [m]; '' for none");
   r.field("grids", grids);
   return r;
 }
@@ -76,6 +79,7 @@ Schema renderSchema() {
 RenderKeys renderKeys(const json& r, const std::string& source) {
   RenderKeys k;
   k.enabled = r.at("enabled").get<bool>();
+  k.exr = r.at("exr").get<bool>();
   render::FrameRenderConfig& c = k.config;
   const json& cam = r.at("camera");
   c.width = cam.at("width").get<int>();
@@ -119,6 +123,7 @@ RenderKeys renderKeys(const json& r, const std::string& source) {
   c.medium.emissionReference = m.at("emission_reference").get<double>();
   c.settings.background = paddedVec3(r.at("background"));
   c.settings.ambient = paddedVec3(r.at("ambient"));
+  c.settings.surfaceAlbedo = paddedVec3(r.at("surface_albedo"));
   c.settings.exposure = r.at("exposure").get<double>();
   c.settings.stepCells = r.at("step").get<double>();
   c.multipleScattering = r.at("multiple_scattering").get<bool>();
@@ -133,6 +138,7 @@ RenderKeys renderKeys(const json& r, const std::string& source) {
   k.densityGrid = g.at("density");
   k.temperatureGrid = g.at("temperature");
   k.emitterGrid = g.at("emitter");
+  k.obstacleGrid = g.at("obstacle_distance");
   if (k.densityGrid.empty()) throw InputError(source + ": 'render.grids.density' must name a grid");
   return k;
 }

@@ -16,8 +16,9 @@ Schema renderSchema();
 
 struct RenderKeys {
   bool enabled = false;
+  bool exr = false;  // also write the linear radiance as OpenEXR next to each PNG
   render::FrameRenderConfig config;
-  std::string densityGrid, temperatureGrid, emitterGrid;  // "" = not used
+  std::string densityGrid, temperatureGrid, emitterGrid, obstacleGrid;  // "" = not used
 };
 
 // From the resolved "render" object; InputError naming `source` and the key for values the

@@ -226,8 +226,8 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
       if (layout.render.enabled) {
         // From the file just written, exactly as 'msim render' would make it later.
         ScopedStage stage(timers, "render frame");
-        io::writePng(frameFile(layout.renderDir, layout.name, frame, "png"),
-                     renderSavedFrame(frameFile(layout.vdbDir, layout.name, frame, "vdb"), layout.render));
+        renderSavedFrame(frameFile(layout.vdbDir, layout.name, frame, "vdb"), layout.render,
+                         frameFile(layout.renderDir, layout.name, frame, "png"));
       }
       if (layout.png) {
         ScopedStage stage(timers, "write png");

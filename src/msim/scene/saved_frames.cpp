@@ -2,12 +2,15 @@
 
 #include <algorithm>
 #include <fstream>
+#include <optional>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
 #include "msim/core/error.hpp"
 #include "msim/core/log.hpp"
 #include "msim/io/atomic_file.hpp"
+#include "msim/io/exr.hpp"
 #include "msim/io/vdb.hpp"
 #include "msim/io/video.hpp"
 #include "msim/scene/progress_bar.hpp"
@@ -20,6 +23,9 @@ namespace msim::scene {
 namespace fs = std::filesystem;
 
 namespace {
+
+// The smoke solver's obstacles, a signed distance at the cell centres (negative inside), drawn as
+// opaque surfaces when a frame has them.
 
 bool hasGrid(const std::vector<std::string>& grids, const std::string& name) {
   return !name.empty() && std::find(grids.begin(), grids.end(), name) != grids.end();
@@ -42,7 +48,8 @@ RenderKeys jobKeys(const nlohmann::json& storedRender, const std::vector<std::st
 
 }  // namespace
 
-io::Image renderSavedFrame(const fs::path& vdbFile, const RenderKeys& keys, render::FrameTimings* timings) {
+void renderSavedFrame(const fs::path& vdbFile, const RenderKeys& keys, const fs::path& png,
+                      render::FrameTimings* timings) {
   const std::vector<std::string> grids = io::listVdbGrids(vdbFile);
   if (!hasGrid(grids, keys.densityGrid))
     throw InputError(fmt::format("{}: no grid '{}' to render (the file has: {}); set render.grids.density",
@@ -51,10 +58,21 @@ io::Image renderSavedFrame(const fs::path& vdbFile, const RenderKeys& keys, rend
   std::optional<Grid<float, 3>> temperature, emitter;
   if (hasGrid(grids, keys.temperatureGrid)) temperature = io::readFloatGrid(vdbFile, keys.temperatureGrid);
   if (temperature && hasGrid(grids, keys.emitterGrid)) emitter = io::readFloatGrid(vdbFile, keys.emitterGrid);
-  const render::FrameResult r =
-      render::renderFrame(keys.config, density, temperature ? &*temperature : nullptr, emitter ? &*emitter : nullptr);
-  if (timings) *timings = r.timings;
-  return r.render.image;
+  std::optional<Grid<float, 3>> obstacles;
+  if (hasGrid(grids, keys.obstacleGrid)) obstacles = io::readFloatGrid(vdbFile, keys.obstacleGrid);
+  render::FrameSurfaces surfaces;
+  surfaces.distance = obstacles ? &*obstacles : nullptr;
+  try {
+    const render::FrameResult r = render::renderFrame(keys.config, density, temperature ? &*temperature : nullptr,
+                                                      emitter ? &*emitter : nullptr, surfaces);
+    if (timings) *timings = r.timings;
+    io::writePng(png, r.render.image);
+    if (keys.exr) io::writeExr(fs::path(png).replace_extension(".exr"), r.render.radiance);
+  } catch (const std::invalid_argument& e) {
+    // What the renderer refuses in a valid file (a camera inside an obstacle, grids of different
+    // layouts) is an input error of this frame: exit 2 naming it.
+    throw InputError(fmt::format("{}: cannot render: {}", vdbFile.string(), e.what()));
+  }
 }
 
 std::vector<fs::path> renderSavedFrames(const RenderJob& job) {
@@ -86,7 +104,6 @@ std::vector<fs::path> renderSavedFrames(const RenderJob& job) {
   std::vector<fs::path> written;
   ProgressBar progress(1, static_cast<int>(frames.size()));
   for (std::size_t i = 0; i < frames.size(); ++i) {
-    const io::Image image = renderSavedFrame(frames[i], keys);
     fs::path target;
     if (outDir.empty()) {
       target = job.output.empty() ? fs::path(job.input).replace_extension(".png") : job.output;
@@ -94,7 +111,7 @@ std::vector<fs::path> renderSavedFrames(const RenderJob& job) {
       fs::create_directories(outDir);
       target = outDir / frames[i].filename().replace_extension(".png");
     }
-    io::writePng(target, image);
+    renderSavedFrame(frames[i], keys, target);
     written.push_back(target);
     if (job.showProgress) progress.update(static_cast<int>(i) + 1, 1);
   }

@@ -12,14 +12,16 @@
 
 namespace msim::scene {
 
-// The picture of one saved frame. InputError naming the file for a missing or unreadable file or a
-// missing density grid; the temperature and emitter grids are used when the file has them.
-io::Image renderSavedFrame(const std::filesystem::path& vdbFile, const RenderKeys& keys,
-                           render::FrameTimings* timings = nullptr);
+// Renders one saved frame into `png` (and its .exr twin when keys.exr). InputError naming the
+// file for a missing or unreadable file, a missing density grid, or a picture the renderer refuses
+// (a camera inside an obstacle); the temperature, emitter and obstacle grids are used when present.
+void renderSavedFrame(const std::filesystem::path& vdbFile, const RenderKeys& keys, const std::filesystem::path& png,
+                      render::FrameTimings* timings = nullptr);
 
 struct RenderJob {
   std::filesystem::path input;   // a run folder (with run.json and vdb/) or one .vdb file
   std::filesystem::path output;  // folder for a run (default <input>/render), file for a .vdb (default <input>.png)
+                                 // (with render.exr, an .exr of the same name beside each picture)
   std::vector<std::string> overrides;  // "render.key=value" changes to the stored keys
   bool showProgress = true;
 };

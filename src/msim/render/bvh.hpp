@@ -1,0 +1,100 @@
+#pragma once
+// Bounding volume hierarchy over axis-aligned boxes, for the rays the renderer traces against
+// opaque primitives (triangles of meshes, spheres of point sets; surfaces.hpp). Built once per
+// render by the binned surface area heuristic; a query walks it with a fixed stack, so tracing
+// allocates nothing.
+#include <limits>
+#include <utility>
+#include <vector>
+
+#include "msim/core/vec.hpp"
+
+namespace msim::render {
+
+struct Aabb {
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+  Vec3 hi = Vec3::Constant(-std::numeric_limits<double>::infinity());
+
+  void grow(const Vec3& p) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  void grow(const Aabb& b) {
+    lo = lo.cwiseMin(b.lo);
+    hi = hi.cwiseMax(b.hi);
+  }
+  Vec3 centre() const { return 0.5 * (lo + hi); }
+  double halfArea() const {  // half the surface area: the SAH only compares areas
+    const Vec3 e = (hi - lo).cwiseMax(0.0);
+    return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
+  }
+};
+
+class Bvh {
+ public:
+  Bvh() = default;
+  // One box per primitive; primitive i is reported to queries as i.
+  explicit Bvh(const std::vector<Aabb>& boxes);
+
+  bool empty() const { return nodes_.empty(); }
+
+  // Calls hit(primitive, tMax) for the primitives whose boxes the ray origin + t dir meets for t in
+  // [0, tMax], near subtrees first; hit returns true when the primitive was hit before tMax (and
+  // lowered tMax to the hit). With AnyHit the walk stops at the first hit (shadow rays).
+  template <bool AnyHit, typename F>
+  bool traverse(const Vec3& origin, const Vec3& dir, double& tMax, F&& hit) const {
+    if (nodes_.empty()) return false;
+    const Vec3 inv(1.0 / dir[0], 1.0 / dir[1], 1.0 / dir[2]);  // +-inf for zero components is fine
+    int stack[kMaxDepth + 2];
+    int top = 0;
+    stack[top++] = 0;
+    bool found = false;
+    while (top > 0) {
+      const Node& node = nodes_[static_cast<std::size_t>(stack[--top])];
+      if (!(entry(node.box, origin, inv, tMax) <= tMax)) continue;
+      if (node.count > 0) {
+        for (int k = node.first; k < node.first + node.count; ++k)
+          if (hit(primitives_[static_cast<std::size_t>(k)], tMax)) {
+            found = true;
+            if constexpr (AnyHit) return true;
+          }
+        continue;
+      }
+      const double nearL = entry(nodes_[static_cast<std::size_t>(node.first)].box, origin, inv, tMax);
+      const double nearR = entry(nodes_[static_cast<std::size_t>(node.first) + 1].box, origin, inv, tMax);
+      // Push the far child first so the near one is walked first and shrinks tMax for the other.
+      const bool leftFirst = nearL <= nearR;
+      stack[top++] = leftFirst ? node.first + 1 : node.first;
+      stack[top++] = leftFirst ? node.first : node.first + 1;
+    }
+    return found;
+  }
+
+ private:
+  static constexpr int kMaxDepth = 60;  // deeper nodes become leaves, which bounds the stack
+
+  struct Node {
+    Aabb box;
+    int first = 0;  // leaf: first index into primitives_; inner node: the left child (right = first + 1)
+    int count = 0;  // primitives of a leaf; 0 for an inner node
+  };
+
+  // Ray parameter where the ray enters the box, +infinity when it misses it within [0, tMax].
+  static double entry(const Aabb& b, const Vec3& o, const Vec3& inv, double tMax) {
+    double t0 = 0.0, t1 = tMax;
+    for (int a = 0; a < 3; ++a) {
+      double ta = (b.lo[a] - o[a]) * inv[a], tb = (b.hi[a] - o[a]) * inv[a];
+      if (ta > tb) std::swap(ta, tb);
+      t0 = ta > t0 ? ta : t0;  // NaN (0 * inf on a box face) leaves the bound unchanged
+      t1 = tb < t1 ? tb : t1;
+    }
+    return t0 <= t1 ? t0 : std::numeric_limits<double>::infinity();
+  }
+
+  void build(int node, int begin, int end, int depth, const std::vector<Aabb>& boxes, std::vector<Vec3>& centres);
+
+  std::vector<Node> nodes_;
+  std::vector<int> primitives_;
+};
+
+}  // namespace msim::render
