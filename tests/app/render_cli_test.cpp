@@ -92,3 +92,22 @@ TEST(RenderCli, BadInputIsOneClearMessage) {
     EXPECT_FALSE(fs::exists(dir / "bad.png")) << c.args;
   }
 }
+
+TEST(RenderCli, TwoDimensionalFramesRenderAsSlabs) {
+  const fs::path dir = scratch("render_2d");
+  writeText(dir / "s.json", R"({"name": "flat", "phenomenon": "smoke",
+    "domain": {"min": [0, 0], "max": [1, 1], "resolution": 24},
+    "time": {"duration": 0.125, "fps": 8},
+    "sources": [{"shape": {"type": "sphere", "center": [0.5, 0.3], "radius": 0.2}, "mode": "set", "density": 1.0}],
+    "obstacles": [{"shape": {"type": "sphere", "center": [0.5, 0.7], "radius": 0.1}}],
+    "outputs": {"mp4": false}})");
+  ASSERT_EQ(runMsim("run " + (dir / "s.json").string() + " -q --out " + (dir / "out").string()).exitCode, 0);
+  const Result r = runMsim("render " + (dir / "out" / "vdb" / "flat_0001.vdb").string() + " -q --out " +
+                           (dir / "flat.png").string() + " --set render.camera.width=40 --set render.camera.height=40");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  // The smoke (lower half) and the obstacle (upper half) are both visible against the background.
+  const msim::io::Image image = msim::io::readPng(dir / "flat.png");
+  const auto* background = image.pixel(1, 1);
+  EXPECT_NE(image.pixel(20, 26)[0], background[0]);  // smoke at (0.5, 0.3)
+  EXPECT_NE(image.pixel(20, 13)[0], background[0]);  // obstacle at (0.5, 0.7)
+}

@@ -1,6 +1,8 @@
 #include "msim/scene/gas_phenomenon.hpp"
 
 #include <cmath>
+#include <limits>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -108,7 +110,13 @@ class GasPhenomenon final : public Phenomenon {
     const json& obstacles = r.at("obstacles");
     for (std::size_t i = 0; i < obstacles.size(); ++i) {
       const std::string key = fmt::format("obstacles[{}].shape", i);
-      const Grid<float, D> cover = geometry::occupancy(*sceneShape<D>(scene, obstacles[i].at("shape"), key), spec);
+      const auto shape = sceneShape<D>(scene, obstacles[i].at("shape"), key);
+      const Grid<float, D> cover = geometry::occupancy(*shape, spec);
+      // The signed distance goes into every frame so renderers can draw the obstacles.
+      const Grid<float, D> distance = shape->distanceField(spec);
+      if (!obstacleDistance_) obstacleDistance_.emplace(spec, std::numeric_limits<float>::max());
+      for (std::size_t c = 0; c < distance.count(); ++c)
+        (*obstacleDistance_)[c] = std::min((*obstacleDistance_)[c], distance[c]);
       std::size_t inside = 0;
       for (std::size_t c = 0; c < cover.count(); ++c)
         if (cover[c] > 0.5f) solid[c] = 1.0f, ++inside;
@@ -144,6 +152,7 @@ class GasPhenomenon final : public Phenomenon {
     io::VdbWriter writer;
     writer.addFloatGrid("density", solver_.density());
     writer.addFloatGrid("temperature", solver_.temperature());
+    if (obstacleDistance_) writer.addFloatGrid("obstacle_distance", *obstacleDistance_);
     writer.write(vdbFile);
   }
 
@@ -184,6 +193,7 @@ class GasPhenomenon final : public Phenomenon {
   std::string source_;
   StageTimers& timers_;
   fluid::GasSolver<D> solver_;
+  std::optional<Grid<float, D>> obstacleDistance_;  // signed distance of the obstacles [m], if any
   render::PreviewSettings preview_;
 };
 

@@ -67,6 +67,7 @@ Schema renderSchema() {
   r.number("exposure", "", 1.0, "radiance multiplier before tone mapping").min(0.0, Bound::Exclusive);
   r.boolean("multiple_scattering", true, "add multiple scattering by the diffusion approximation (ch. 5.5)");
   r.number("step", "cells", 0.5, "ray-march step").min(0.05).max(4.0);
+  r.integer("slab_cells", 8, "2D scenes render as a slab this many cells thick, seen face-on").min(1).max(256);
   Schema grids = Schema::object("names of the grids in the saved frames");
   grids.string("density", "density", "scattering and absorbing density");
   grids.string("temperature", "temperature", "temperature [K] for fire emission; '' for none");
@@ -126,6 +127,7 @@ RenderKeys renderKeys(const json& r, const std::string& source) {
   c.settings.surfaceAlbedo = paddedVec3(r.at("surface_albedo"));
   c.settings.exposure = r.at("exposure").get<double>();
   c.settings.stepCells = r.at("step").get<double>();
+  k.slabCells = r.at("slab_cells").get<int>();
   c.multipleScattering = r.at("multiple_scattering").get<bool>();
   if (c.camera) {
     try {

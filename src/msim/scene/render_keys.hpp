@@ -17,6 +17,7 @@ Schema renderSchema();
 struct RenderKeys {
   bool enabled = false;
   bool exr = false;  // also write the linear radiance as OpenEXR next to each PNG
+  int slabCells = 8;  // a 2D frame is rendered as a slab this many cells thick
   render::FrameRenderConfig config;
   std::string densityGrid, temperatureGrid, emitterGrid, obstacleGrid;  // "" = not used
 };

@@ -31,6 +31,21 @@ bool hasGrid(const std::vector<std::string>& grids, const std::string& name) {
   return !name.empty() && std::find(grids.begin(), grids.end(), name) != grids.end();
 }
 
+// A grid of a saved frame; a 2D scene's frame (one cell thick in z) becomes a slab `slabCells`
+// thick, every layer a copy of the slice, so the 3D renderer sees the flow face-on with some body
+// (obstacles become prisms, as a 2D obstacle is).
+Grid<float, 3> readForRender(const fs::path& vdbFile, const std::string& name, int slabCells) {
+  Grid<float, 3> grid = io::readFloatGrid(vdbFile, name);
+  if (grid.size().z() != 1 || slabCells <= 1) return grid;
+  GridSpec<3> spec = grid.spec();
+  spec.res.z() = slabCells;
+  Grid<float, 3> slab(spec);
+  const std::size_t layer = grid.count();
+  for (int z = 0; z < slabCells; ++z)
+    std::copy(grid.data().begin(), grid.data().end(), slab.data().begin() + static_cast<std::ptrdiff_t>(z * layer));
+  return slab;
+}
+
 // The render.* keys of a run (or the defaults), with the job's overrides applied.
 RenderKeys jobKeys(const nlohmann::json& storedRender, const std::vector<std::string>& overrides,
                    const std::string& source) {
@@ -54,12 +69,13 @@ void renderSavedFrame(const fs::path& vdbFile, const RenderKeys& keys, const fs:
   if (!hasGrid(grids, keys.densityGrid))
     throw InputError(fmt::format("{}: no grid '{}' to render (the file has: {}); set render.grids.density",
                                  vdbFile.string(), keys.densityGrid, fmt::join(grids, ", ")));
-  const Grid<float, 3> density = io::readFloatGrid(vdbFile, keys.densityGrid);
+  const Grid<float, 3> density = readForRender(vdbFile, keys.densityGrid, keys.slabCells);
   std::optional<Grid<float, 3>> temperature, emitter;
-  if (hasGrid(grids, keys.temperatureGrid)) temperature = io::readFloatGrid(vdbFile, keys.temperatureGrid);
-  if (temperature && hasGrid(grids, keys.emitterGrid)) emitter = io::readFloatGrid(vdbFile, keys.emitterGrid);
+  if (hasGrid(grids, keys.temperatureGrid)) temperature = readForRender(vdbFile, keys.temperatureGrid, keys.slabCells);
+  if (temperature && hasGrid(grids, keys.emitterGrid))
+    emitter = readForRender(vdbFile, keys.emitterGrid, keys.slabCells);
   std::optional<Grid<float, 3>> obstacles;
-  if (hasGrid(grids, keys.obstacleGrid)) obstacles = io::readFloatGrid(vdbFile, keys.obstacleGrid);
+  if (hasGrid(grids, keys.obstacleGrid)) obstacles = readForRender(vdbFile, keys.obstacleGrid, keys.slabCells);
   render::FrameSurfaces surfaces;
   surfaces.distance = obstacles ? &*obstacles : nullptr;
   try {
