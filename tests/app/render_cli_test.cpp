@@ -111,3 +111,24 @@ TEST(RenderCli, TwoDimensionalFramesRenderAsSlabs) {
   EXPECT_NE(image.pixel(20, 26)[0], background[0]);  // smoke at (0.5, 0.3)
   EXPECT_NE(image.pixel(20, 13)[0], background[0]);  // obstacle at (0.5, 0.7)
 }
+
+TEST(RenderCli, MeshesAndPointsFromFilesAreDrawnAndBadFilesNamed) {
+  const fs::path dir = simulate("render_geometry");
+  writeText(dir / "tetra.obj", "v 0.3 0.3 0.3\nv 0.7 0.3 0.3\nv 0.5 0.7 0.3\nv 0.5 0.5 0.7\n"
+                               "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n");
+  writeText(dir / "grains.ply", "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+                                "property float z\nend_header\n0.2 0.8 0.5\n0.8 0.8 0.5\n");
+  const std::string vdb = (dir / "out" / "vdb" / "tiny3d_0001.vdb").string();
+  const std::string size = " --set render.camera.width=32 --set render.camera.height=32";
+  const Result ok = runMsim("render " + vdb + " -q --out " + (dir / "with.png").string() + size +
+                            " --set 'render.meshes=[{\"file\":\"" + (dir / "tetra.obj").string() + "\"}]'" +
+                            " --set render.points.file=" + (dir / "grains.ply").string() + " --set render.points.radius=0.05");
+  ASSERT_EQ(ok.exitCode, 0) << ok.output;
+  ASSERT_EQ(runMsim("render " + vdb + " -q --out " + (dir / "without.png").string() + size).exitCode, 0);
+  EXPECT_NE(msim::io::readPng(dir / "with.png").rgb, msim::io::readPng(dir / "without.png").rgb);
+  const Result bad = runMsim("render " + vdb + " -q --out " + (dir / "bad.png").string() +
+                             " --set 'render.meshes=[{\"file\":\"" + (dir / "missing.obj").string() + "\"}]'");
+  EXPECT_EQ(bad.exitCode, 2) << bad.output;
+  EXPECT_NE(bad.output.find("render.meshes[0].file"), std::string::npos) << bad.output;
+  EXPECT_FALSE(fs::exists(dir / "bad.png"));
+}

@@ -7,7 +7,6 @@
 //  - the time of a few thousand blobs at 320 x 240; input validation.
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -159,35 +158,31 @@ TEST(Blobs, LitBlobAgreesWithTheGridVolumeRenderer) {
               withSelf, 100.0 * (withSelf / grid - 1.0), without, 100.0 * (without / grid - 1.0));
 }
 
-TEST(Blobs, ThousandsOfBlobsRenderQuickly) {
-  // 3000 blobs in a ball of radius 1 (a cloud), 320 x 240, one light, sky and background.
+TEST(Blobs, AThousandOverlappingBlobsRenderFiniteAndVisible) {
+  // A cloud of 1000 blobs in a ball of radius 1, one light, sky and background; the time this
+  // takes is measured in bench/blob_bench.cpp.
   Rng rng(7);
   std::vector<Blob> blobs;
-  while (blobs.size() < 3000) {
+  while (blobs.size() < 1000) {
     const Vec3 p(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0));
-    if (p.norm() < 1.0) blobs.push_back({p, 0.002, rng.uniform(0.04, 0.1)});
+    if (p.norm() < 1.0) blobs.push_back({p, 0.006, rng.uniform(0.04, 0.1)});
   }
   const BlobSet set(std::move(blobs));
   Camera cam = view(1, Vec3(0.0, 0.5, 4.0));
-  cam.width = 320;
-  cam.height = 240;
+  cam.width = 160;
+  cam.height = 120;
   Light light;
   light.direction = Vec3(-1.0, -1.0, -0.3);
   light.intensity = 3.0;
   Medium m;
   m.extinction = 10.0;
-  const auto t0 = std::chrono::steady_clock::now();
   const BlobRenderResult r = renderBlobs(set, cam, {light}, m, VolumeRenderSettings{});
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   double mn = 1e9, mx = 0.0;
   for (float v : r.radiance.rgb) {
     ASSERT_TRUE(std::isfinite(v));
     mn = std::min(mn, double(v)), mx = std::max(mx, double(v));
   }
   EXPECT_GT(mx, 2.0 * mn);  // the cloud shows against the background
-  EXPECT_LT(seconds, 3.0);  // about 0.1-0.2 s on 2 cores; loose for a loaded machine
-  std::printf("3000 blobs at 320 x 240: %.3f s (shadows %.3f s, rays %.3f s), %.1f blobs per ray\n", seconds,
-              r.stats.secondsShadows, r.stats.secondsRays, double(r.stats.blobRayPairs) / r.stats.rays);
 }
 
 TEST(Blobs, BadInputIsRefused) {

@@ -5,6 +5,8 @@
 #include <fmt/format.h>
 
 #include "msim/core/error.hpp"
+#include "msim/io/obj.hpp"
+#include "msim/io/ply.hpp"
 #include "msim/scene/json_vectors.hpp"
 
 namespace msim::scene {
@@ -52,6 +54,63 @@ Schema mediumSchema() {
   return medium;
 }
 
+Schema meshSchema() {
+  Schema mesh = Schema::object("a triangle mesh drawn with every frame (e.g. cloth or a rigid body exported by another tool)");
+  mesh.string("file", "an .obj or .ply file, relative to the scene file (run folders) or the current folder").required();
+  mesh.number("scale", "", 1.0, "uniform scale of the vertices").min(0.0, Bound::Exclusive);
+  mesh.vector("translate", "m", {0.0, 0.0, 0.0}, "translation after scaling").lengths({3});
+  return mesh;
+}
+
+Schema pointsSchema() {
+  Schema points = Schema::object("points drawn as small spheres with every frame (sand grains, particles)");
+  points.string("file", "", "a .ply point file; '' for none");
+  points.number("radius", "m", 0.005, "sphere radius").min(0.0, Bound::Exclusive);
+  points.vector("albedo", "", {0.76, 0.62, 0.42}, "diffuse colour, linear RGB").lengths({3}).min(0.0).max(1.0);
+  return points;
+}
+
+std::filesystem::path resolvedPath(const std::filesystem::path& base, const std::string& file) {
+  const std::filesystem::path p(file);
+  return p.is_absolute() || base.empty() ? p : base / p;
+}
+
+// Loads render.meshes[] and render.points; errors name the key.
+std::shared_ptr<const RenderGeometry> loadGeometry(const json& r, const std::string& source,
+                                                   const std::filesystem::path& base) {
+  auto g = std::make_shared<RenderGeometry>();
+  const json& meshes = r.at("meshes");
+  for (std::size_t i = 0; i < meshes.size(); ++i) {
+    const std::filesystem::path file = resolvedPath(base, meshes[i].at("file").get<std::string>());
+    const std::string key = fmt::format("render.meshes[{}].file", i);
+    TriangleMesh mesh;
+    try {
+      const std::string ext = file.extension().string();
+      if (ext == ".obj") mesh = io::readObj(file);
+      else if (ext == ".ply") mesh = io::readPlyMesh(file).mesh;
+      else throw InputError(fmt::format("{}: '{}' is '{}': expected an .obj or .ply file", source, key, file.string()));
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("{}: '{}': {}", source, key, e.what()));
+    }
+    const double scale = meshes[i].at("scale").get<double>();
+    const Vec3 shift = paddedVec3(meshes[i].at("translate"));
+    for (Vec3& v : mesh.vertices) v = v * scale + shift;
+    g->meshes.push_back(std::move(mesh));
+  }
+  const json& points = r.at("points");
+  const std::string pointFile = points.at("file");
+  if (!pointFile.empty()) {
+    try {
+      g->points = io::readPlyPoints(resolvedPath(base, pointFile)).positions;
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("{}: 'render.points.file': {}", source, e.what()));
+    }
+    g->pointRadius = points.at("radius").get<double>();
+    g->pointAlbedo = paddedVec3(points.at("albedo"));
+  }
+  return g;
+}
+
 }  // namespace
 
 Schema renderSchema() {
@@ -68,6 +127,8 @@ Schema renderSchema() {
   r.boolean("multiple_scattering", true, "add multiple scattering by the diffusion approximation (ch. 5.5)");
   r.number("step", "cells", 0.5, "ray-march step").min(0.05).max(4.0);
   r.integer("slab_cells", 8, "2D scenes render as a slab this many cells thick, seen face-on").min(1).max(256);
+  r.array("meshes", meshSchema(), "triangle meshes drawn with every frame, shaded with surface_albedo");
+  r.field("points", pointsSchema());
   Schema grids = Schema::object("names of the grids in the saved frames");
   grids.string("density", "density", "scattering and absorbing density");
   grids.string("temperature", "temperature", "temperature [K] for fire emission; '' for none");
@@ -77,7 +138,7 @@ Schema renderSchema() {
   return r;
 }
 
-RenderKeys renderKeys(const json& r, const std::string& source) {
+RenderKeys renderKeys(const json& r, const std::string& source, const std::filesystem::path& baseDirectory) {
   RenderKeys k;
   k.enabled = r.at("enabled").get<bool>();
   k.exr = r.at("exr").get<bool>();
@@ -142,6 +203,7 @@ RenderKeys renderKeys(const json& r, const std::string& source) {
   k.emitterGrid = g.at("emitter");
   k.obstacleGrid = g.at("obstacle_distance");
   if (k.densityGrid.empty()) throw InputError(source + ": 'render.grids.density' must name a grid");
+  k.geometry = loadGeometry(r, source, baseDirectory);
   return k;
 }
 

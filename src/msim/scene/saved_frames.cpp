@@ -48,7 +48,7 @@ Grid<float, 3> readForRender(const fs::path& vdbFile, const std::string& name, i
 
 // The render.* keys of a run (or the defaults), with the job's overrides applied.
 RenderKeys jobKeys(const nlohmann::json& storedRender, const std::vector<std::string>& overrides,
-                   const std::string& source) {
+                   const std::string& source, const fs::path& baseDirectory) {
   nlohmann::json doc = {{"render", storedRender}};
   for (const auto& o : overrides) {
     if (o.rfind("render.", 0) != 0)
@@ -58,7 +58,7 @@ RenderKeys jobKeys(const nlohmann::json& storedRender, const std::vector<std::st
   // Resolved as the scene's own "render" key, so errors name 'render.camera.fov', not 'camera.fov'.
   Schema root = Schema::object("the render keys of saved frames");
   root.field("render", renderSchema());
-  return renderKeys(resolve(root, doc, source).at("render"), source);
+  return renderKeys(resolve(root, doc, source).at("render"), source, baseDirectory);
 }
 
 }  // namespace
@@ -78,6 +78,14 @@ void renderSavedFrame(const fs::path& vdbFile, const RenderKeys& keys, const fs:
   if (hasGrid(grids, keys.obstacleGrid)) obstacles = readForRender(vdbFile, keys.obstacleGrid, keys.slabCells);
   render::FrameSurfaces surfaces;
   surfaces.distance = obstacles ? &*obstacles : nullptr;
+  for (const TriangleMesh& mesh : keys.geometry->meshes) surfaces.meshes.push_back(&mesh);
+  if (!keys.geometry->points.empty()) {
+    render::PointSet points;
+    points.positions = &keys.geometry->points;
+    points.radius = keys.geometry->pointRadius;
+    points.albedo = keys.geometry->pointAlbedo;
+    surfaces.points.push_back(points);
+  }
   try {
     const render::FrameResult r = render::renderFrame(keys.config, density, temperature ? &*temperature : nullptr,
                                                       emitter ? &*emitter : nullptr, surfaces);
@@ -102,7 +110,10 @@ std::vector<fs::path> renderSavedFrames(const RenderJob& job) {
       throw InputError(source + ": not a run folder (no run.json); give a folder written by 'msim run' or a .vdb file");
     const nlohmann::json run = loadJsonFile(runFile);
     const nlohmann::json params = run.value("parameters", nlohmann::json::object());
-    keys = jobKeys(params.value("render", nlohmann::json::object()), job.overrides, runFile.string());
+    // Mesh and point files are named relative to the scene file, as in the scene itself.
+    const fs::path sceneFile = run.value("scene_file", std::string());
+    keys = jobKeys(params.value("render", nlohmann::json::object()), job.overrides, runFile.string(),
+                   sceneFile.parent_path());
     if (fs::is_directory(job.input / "vdb"))
       for (const auto& e : fs::directory_iterator(job.input / "vdb"))
         if (e.path().extension() == ".vdb") frames.push_back(e.path());
@@ -111,7 +122,7 @@ std::vector<fs::path> renderSavedFrames(const RenderJob& job) {
     outDir = job.output.empty() ? job.input / "render" : job.output;
   } else if (job.input.extension() == ".vdb") {
     if (!fs::exists(job.input)) throw InputError(source + ": no such file");
-    keys = jobKeys(nlohmann::json::object(), job.overrides, source);
+    keys = jobKeys(nlohmann::json::object(), job.overrides, source, fs::path());
     frames.push_back(job.input);
   } else {
     throw InputError(source + ": expected a run folder (with run.json) or a .vdb file");
