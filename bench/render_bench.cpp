@@ -31,22 +31,28 @@ Grid<float, 3> smokePuffs(int n) {
   return rho;
 }
 
-void BM_RenderVolume(benchmark::State& state) {
-  const Grid<float, 3> rho = smokePuffs(static_cast<int>(state.range(0)));
-  const render::Camera camera = render::frameBox(rho.spec().origin, rho.spec().upper(), 640, 480);
+render::Light benchSun() {
   render::Light sun;
   sun.type = render::Light::Type::Directional;
   sun.direction = Vec3(0.5, -1.0, -0.3);
   sun.intensity = 10.0;
-  const render::Medium medium;
-  const render::VolumeRenderSettings settings;
+  return sun;
+}
+
+// Renders `input` at 640 x 480 (framing its density's box) for every iteration and reports the
+// cost split: light grids, march, rays/s, samples, surface pixels.
+void runRenderVolume(benchmark::State& state, const render::VolumeInput& input) {
+  const GridSpec<3>& spec = input.density->spec();
+  const render::Camera camera = render::frameBox(spec.origin, spec.upper(), 640, 480);
   render::RenderStats total;
   for (auto _ : state) {
-    const render::RenderResult r = render::renderVolume({&rho}, camera, {sun}, medium, settings);
+    const render::RenderResult r =
+        render::renderVolume(input, camera, {benchSun()}, render::Medium(), render::VolumeRenderSettings());
     total.secondsLightGrids += r.stats.secondsLightGrids;
     total.secondsMarch += r.stats.secondsMarch;
     total.primaryRays += r.stats.primaryRays;
     total.samples += r.stats.samples;
+    total.surfaceHits += r.stats.surfaceHits;
     benchmark::DoNotOptimize(r.image.rgb.data());
   }
   const double iterations = static_cast<double>(state.iterations());
@@ -55,6 +61,12 @@ void BM_RenderVolume(benchmark::State& state) {
   state.counters["rays_per_s"] = static_cast<double>(total.primaryRays) / (total.secondsLightGrids + total.secondsMarch);
   state.counters["samples_per_s"] = static_cast<double>(total.samples) / total.secondsMarch;
   state.counters["samples_per_ray"] = static_cast<double>(total.samples) / static_cast<double>(total.primaryRays);
+  if (total.surfaceHits > 0) state.counters["surface_pixels"] = static_cast<double>(total.surfaceHits) / iterations;
+}
+
+void BM_RenderVolume(benchmark::State& state) {
+  const Grid<float, 3> rho = smokePuffs(static_cast<int>(state.range(0)));
+  runRenderVolume(state, render::VolumeInput{&rho});
 }
 
 // The same with a solid ball (radius 0.15, lower middle of the box, partly inside the lower puffs)
@@ -65,25 +77,9 @@ void BM_RenderVolumeWithBall(benchmark::State& state) {
   Grid<float, 3> ball(rho.spec());
   for (std::size_t i = 0; i < ball.count(); ++i)
     ball[i] = static_cast<float>((ball.position(ball.coord(i)) - Vec3(0.5, 0.3, 0.55)).norm() - 0.15);
-  const render::Camera camera = render::frameBox(rho.spec().origin, rho.spec().upper(), 640, 480);
-  render::Light sun;
-  sun.type = render::Light::Type::Directional;
-  sun.direction = Vec3(0.5, -1.0, -0.3);
-  sun.intensity = 10.0;
   render::VolumeInput input{&rho};
   input.surfaceDistance = &ball;
-  render::RenderStats total;
-  for (auto _ : state) {
-    const render::RenderResult r = render::renderVolume(input, camera, {sun}, render::Medium(), render::VolumeRenderSettings());
-    total.secondsLightGrids += r.stats.secondsLightGrids;
-    total.secondsMarch += r.stats.secondsMarch;
-    total.surfaceHits += r.stats.surfaceHits;
-    benchmark::DoNotOptimize(r.image.rgb.data());
-  }
-  const double iterations = static_cast<double>(state.iterations());
-  state.counters["s_light_grids"] = total.secondsLightGrids / iterations;
-  state.counters["s_march"] = total.secondsMarch / iterations;
-  state.counters["surface_pixels"] = static_cast<double>(total.surfaceHits) / iterations;
+  runRenderVolume(state, input);
 }
 
 // Issue #4's figure: the whole picture with multiple scattering (light grid, first-scatter source,
@@ -91,10 +87,7 @@ void BM_RenderVolumeWithBall(benchmark::State& state) {
 void BM_RenderFrameWithMultipleScattering(benchmark::State& state) {
   const Grid<float, 3> rho = smokePuffs(static_cast<int>(state.range(0)));
   render::FrameRenderConfig config;
-  render::Light sun;
-  sun.direction = Vec3(0.5, -1.0, -0.3);
-  sun.intensity = 10.0;
-  config.lights = {sun};
+  config.lights = {benchSun()};
   render::FrameTimings total;
   for (auto _ : state) {
     const render::FrameResult r = render::renderFrame(config, rho);
