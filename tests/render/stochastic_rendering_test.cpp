@@ -15,6 +15,7 @@
 
 #include "expect_invalid.hpp"
 #include "msim/core/rng.hpp"
+#include "msim/render/camera.hpp"
 #include "msim/render/stochastic_rendering.hpp"
 
 using namespace msim;
@@ -178,4 +179,158 @@ TEST(StochasticRendering, BadInputIsRefused) {
   StochasticBlobParameters p;
   p.eta = 0.0;
   expectInvalidArgument([&] { blobRayStatistics(BlobSet({}), Ray{Vec3::Zero(), Vec3::UnitX()}, 0.0, 1.0, p); }, "eta");
+  expectInvalidArgument([] { FourierNoise({}, 1, 0); }, "terms");
+  StochasticRenderSettings r;
+  r.noiseTerms = 0;
+  expectInvalidArgument([&] { renderStochasticBlobs(BlobSet({}), Camera{}, {}, Medium{}, VolumeRenderSettings{}, r); },
+                        "noiseTerms");
+}
+
+namespace {
+
+// A small cloud: blobs of different sizes, one emitting, lit by a sun and the sky.
+BlobSet cloud() {
+  std::vector<Blob> blobs;
+  Rng rng(3);
+  for (int i = 0; i < 12; ++i)
+    blobs.push_back({Vec3(rng.uniform(-0.6, 0.6), rng.uniform(-0.4, 0.4), rng.uniform(-0.3, 0.3)), rng.uniform(0.05, 0.3),
+                     rng.uniform(0.12, 0.3), i == 0 ? Vec3(0.5, 0.3, 0.1) : Vec3::Zero()});
+  return BlobSet(blobs);
+}
+
+Camera view(int size) {
+  Camera c;
+  c.width = c.height = size;  // odd: the middle pixel's ray passes through the target, the origin
+  return c;
+}
+
+std::vector<Light> sun() {
+  Light l;
+  l.type = Light::Type::Directional;
+  l.direction = Vec3(-1.0, -1.0, -0.5);
+  return {l};
+}
+
+StochasticRenderSettings turbulent(StochasticImage image, std::uint64_t seed) {
+  StochasticRenderSettings s;
+  s.parameters.epsilon = 2.0;
+  s.parameters.eta = 0.8;
+  s.parameters.correlation.length = 0.05;
+  s.image = image;
+  s.seed = seed;
+  return s;
+}
+
+Vec3 pixel(const FloatImage& image, int x, int y) {
+  const float* p = image.pixel(x, y);
+  return Vec3(p[0], p[1], p[2]);
+}
+
+}  // namespace
+
+TEST(StochasticRendering, FourierNoiseHasUnitVarianceAndTheCorrelation) {
+  // Over seeds, at two points a correlation length apart: mean 0, variance 1, correlation c(l).
+  for (const Correlation::Kind kind : {Correlation::Kind::Gaussian, Correlation::Kind::Exponential}) {
+    const Correlation c{kind, 0.05};
+    const Vec3 x(0.3, -0.2, 0.1), y = x + c.length * Vec3(0.6, 0.0, 0.8);
+    const int seeds = 4000;
+    double sum = 0.0, sum2 = 0.0, product = 0.0;
+    for (int seed = 0; seed < seeds; ++seed) {
+      const FourierNoise q(c, static_cast<std::uint64_t>(seed));
+      const double a = q(x), b = q(y);
+      sum += a, sum2 += a * a, product += a * b;
+    }
+    std::printf("noise %s: mean %.4f variance %.4f correlation at l %.4f (c(l) = %.4f)\n",
+                kind == Correlation::Kind::Gaussian ? "Gaussian" : "exponential", sum / seeds, sum2 / seeds,
+                product / seeds, c(c.length));
+    EXPECT_NEAR(sum / seeds, 0.0, 0.06);
+    EXPECT_NEAR(sum2 / seeds, 1.0, 0.08);
+    EXPECT_NEAR(product / seeds, c(c.length), 0.08);
+  }
+}
+
+TEST(StochasticRendering, ZeroVarianceImageIsRenderBlobs) {
+  const BlobSet blobs = cloud();
+  const Camera camera = view(33);
+  const Medium medium{5.0, 0.9, 0.3};
+  const BlobRenderResult reference = renderBlobs(blobs, camera, sun(), medium, VolumeRenderSettings{});
+  for (const StochasticImage image : {StochasticImage::Realisation, StochasticImage::Expected}) {
+    StochasticRenderSettings s = turbulent(image, 7);
+    s.parameters.epsilon = 0.0;
+    const BlobRenderResult r = renderStochasticBlobs(blobs, camera, sun(), medium, VolumeRenderSettings{}, s);
+    double worst = 0.0;
+    for (std::size_t i = 0; i < r.radiance.rgb.size(); ++i)
+      worst = std::max(worst, std::abs(r.radiance.rgb[i] - reference.radiance.rgb[i]) /
+                                  std::max(1e-30, static_cast<double>(std::abs(reference.radiance.rgb[i]))));
+    EXPECT_LE(worst, 1e-6);
+  }
+}
+
+TEST(StochasticRendering, MeanOfRealisationsIsTheExpectedPicture) {
+  // One blob (the blobs' perturbations are independent only when their closest points are more
+  // than a correlation length apart), seen through its centre.
+  const BlobSet blobs({Blob{Vec3::Zero(), 0.565, 0.3}});
+  const Camera camera = view(5);
+  const Medium medium{1.0, 0.9, 0.0};
+  VolumeRenderSettings transparency;  // pixel = tau: background 1, nothing scattered
+  transparency.background = Vec3::Ones();
+  transparency.ambient = Vec3::Zero();
+  VolumeRenderSettings lit;  // pixel = tau B + (1 - tau) J_avg
+  lit.background = Vec3(0.2, 0.3, 0.5);
+  lit.ambient = Vec3(0.6, 0.6, 0.7);
+  const Ray centre = CameraRays(camera).ray(2.5, 2.5);
+  const StochasticRenderSettings expectedSettings = turbulent(StochasticImage::Expected, 0);
+  const double expectedTau =
+      expectedTransparency(medium.extinction, blobRayStatistics(blobs, centre, 0.0, kInf, expectedSettings.parameters));
+  const double expectedPixel = renderStochasticBlobs(blobs, camera, {}, medium, transparency, expectedSettings).radiance.pixel(2, 2)[0];
+  const Vec3 expectedLit = pixel(renderStochasticBlobs(blobs, camera, sun(), medium, lit, expectedSettings).radiance, 2, 2);
+  // The cut-off at 4 sigma leaves out 6e-5 of the line integral through the centre.
+  EXPECT_NEAR(expectedPixel / expectedTau, 1.0, 1e-3);
+  const int seeds = 2000;
+  double sumTau = 0.0;
+  Vec3 sumLit = Vec3::Zero();
+  for (int seed = 1; seed <= seeds; ++seed) {
+    const StochasticRenderSettings s = turbulent(StochasticImage::Realisation, static_cast<std::uint64_t>(seed));
+    sumTau += renderStochasticBlobs(blobs, camera, {}, medium, transparency, s).radiance.pixel(2, 2)[0];
+    sumLit += pixel(renderStochasticBlobs(blobs, camera, sun(), medium, lit, s).radiance, 2, 2);
+  }
+  const double meanTau = sumTau / seeds;
+  const double beerLambert = std::exp(-medium.extinction * blobs.opticalDepth(centre, 0.0, kInf));
+  std::printf("centre pixel: Beer-Lambert %.5f, E[tau] %.5f, mean of %d realisations %.5f (%+.2f%%)\n", beerLambert,
+              expectedTau, seeds, meanTau, 100.0 * (meanTau / expectedTau - 1.0));
+  EXPECT_NEAR(meanTau / expectedTau, 1.0, 0.03);
+  EXPECT_GT(expectedTau, beerLambert * 1.05);  // Jensen: the average picture is visibly brighter
+  for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(sumLit[ch] / seeds / expectedLit[ch], 1.0, 0.03);
+}
+
+TEST(StochasticRendering, RealisationIsFiniteDeterministicAndVariesWithTheSeed) {
+  const BlobSet blobs = cloud();
+  const Camera camera = view(33);
+  const Medium medium{5.0, 0.9, 0.3};
+  VolumeRenderSettings transparency;
+  transparency.background = Vec3::Ones();
+  transparency.ambient = Vec3::Zero();
+  const BlobRenderResult a = renderStochasticBlobs(blobs, camera, sun(), medium, VolumeRenderSettings{}, turbulent(StochasticImage::Realisation, 5));
+  const BlobRenderResult b = renderStochasticBlobs(blobs, camera, sun(), medium, VolumeRenderSettings{}, turbulent(StochasticImage::Realisation, 5));
+  const BlobRenderResult c = renderStochasticBlobs(blobs, camera, sun(), medium, VolumeRenderSettings{}, turbulent(StochasticImage::Realisation, 6));
+  EXPECT_EQ(a.radiance.rgb, b.radiance.rgb);
+  EXPECT_EQ(a.image.rgb, b.image.rgb);
+  double change = 0.0;
+  for (std::size_t i = 0; i < a.radiance.rgb.size(); ++i) {
+    EXPECT_TRUE(std::isfinite(a.radiance.rgb[i]));
+    EXPECT_GE(a.radiance.rgb[i], 0.0f);
+    change = std::max(change, static_cast<double>(std::abs(a.radiance.rgb[i] - c.radiance.rgb[i])));
+  }
+  EXPECT_GT(change, 1e-3);  // the detail is visible
+  // Transparency alone, thick enough that renderBlobs stops some rays at T < 1e-4: tau in [0, 1]
+  // (Gamma clamped at 0).
+  const Medium thick{200.0, 0.9, 0.3};
+  const BlobRenderResult t = renderStochasticBlobs(blobs, camera, {}, thick, transparency, turbulent(StochasticImage::Realisation, 5));
+  int opaque = 0;
+  for (float v : t.radiance.rgb) {
+    EXPECT_GE(v, 0.0f);
+    EXPECT_LE(v, 1.0f);
+    opaque += v < 1e-4f;
+  }
+  EXPECT_GT(opaque, 0);
 }

@@ -16,7 +16,6 @@ namespace msim::render {
 namespace {
 
 constexpr double kInv4Pi = 0.25 * std::numbers::inv_pi;
-constexpr double kMinTransmittance = 1e-4;  // as renderVolume: the rest of the ray adds < 1e-4 of J
 
 bool finite(const Vec3& v) { return v.allFinite(); }
 
@@ -118,12 +117,6 @@ double shadowDepth(const std::vector<Blob>& blobs, std::size_t k, const Ray& ray
   return depth;
 }
 
-struct Chord {
-  double in, out;
-  double gamma;  // Gamma_k / (out - in): the blob's depth per unit length on its chord
-  std::size_t blob;
-};
-
 // Indices of chords ordered by key(chord) by insertion sort: O(n) for the nearly sorted lists the
 // depth-sorted tile lists give (neighbouring rays meet the blobs in almost the same order).
 template <typename Key>
@@ -141,7 +134,7 @@ void insertionSort(std::vector<std::size_t>& idx, Key&& key) {
 
 BlobRenderResult renderBlobs(const BlobSet& blobSet, const Camera& camera, const std::vector<Light>& lights,
                              const Medium& medium, const VolumeRenderSettings& settings,
-                             const BlobRenderSettings& blobSettings) {
+                             const BlobRenderSettings& blobSettings, const BlobPixelShader& shade) {
   medium.validate();
   settings.validate();
   blobSettings.validate();
@@ -213,7 +206,7 @@ BlobRenderResult renderBlobs(const BlobSet& blobSet, const Camera& camera, const
   std::vector<long long> pairsPerTile(tileBlobs.size(), 0);
   parallelFor(0, tileBlobs.size(), [&](std::size_t t) {
     const int tx = static_cast<int>(t % tilesX), ty = static_cast<int>(t / tilesX);
-    std::vector<Chord> chords;
+    std::vector<BlobChord> chords;
     std::vector<std::size_t> ins, outs;  // chords by entry and by exit
     std::vector<Vec3> chordSource;       // gamma_k J_k(s) of each chord
     std::vector<double> lightPhase(lights.size());
@@ -240,7 +233,7 @@ BlobRenderResult renderBlobs(const BlobSet& blobSet, const Camera& camera, const
           const double depth = in > 0.0 ? b.mass * closestApproachGaussian(d2, b.width) *
                                                std::erf(h / (std::numbers::sqrt2 * b.width))
                                          : chordIntegral(b.mass, b.width, c, d2, in, out);
-          chords.push_back({in, out, depth / (out - in), k});
+          chords.push_back({in, out, depth, depth / (out - in), k});
         }
         pairsPerTile[t] += static_cast<long long>(chords.size());
         for (std::size_t i = 0; i < chords.size(); ++i) {
@@ -257,7 +250,7 @@ BlobRenderResult renderBlobs(const BlobSet& blobSet, const Camera& camera, const
         insertionSort(outs, [&](std::size_t i) { return chords[i].out; });
 
         Vec3 radiance = Vec3::Zero(), source = Vec3::Zero();
-        double T = 1.0, gamma = 0.0, u = 0.0;
+        double T = 1.0, gamma = 0.0, u = 0.0, opacity = 0.0;
         int active = 0;
         // Merge of the entries and exits (an entry first on a tie: a chord ends after it begins).
         for (std::size_t nextIn = 0, nextOut = 0; nextOut < outs.size();) {
@@ -268,8 +261,9 @@ BlobRenderResult renderBlobs(const BlobSet& blobSet, const Camera& camera, const
           if (active > 0 && len > 0.0 && gamma > 0.0) {
             const double tau = std::exp(-sigmaT * gamma * len);
             radiance += (T * (1.0 - tau) / gamma) * source;  // (1 - tau_j) J_j, J_j = source / gamma
+            opacity += T * (1.0 - tau);
             T *= tau;
-            if (T < kMinTransmittance) break;
+            if (T < kBlobMinTransmittance) break;
           }
           u = eu;
           const double sign = enter ? 1.0 : -1.0;
@@ -282,7 +276,10 @@ BlobRenderResult renderBlobs(const BlobSet& blobSet, const Camera& camera, const
           }
           source = source.cwiseMax(0.0);
         }
-        if (T >= kMinTransmittance) radiance += T * settings.background;
+        if (shade)
+          radiance = shade(px, py, ray, chords, BlobRayIntegral{radiance, opacity});
+        else if (T >= kBlobMinTransmittance)
+          radiance += T * settings.background;
         float* out = result.radiance.pixel(px, py);
         for (int ch = 0; ch < 3; ++ch) out[ch] = static_cast<float>(radiance[ch]);
       }

@@ -13,6 +13,8 @@
 //   g2(d) = exp(-d^2 / (2 sigma^2)) / (2 pi sigma^2)   (the 2D Gaussian of the closest approach).
 // (The seed prints the prefactor as 1/(4 pi sigma^2) times the erf difference, the same thing.)
 // Over the whole line the integral is m_k g2(d_k).
+#include <functional>
+#include <span>
 #include <vector>
 
 #include "msim/core/vec.hpp"
@@ -83,6 +85,29 @@ struct BlobRenderResult {
   BlobRenderStats stats;
 };
 
+// A camera ray's chord through blob k's cut-off sphere, [in, out] along the ray (clipped at the
+// camera), with its exact integral depth = integral_in^out m_k G du (eq. 5.17).
+struct BlobChord {
+  double in = 0.0, out = 0.0;
+  double depth = 0.0;
+  double gamma = 0.0;  // depth / (out - in): the blob's depth per unit length spread over its chord
+  std::size_t blob = 0;
+};
+
+// renderBlobs stops a ray once its transmittance T falls below this and adds no background behind
+// it (as renderVolume: the rest of the ray adds < 1e-4 of J).
+inline constexpr double kBlobMinTransmittance = 1e-4;
+
+// What the ray integration of renderBlobs found along one camera ray (up to where it stopped).
+struct BlobRayIntegral {
+  Vec3 scattered = Vec3::Zero();  // I_d = sum_j T_j (1 - tau_j) J_j, the light the blobs send along the ray
+  double opacity = 0.0;           // sum_j T_j (1 - tau_j) = 1 - T, summed as I_d is
+};
+
+// Radiance of pixel (px, py) from its ray, its chords (in no particular order) and their integral.
+using BlobPixelShader = std::function<Vec3(int px, int py, const Ray& ray, std::span<const BlobChord> chords,
+                                           const BlobRayIntegral& integral)>;
+
 // Renders a blob set with lights, sky light and per-blob emission (Stam's "high quality, level 1",
 // T21: one shooting pass lights -> blobs, then ray integration of T13):
 //  - Shooting (T14): each blob gets the source J_k(s) = Omega [ sum_l E_l T_lk p(s_l . s) / (4 pi)
@@ -112,8 +137,11 @@ struct BlobRenderResult {
 // per ray x log) for the image; tiles of tileSize pixels keep the per-ray lists short.
 // medium.extinction is sigma_t per unit mass density, medium.albedo Omega, medium.phaseG g;
 // settings: background, ambient, exposure, gamma, toneMap (stepCells and surfaceAlbedo are unused).
+//  - shade, when given, makes each pixel's radiance from what the ray integration found (the hook of
+//    renderStochasticBlobs, stochastic_rendering.hpp); left empty, a pixel is I_d + T background
+//    (I_d alone once T < kBlobMinTransmittance).
 BlobRenderResult renderBlobs(const BlobSet& blobs, const Camera& camera, const std::vector<Light>& lights,
                              const Medium& medium, const VolumeRenderSettings& settings,
-                             const BlobRenderSettings& blobSettings = {});
+                             const BlobRenderSettings& blobSettings = {}, const BlobPixelShader& shade = {});
 
 }  // namespace msim::render

@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "msim/core/rng.hpp"
+
 namespace msim::render {
 
 namespace {
@@ -105,6 +107,71 @@ double realisedOpticalDepth(const BlobSet& blobs, const Ray& ray, double a, doub
     }
   }
   return std::max(0.0, gamma);
+}
+
+FourierNoise::FourierNoise(const Correlation& correlation, std::uint64_t seed, int terms) {
+  correlation.validate();
+  if (terms < 1) throw std::invalid_argument("FourierNoise: terms must be >= 1, got " + std::to_string(terms));
+  Rng rng(seed);
+  for (int i = 0; i < terms; ++i) {
+    const Vec3 z(rng.normal(), rng.normal(), rng.normal());
+    double scale = 1.0 / correlation.length;
+    if (correlation.kind == Correlation::Kind::Exponential) {
+      double w = 0.0;
+      while (w == 0.0) w = rng.normal();
+      scale /= std::abs(w);
+    }
+    wavevectors_.push_back(scale * z);
+    phases_.push_back(rng.uniform(0.0, 2.0 * std::numbers::pi));
+  }
+  amplitude_ = std::sqrt(2.0 / terms);
+}
+
+double FourierNoise::operator()(const Vec3& x) const {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < phases_.size(); ++i) sum += std::cos(wavevectors_[i].dot(x) + phases_[i]);
+  return amplitude_ * sum;
+}
+
+void StochasticRenderSettings::validate() const {
+  parameters.validate();
+  if (noiseTerms < 1) throw std::invalid_argument("stochastic rendering: noiseTerms must be >= 1, got " + std::to_string(noiseTerms));
+}
+
+BlobRenderResult renderStochasticBlobs(const BlobSet& blobs, const Camera& camera, const std::vector<Light>& lights,
+                                       const Medium& medium, const VolumeRenderSettings& settings,
+                                       const StochasticRenderSettings& stochastic,
+                                       const BlobRenderSettings& blobSettings) {
+  stochastic.validate();
+  const FourierNoise q(stochastic.parameters.correlation, stochastic.seed, stochastic.noiseTerms);
+  const double scale = stochastic.parameters.epsilon * stochastic.parameters.correlation.integralLength();
+  const double eta = stochastic.parameters.eta, sigmaT = medium.extinction;
+  const bool realisation = stochastic.image == StochasticImage::Realisation;
+  const BlobPixelShader shade = [&](int, int, const Ray& ray, std::span<const BlobChord> chords,
+                                    const BlobRayIntegral& integral) -> Vec3 {
+    double mean = 0.0, delta = 0.0, variance = 0.0;
+    for (const BlobChord& chord : chords) {
+      mean += chord.depth;
+      if (!(scale > 0.0)) continue;
+      const Blob& blob = blobs.blobs()[chord.blob];
+      const double v = scale * clampedBlobLineIntegral(blob, ray, chord.in, chord.out, eta);  // eq. 5.29
+      if (realisation) {
+        const double closest = std::clamp((blob.centre - ray.origin).dot(ray.direction), chord.in, chord.out);
+        delta += std::sqrt(v) * q(ray.origin + closest * ray.direction);  // eq. 5.30
+      } else {
+        variance += v;
+      }
+    }
+    // T of the mean density over the whole ray (renderBlobs' sweep gives the same up to round-off
+    // but stops at T < 1e-4); delta = 0 gives tau = T exactly.
+    const double T = std::exp(-sigmaT * mean);
+    const double tau = realisation ? std::exp(-sigmaT * std::max(0.0, mean + delta))
+                                   : std::min(1.0, T * std::exp(0.5 * sigmaT * sigmaT * variance));
+    const Vec3 averageSource = integral.opacity > 0.0 ? Vec3(integral.scattered / integral.opacity) : Vec3::Zero();
+    const Vec3 background = tau >= kBlobMinTransmittance ? settings.background : Vec3::Zero();  // as renderBlobs
+    return integral.scattered + tau * background + (T - tau) * averageSource;
+  };
+  return renderBlobs(blobs, camera, lights, medium, settings, blobSettings, shade);
 }
 
 }  // namespace msim::render

@@ -26,8 +26,10 @@
 //  - One realisation (eq. 5.30): Gamma_omega = sum_k (Gamma_bar_k + sigma_Gamma,k Q_omega(x_ck)),
 //    x_ck the ray's point closest to blob k, so a static scene looks the same from frame to frame;
 //    clamped at 0 (the seed's required safeguard: a density is not negative).
+#include <cstdint>
 #include <functional>
 #include <limits>
+#include <vector>
 
 #include "msim/render/blobs.hpp"
 
@@ -80,5 +82,60 @@ OpticalDepthStatistics blobRayStatistics(const BlobSet& blobs, const Ray& ray, d
 // table, T16), clamped at 0.
 double realisedOpticalDepth(const BlobSet& blobs, const Ray& ray, double a, double b,
                             const StochasticBlobParameters& parameters, const std::function<double(const Vec3&)>& q);
+
+// A deterministic smooth realisation of Q (unit variance, correlation c) for eq. 5.30: random
+// Fourier features q(x) = sqrt(2 / N) sum_i cos(k_i . x + phi_i), phi_i uniform in [0, 2 pi), k_i
+// drawn from the spectral density of c (Bochner: E[cos(k . r)] = c(r)), N(0, I / l^2) for the
+// Gaussian and the 3D Cauchy z / (l |w|) (z ~ N(0, I), w ~ N(0, 1)) for the exponential. Over
+// seeds, q(x) has mean 0, variance 1 and correlation c exactly, and is near-Gaussian (a sum of N
+// independent terms); one seed gives a smooth field that, unlike Stam's periodic 32^3 table
+// (T16), does not repeat. std::invalid_argument for a bad correlation or terms < 1.
+class FourierNoise {
+ public:
+  FourierNoise(const Correlation& correlation, std::uint64_t seed, int terms = 128);
+  double operator()(const Vec3& x) const;
+
+ private:
+  std::vector<Vec3> wavevectors_;
+  std::vector<double> phases_;
+  double amplitude_;
+};
+
+// What renderStochasticBlobs draws.
+enum class StochasticImage {
+  Realisation,  // one realisation of the density (eq. 5.30): the wispy detail
+  Expected,     // the average picture over all realisations (log-normal mean transparency)
+};
+
+struct StochasticRenderSettings {
+  StochasticBlobParameters parameters;
+  StochasticImage image = StochasticImage::Realisation;
+  std::uint64_t seed = 1;  // of the FourierNoise q (Realisation only)
+  int noiseTerms = 128;
+
+  void validate() const;  // parameters.validate(), std::invalid_argument for noiseTerms < 1
+};
+
+// Stochastic rendering of the blob set (T16's per-ray algorithm) on top of renderBlobs: each camera
+// ray keeps renderBlobs' mean-density integration - the scattered light I_d and its opacity 1 - T,
+// T = exp(-sigma_t Gamma_bar), Gamma_bar the sum of the chords' exact integrals - and with the
+// average source J_avg = I_d / (1 - T) (the opacity-weighted mean of the blobs' J along the ray;
+// T16 takes the source to depend only on the mean density, smoothed by the ray average and by
+// scattering) the pixel is
+//   I = tau B + (1 - tau) J_avg = I_d + tau B + (T - tau) J_avg,
+// B the background (0 where tau < kBlobMinTransmittance, as renderBlobs). tau is
+//  - Realisation: exp(-sigma_t max(0, Gamma_bar + delta)), delta = sum_k sigma_Gamma,k q(x_ck) over
+//    the ray's chords (eq. 5.30; sigma_Gamma,k^2 = epsilon l_c integral F_eta over the chord, eq.
+//    5.29), q = FourierNoise(seed): a fixed seed gives the same image every frame;
+//  - Expected: min(1, T exp(sigma_t^2 V / 2)), V = sum_k sigma_Gamma,k^2 (independent blobs, as
+//    blobRayStatistics): E[exp(-sigma_t Gamma)] for Gaussian Gamma, clamped at 1 because the
+//    realisations' Gamma is clamped at 0. I is linear in tau, so with J_avg fixed this is exactly
+//    the mean of the realisations' pictures.
+// With epsilon = 0 both are renderBlobs' image. Cost: renderBlobs plus one clamped line integral
+// (eq. 5.17 twice) and one q (N cosines) per chord.
+BlobRenderResult renderStochasticBlobs(const BlobSet& blobs, const Camera& camera, const std::vector<Light>& lights,
+                                       const Medium& medium, const VolumeRenderSettings& settings,
+                                       const StochasticRenderSettings& stochastic,
+                                       const BlobRenderSettings& blobSettings = {});
 
 }  // namespace msim::render
