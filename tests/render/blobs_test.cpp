@@ -13,12 +13,14 @@
 #include <numbers>
 
 #include "expect_invalid.hpp"
+#include "pixel.hpp"
 #include "msim/core/grid.hpp"
 #include "msim/core/rng.hpp"
 #include "msim/render/blobs.hpp"
 
 using namespace msim;
 using namespace msim::render;
+using msim::render::test::pixel;
 
 namespace {
 
@@ -46,11 +48,6 @@ Camera view(int size, const Vec3& position = Vec3(0.0, 0.0, 5.0)) {
   c.target = Vec3::Zero();
   c.width = c.height = size;  // odd: the middle pixel's ray passes through the target
   return c;
-}
-
-Vec3 pixel(const FloatImage& image, int x, int y) {
-  const float* p = image.pixel(x, y);
-  return Vec3(p[0], p[1], p[2]);
 }
 
 }  // namespace

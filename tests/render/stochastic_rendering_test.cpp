@@ -14,12 +14,14 @@
 #include <numbers>
 
 #include "expect_invalid.hpp"
+#include "pixel.hpp"
 #include "msim/core/rng.hpp"
 #include "msim/render/camera.hpp"
 #include "msim/render/stochastic_rendering.hpp"
 
 using namespace msim;
 using namespace msim::render;
+using msim::render::test::pixel;
 
 namespace {
 
@@ -219,11 +221,6 @@ StochasticRenderSettings turbulent(StochasticImage image, std::uint64_t seed) {
   s.image = image;
   s.seed = seed;
   return s;
-}
-
-Vec3 pixel(const FloatImage& image, int x, int y) {
-  const float* p = image.pixel(x, y);
-  return Vec3(p[0], p[1], p[2]);
 }
 
 }  // namespace

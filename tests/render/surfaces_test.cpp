@@ -13,11 +13,13 @@
 #include <numbers>
 
 #include "expect_invalid.hpp"
+#include "pixel.hpp"
 #include "msim/render/frame_renderer.hpp"
 #include "msim/render/volume_renderer.hpp"
 
 using namespace msim;
 using namespace msim::render;
+using msim::render::test::pixel;
 
 namespace {
 
@@ -80,11 +82,6 @@ VolumeRenderSettings surfaceSettings() {
   s.ambient = kSky;
   s.surfaceAlbedo = kAlbedo;
   return s;
-}
-
-Vec3 pixel(const FloatImage& image, int x, int y) {
-  const float* p = image.pixel(x, y);
-  return Vec3(p[0], p[1], p[2]);
 }
 
 // Where the pixel's ray meets the exact sphere: unit normal, and the ray direction.

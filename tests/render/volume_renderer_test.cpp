@@ -10,12 +10,14 @@
 #include <numbers>
 
 #include "expect_invalid.hpp"
+#include "pixel.hpp"
 #include "msim/render/blackbody.hpp"
 #include "msim/render/phase_function.hpp"
 #include "msim/render/volume_renderer.hpp"
 
 using namespace msim;
 using namespace msim::render;
+using msim::render::test::pixel;
 
 namespace {
 
@@ -43,11 +45,6 @@ Camera pinhole(const Vec3& position, const Vec3& target) {
   c.up = std::abs((target - position).normalized().y()) > 0.9 ? Vec3::UnitX() : Vec3::UnitY();
   c.width = c.height = 1;
   return c;
-}
-
-Vec3 pixel(const FloatImage& image, int x, int y) {
-  const float* p = image.pixel(x, y);
-  return Vec3(p[0], p[1], p[2]);
 }
 
 // 32 x 40 x 32 cells of 5 cm, density rho0 in the layers 10 <= j < 30 (a slab 1 m thick).
