@@ -1,0 +1,111 @@
+#pragma once
+// Bound-constrained convex QP
+//
+//   minimise  f(p) = 1/2 p^T A p - b^T p   subject to  p >= 0,   A symmetric positive definite,
+//
+// which is the LCP  p >= 0,  A p - b >= 0,  p^T (A p - b) = 0  of Narain (2011) eqs. 4.15-4.19
+// (unilateral incompressibility of crowds, ch. 4.4; the same structure appears for granular
+// media, ch. 5). Solved by MPRGP, Modified Proportioning with Reduced Gradient Projections
+// (Dostál & Schöberl, Comput. Optim. Appl. 30(1):23-43, 2005), as Narain ch. 4.4 recommends:
+// conjugate-gradient steps on the current free set, expansion steps of fixed length alpha_bar
+// along the free gradient followed by projection onto p >= 0, and proportioning steps that
+// release constraints when the chopped gradient dominates. A is only ever applied (matrix-free),
+// so the crowd and granular modules can pass their own Poisson-like stencils.
+// See docs/bound_qp.md for parameters and validation numbers.
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <cstdint>
+#include <vector>
+
+namespace msim::numerics {
+
+// A symmetric positive definite operator, given by its action.
+class QpOperator {
+ public:
+  virtual ~QpOperator() = default;
+  virtual Eigen::Index size() const = 0;
+  // y = A x. x and y have size() entries and are distinct objects.
+  virtual void apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const = 0;
+  // d = diag(A) (used by Jacobi preconditioning; must be positive).
+  virtual void diagonal(Eigen::VectorXd& d) const = 0;
+  // An upper bound of ||A||_2, e.g. the Gershgorin bound max_i sum_j |a_ij|. The expansion step
+  // length must lie in (0, 2/||A||] for the cost to decrease (Dostál & Schöberl 2005).
+  virtual double normUpperBound() const = 0;
+};
+
+// Adapter for an assembled symmetric matrix. Keeps a reference: the matrix must outlive it.
+class SparseQpOperator final : public QpOperator {
+ public:
+  // Throws std::invalid_argument unless A is square.
+  explicit SparseQpOperator(const Eigen::SparseMatrix<double>& A);
+  Eigen::Index size() const override { return A_.rows(); }
+  void apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const override;
+  void diagonal(Eigen::VectorXd& d) const override { d = diagonal_; }
+  double normUpperBound() const override { return normBound_; }
+
+ private:
+  const Eigen::SparseMatrix<double>& A_;
+  Eigen::VectorXd diagonal_;
+  double normBound_ = 0.0;  // max absolute row sum (Gershgorin)
+};
+
+// Preconditioning "in face" (Dostál, Optimal Quadratic Programming Algorithms, Springer 2009):
+// the CG steps on the free set F use z_F = M_FF^{-1} g_F with M_FF a preconditioner of the
+// reduced matrix A_FF, and z = 0 on the active set. The solver announces every new face before
+// applying; implementations that factor A_FF (e.g. MIC(0) of the free cells) refactor there.
+class QpFacePreconditioner {
+ public:
+  virtual ~QpFacePreconditioner() = default;
+  // free[i] != 0 exactly where p_i > 0; stays valid until the next setFace() call.
+  virtual void setFace(const std::vector<std::uint8_t>& free) = 0;
+  // z_F = M_FF^{-1} g_F, z = 0 off the face. g and z are distinct, of size n.
+  virtual void apply(const Eigen::VectorXd& g, Eigen::VectorXd& z) = 0;
+};
+
+// Preconditioner used when solve() is given no QpFacePreconditioner.
+enum class BoundQpPreconditioning { None, Jacobi };
+
+struct BoundQpSettings {
+  double tolerance = 1e-8;   // stop when ||g^P(p)||_2 <= tolerance * ||b||_2
+  int maxIterations = 10000;  // CG + expansion + proportioning steps
+  // Proportioning parameter Gamma > 0: a proportioning step is taken when
+  // ||beta||^2 > Gamma^2 phi~^T phi (Dostál & Schöberl 2005); phi~ is the reduced free gradient.
+  double gamma = 1.0;
+  // Expansion step length; 0 means alphaBarFactor / A.normUpperBound(). Must be in (0, 2/||A||].
+  double alphaBar = 0.0;
+  double alphaBarFactor = 1.9;
+  BoundQpPreconditioning preconditioning = BoundQpPreconditioning::Jacobi;
+};
+
+struct BoundQpResult {
+  int iterations = 0;  // = cgSteps + expansionSteps + proportioningSteps
+  int cgSteps = 0;
+  int expansionSteps = 0;
+  int proportioningSteps = 0;
+  int operatorApplications = 0;         // products with A, including the initial gradient
+  double projectedGradientNorm = 0.0;   // ||g^P(p)||_2 at exit
+  double relativeProjectedGradient = 0.0;  // projectedGradientNorm / ||b||_2 (0 when b = 0)
+  int activeCount = 0;                  // entries with p_i = 0 at exit
+  bool converged = false;
+};
+
+class BoundQpSolver {
+ public:
+  // Minimises 1/2 p^T A p - b^T p over p >= 0, warm-started from p (first projected onto p >= 0).
+  // The projected gradient g^P (Dostál & Schöberl 2005) is g_i on the free set and
+  // min(g_i, 0) on the active set, g = A p - b; it vanishes exactly at the KKT point.
+  // Throws std::invalid_argument for mismatched sizes or invalid settings. Work vectors are kept
+  // between solves, so repeated solves of one size do not allocate.
+  BoundQpResult solve(const QpOperator& A, const Eigen::VectorXd& b, Eigen::VectorXd& p,
+                      const BoundQpSettings& settings = {}, QpFacePreconditioner* preconditioner = nullptr);
+
+ private:
+  void setFace(const Eigen::VectorXd& p, QpFacePreconditioner* preconditioner);
+  void precondition(QpFacePreconditioner* preconditioner);  // z_ from g_ on the current face
+
+  bool jacobi_ = false;  // built-in Jacobi (no preconditioner passed, Jacobi requested)
+  std::vector<std::uint8_t> free_;
+  Eigen::VectorXd g_, z_, d_, Ad_, invDiagonal_;
+};
+
+}  // namespace msim::numerics
