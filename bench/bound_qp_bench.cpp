@@ -1,15 +1,19 @@
 // MPRGP on a 256^2 unilateral-pressure LCP (Narain eqs. 4.15-4.19): A = 5-point Laplacian with
 // p = 0 outside the box, b = a random divergence in [-1, 1], relative projected gradient 1e-6.
 // Cases: matrix-free stencil and assembled sparse matrix, both cold (p = 0), and a warm start
-// from the previous solution with b perturbed by 1% (as between time steps).
-// Counters: iterations, CG/expansion/proportioning steps, active fraction at the solution.
+// from the previous solution with b perturbed by 1% (as between time steps); the same Laplacian as
+// a GridPoissonQpOperator, cold, with Jacobi and with MIC(0)-in-face preconditioning.
+// Counters: iterations, CG/expansion/proportioning steps, active fraction at the solution, and
+// MIC(0) factorisations (one per distinct face).
 #include <benchmark/benchmark.h>
 
 #include <Eigen/SparseCore>
+#include <array>
 #include <vector>
 
 #include "msim/core/rng.hpp"
 #include "msim/numerics/bound_qp.hpp"
+#include "msim/numerics/bound_qp_mic0.hpp"
 
 using namespace msim;
 using namespace msim::numerics;
@@ -93,6 +97,33 @@ void BM_ColdSolve(benchmark::State& state, bool matrixFree) {
   report(state, r, A.size());
 }
 
+// Unit face weights (the boundary faces included), so A is the Laplacian of Laplacian2d.
+void BM_ColdSolveGrid(benchmark::State& state, bool mic0) {
+  const std::size_t n = std::size_t{kRes} * kRes;
+  const IVec<2> res(kRes, kRes);
+  const std::array<std::vector<double>, 2> lower{std::vector<double>(n, 1.0), std::vector<double>(n, 1.0)};
+  const std::vector<double> diagonal(n, 4.0);
+  const GridPoissonQpOperator<2> A(res, lower, diagonal);
+  GridMic0FacePreconditioner<2> preconditioner(res, lower, diagonal);
+  Rng rng(1);
+  const Eigen::VectorXd b = randomDivergence(A.size(), rng);
+  BoundQpSettings settings;
+  settings.tolerance = 1e-6;
+  BoundQpSolver solver;
+  Eigen::VectorXd p(A.size());
+  BoundQpResult r;
+  int factorizations = 0;
+  for (auto _ : state) {
+    p.setZero();
+    const int before = preconditioner.factorizations();
+    r = solver.solve(A, b, p, settings, mic0 ? &preconditioner : nullptr);
+    factorizations = preconditioner.factorizations() - before;
+    benchmark::DoNotOptimize(p.data());
+  }
+  report(state, r, A.size());
+  if (mic0) state.counters["factorizations"] = factorizations;
+}
+
 void BM_WarmSolve(benchmark::State& state) {
   const Laplacian2d A(kRes);
   Rng rng(1);
@@ -118,4 +149,6 @@ void BM_WarmSolve(benchmark::State& state) {
 
 BENCHMARK_CAPTURE(BM_ColdSolve, matrix_free_256, true)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ColdSolve, sparse_256, false)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ColdSolveGrid, grid_jacobi_256, false)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ColdSolveGrid, grid_mic0_256, true)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_WarmSolve)->Name("BM_WarmSolve/matrix_free_256_b_drift_1pct")->Unit(benchmark::kMillisecond)->UseRealTime();
