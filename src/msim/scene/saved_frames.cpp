@@ -103,12 +103,15 @@ std::vector<fs::path> renderSavedFrames(const RenderJob& job) {
   std::vector<fs::path> frames;
   fs::path outDir;
   RenderKeys keys;
+  double fps = 24.0;
   const std::string source = job.input.string();
   if (fs::is_directory(job.input)) {
     const fs::path runFile = job.input / "run.json";
     if (!fs::exists(runFile))
       throw InputError(source + ": not a run folder (no run.json); give a folder written by 'msim run' or a .vdb file");
     const nlohmann::json run = loadJsonFile(runFile);
+    // Frames are 1/fps apart in the run; without it in run.json the movie plays at 24 fps.
+    fps = run.value("fps", fps);
     const nlohmann::json params = run.value("parameters", nlohmann::json::object());
     // Mesh and point files are named relative to the scene file, as in the scene itself.
     const fs::path sceneFile = run.value("scene_file", std::string());
@@ -144,10 +147,6 @@ std::vector<fs::path> renderSavedFrames(const RenderJob& job) {
   }
   if (job.showProgress) progress.finish();
   if (!outDir.empty() && written.size() > 1) {
-    // Frames are 1/fps apart in the run; without it in run.json the movie plays at 24 fps.
-    double fps = 24.0;
-    const nlohmann::json run = loadJsonFile(job.input / "run.json");
-    if (run.contains("fps")) fps = run.at("fps").get<double>();
     const io::VideoResult video = io::encodeMp4(written, fps, outDir / "render.mp4");
     if (!video.written) logger().warn("{}", video.note);
   }
