@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -52,3 +53,21 @@ inline bool noFramesIn(const fs::path& out) {
   return true;
 }
 
+
+// `text` with the first occurrence of `from` replaced by `to` (a test failure if absent).
+inline std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
+// Runs `scene` and expects exit code 2 (bad input), every needle in the output, and no files.
+inline void expectInputError(const std::string& name, const std::string& scene, const std::vector<std::string>& needles) {
+  const fs::path dir = scratch(name);
+  writeText(dir / "s.json", scene);
+  const Result r = runMsim("run " + (dir / "s.json").string() + " -q --out " + (dir / "out").string());
+  EXPECT_EQ(r.exitCode, 2) << r.output;
+  for (const auto& n : needles) EXPECT_NE(r.output.find(n), std::string::npos) << n << "\n" << r.output;
+  EXPECT_TRUE(noFramesIn(dir / "out"));
+}

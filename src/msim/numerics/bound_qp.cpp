@@ -1,10 +1,13 @@
 #include "msim/numerics/bound_qp.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
+
+#include <tbb/parallel_for.h>
 
 namespace msim::numerics {
 
@@ -23,8 +26,52 @@ SparseQpOperator::SparseQpOperator(const Eigen::SparseMatrix<double>& A) : A_(A)
 
 void SparseQpOperator::apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const { y.noalias() = A_ * x; }
 
+namespace {
+
+// Vector loops of MPRGP: fixed blocks of kBlock entries, run in parallel when n >= kParallelMin.
+// Reductions keep one partial per block and combine them in block order, so every sum is the same
+// whatever the thread count (and whether the loop ran in parallel or not).
+constexpr Eigen::Index kBlock = 4096;
+constexpr Eigen::Index kParallelMin = 3 * kBlock;
+
+Eigen::Index blockCount(Eigen::Index n) { return (n + kBlock - 1) / kBlock; }
+
+// f(begin, end) over the blocks of [0, n).
+template <typename F>
+void forBlocks(Eigen::Index n, const F& f) {
+  const Eigen::Index blocks = blockCount(n);
+  if (n >= kParallelMin)
+    tbb::parallel_for(Eigen::Index(0), blocks, [&](Eigen::Index b) { f(b * kBlock, std::min(n, (b + 1) * kBlock)); });
+  else
+    for (Eigen::Index b = 0; b < blocks; ++b) f(b * kBlock, std::min(n, (b + 1) * kBlock));
+}
+
+// K reductions in one pass: f(begin, end, acc) adds into acc[0..K) (acc starts at init); the
+// partials are combined in block order with combine(k, total, partial).
+template <int K, typename F, typename Combine>
+std::array<double, K> reduceBlocks(Eigen::Index n, std::vector<double>& partial, const std::array<double, K>& init,
+                                   const F& f, const Combine& combine) {
+  const Eigen::Index blocks = blockCount(n);
+  partial.resize(static_cast<std::size_t>(blocks * K));
+  forBlocks(n, [&](Eigen::Index begin, Eigen::Index end) {
+    std::array<double, K> acc = init;
+    f(begin, end, acc);
+    std::copy(acc.begin(), acc.end(), partial.begin() + (begin / kBlock) * K);
+  });
+  std::array<double, K> total = init;
+  for (Eigen::Index b = 0; b < blocks; ++b)
+    for (int k = 0; k < K; ++k) total[k] = combine(k, total[k], partial[static_cast<std::size_t>(b * K + k)]);
+  return total;
+}
+
+constexpr auto kAdd = [](int, double a, double b) { return a + b; };
+
+}  // namespace
+
 void BoundQpSolver::setFace(const Eigen::VectorXd& p, QpFacePreconditioner* preconditioner) {
-  for (Eigen::Index i = 0; i < p.size(); ++i) free_[i] = p[i] > 0.0 ? 1 : 0;
+  forBlocks(p.size(), [&](Eigen::Index begin, Eigen::Index end) {
+    for (Eigen::Index i = begin; i < end; ++i) free_[i] = p[i] > 0.0 ? 1 : 0;
+  });
   if (preconditioner) preconditioner->setFace(free_);
 }
 
@@ -34,8 +81,17 @@ void BoundQpSolver::precondition(QpFacePreconditioner* preconditioner) {
     return;
   }
   // For a diagonal M, M_FF^{-1} = (M^{-1})_FF: Jacobi needs no refactoring when the face changes.
-  for (Eigen::Index i = 0; i < g_.size(); ++i)
-    z_[i] = free_[i] ? (jacobi_ ? g_[i] * invDiagonal_[i] : g_[i]) : 0.0;
+  forBlocks(g_.size(), [&](Eigen::Index begin, Eigen::Index end) {
+    for (Eigen::Index i = begin; i < end; ++i) z_[i] = free_[i] ? (jacobi_ ? g_[i] * invDiagonal_[i] : g_[i]) : 0.0;
+  });
+}
+
+double BoundQpSolver::dot(const Eigen::VectorXd& x, const Eigen::VectorXd& y) {
+  return reduceBlocks<1>(x.size(), partial_, {0.0}, [&](Eigen::Index begin, Eigen::Index end, auto& acc) {
+    double s = 0.0;
+    for (Eigen::Index i = begin; i < end; ++i) s += x[i] * y[i];
+    acc[0] = s;
+  }, kAdd)[0];
 }
 
 BoundQpResult BoundQpSolver::solve(const QpOperator& A, const Eigen::VectorXd& b, Eigen::VectorXd& p,
@@ -50,7 +106,7 @@ BoundQpResult BoundQpSolver::solve(const QpOperator& A, const Eigen::VectorXd& b
                                 "maxIterations >= 0, alphaBar >= 0, 0 < alphaBarFactor <= 2)");
 
   BoundQpResult result;
-  const double bNorm = b.norm();
+  const double bNorm = std::sqrt(dot(b, b));
   if (bNorm == 0.0) {
     // A is positive definite, so f(p) >= 0 = f(0) on p >= 0: the solution is p = 0 exactly.
     p.setZero();
@@ -78,10 +134,15 @@ BoundQpResult BoundQpSolver::solve(const QpOperator& A, const Eigen::VectorXd& b
     invDiagonal_ = invDiagonal_.cwiseInverse();
   }
 
-  p = p.cwiseMax(0.0);  // warm start projected onto the feasible set
+  // Warm start projected onto the feasible set.
+  forBlocks(n, [&](Eigen::Index begin, Eigen::Index end) {
+    for (Eigen::Index i = begin; i < end; ++i) p[i] = std::max(p[i], 0.0);
+  });
   auto updateGradient = [&] {
     A.apply(p, g_);
-    g_ -= b;
+    forBlocks(n, [&](Eigen::Index begin, Eigen::Index end) {
+      for (Eigen::Index i = begin; i < end; ++i) g_[i] -= b[i];
+    });
     ++result.operatorApplications;
   };
   // After a step that may change the free set, restart CG from the new preconditioned free
@@ -89,7 +150,9 @@ BoundQpResult BoundQpSolver::solve(const QpOperator& A, const Eigen::VectorXd& b
   auto restart = [&] {
     setFace(p, preconditioner);
     precondition(preconditioner);
-    d_ = z_;
+    forBlocks(n, [&](Eigen::Index begin, Eigen::Index end) {
+      for (Eigen::Index i = begin; i < end; ++i) d_[i] = z_[i];
+    });
   };
   updateGradient();
   restart();
@@ -98,16 +161,21 @@ BoundQpResult BoundQpSolver::solve(const QpOperator& A, const Eigen::VectorXd& b
     // Free gradient phi (g on F), chopped gradient beta (min(g, 0) off F), and the reduced free
     // gradient phi~_i = min(p_i / alphaBar, phi_i), whose product with phi measures how far a
     // fixed-length projected step along phi can go before it is cut by the bound.
-    double phi2 = 0.0, beta2 = 0.0, reducedPhi = 0.0;
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const double gi = g_[i];
-      if (free_[i]) {
-        phi2 += gi * gi;
-        reducedPhi += std::min(p[i] / alphaBar, gi) * gi;
-      } else if (gi < 0.0) {
-        beta2 += gi * gi;
+    const auto sums = reduceBlocks<3>(n, partial_, {0.0, 0.0, 0.0},
+                                      [&](Eigen::Index begin, Eigen::Index end, auto& acc) {
+      double phi2 = 0.0, beta2 = 0.0, reduced = 0.0;
+      for (Eigen::Index i = begin; i < end; ++i) {
+        const double gi = g_[i];
+        if (free_[i]) {
+          phi2 += gi * gi;
+          reduced += std::min(p[i] / alphaBar, gi) * gi;
+        } else if (gi < 0.0) {
+          beta2 += gi * gi;
+        }
       }
-    }
+      acc = {phi2, beta2, reduced};
+    }, kAdd);
+    const double phi2 = sums[0], beta2 = sums[1], reducedPhi = sums[2];
     result.projectedGradientNorm = std::sqrt(phi2 + beta2);
     if (result.projectedGradientNorm <= threshold) {
       result.converged = true;
@@ -120,29 +188,48 @@ BoundQpResult BoundQpSolver::solve(const QpOperator& A, const Eigen::VectorXd& b
       // Proportional iterate: a CG step on the face, unless it would leave p >= 0.
       A.apply(d_, Ad_);
       ++result.operatorApplications;
-      const double dAd = d_.dot(Ad_);
-      const double alphaCg = g_.dot(d_) / dAd;  // exact line search; d is zero off the face
-      double alphaFeasible = std::numeric_limits<double>::infinity();
-      for (Eigen::Index i = 0; i < n; ++i)
-        if (d_[i] > 0.0) alphaFeasible = std::min(alphaFeasible, p[i] / d_[i]);
+      constexpr double inf = std::numeric_limits<double>::infinity();
+      const auto step = reduceBlocks<3>(n, partial_, {0.0, 0.0, inf},
+                                        [&](Eigen::Index begin, Eigen::Index end, auto& acc) {
+        double dAd = 0.0, gd = 0.0, feasible = inf;
+        for (Eigen::Index i = begin; i < end; ++i) {
+          const double di = d_[i];
+          dAd += di * Ad_[i];
+          gd += g_[i] * di;
+          if (di > 0.0) feasible = std::min(feasible, p[i] / di);
+        }
+        acc = {dAd, gd, feasible};
+      }, [](int k, double a, double v) { return k == 2 ? std::min(a, v) : a + v; });
+      const double dAd = step[0];
+      const double alphaCg = step[1] / dAd;  // exact line search; d is zero off the face
+      const double alphaFeasible = step[2];
 
       if (alphaCg <= alphaFeasible) {
         // The clamp only removes round-off when alphaCg is within an ulp of alphaFeasible.
-        for (Eigen::Index i = 0; i < n; ++i) p[i] = std::max(p[i] - alphaCg * d_[i], 0.0);
-        g_ -= alphaCg * Ad_;
+        forBlocks(n, [&](Eigen::Index begin, Eigen::Index end) {
+          for (Eigen::Index i = begin; i < end; ++i) {
+            p[i] = std::max(p[i] - alphaCg * d_[i], 0.0);
+            g_[i] -= alphaCg * Ad_[i];
+          }
+        });
         precondition(preconditioner);
         // Next direction A-conjugate to the previous one (Dostál & Schöberl 2005, CG step).
-        const double conj = z_.dot(Ad_) / dAd;
-        d_ = z_ - conj * d_;
+        const double conj = dot(z_, Ad_) / dAd;
+        forBlocks(n, [&](Eigen::Index begin, Eigen::Index end) {
+          for (Eigen::Index i = begin; i < end; ++i) d_[i] = z_[i] - conj * d_[i];
+        });
         ++result.cgSteps;
       } else {
         // Expansion: the largest feasible step along d, then a fixed-length step alphaBar along
         // the free gradient at that point, projected onto p >= 0. With alphaBar <= 2/||A|| this
         // decreases f and may add several constraints at once (unlike active-set CG).
-        p -= alphaFeasible * d_;
-        g_ -= alphaFeasible * Ad_;
-        for (Eigen::Index i = 0; i < n; ++i)
-          p[i] = p[i] > 0.0 ? std::max(p[i] - alphaBar * g_[i], 0.0) : 0.0;
+        forBlocks(n, [&](Eigen::Index begin, Eigen::Index end) {
+          for (Eigen::Index i = begin; i < end; ++i) {
+            const double pi = p[i] - alphaFeasible * d_[i];
+            const double gi = g_[i] - alphaFeasible * Ad_[i];
+            p[i] = pi > 0.0 ? std::max(pi - alphaBar * gi, 0.0) : 0.0;
+          }
+        });
         updateGradient();
         restart();
         ++result.expansionSteps;
@@ -150,19 +237,28 @@ BoundQpResult BoundQpSolver::solve(const QpOperator& A, const Eigen::VectorXd& b
     } else {
       // Proportioning: the chopped gradient dominates, so the active set is wrong; an exact line
       // search along -beta releases the constraints whose multipliers are negative.
-      for (Eigen::Index i = 0; i < n; ++i) d_[i] = !free_[i] && g_[i] < 0.0 ? g_[i] : 0.0;
+      forBlocks(n, [&](Eigen::Index begin, Eigen::Index end) {
+        for (Eigen::Index i = begin; i < end; ++i) d_[i] = !free_[i] && g_[i] < 0.0 ? g_[i] : 0.0;
+      });
       A.apply(d_, Ad_);
       ++result.operatorApplications;
-      const double alpha = beta2 / d_.dot(Ad_);  // g^T beta = beta^T beta
-      p -= alpha * d_;
-      g_ -= alpha * Ad_;
+      const double alpha = beta2 / dot(d_, Ad_);  // g^T beta = beta^T beta
+      forBlocks(n, [&](Eigen::Index begin, Eigen::Index end) {
+        for (Eigen::Index i = begin; i < end; ++i) {
+          p[i] -= alpha * d_[i];
+          g_[i] -= alpha * Ad_[i];
+        }
+      });
       restart();
       ++result.proportioningSteps;
     }
   }
 
   result.relativeProjectedGradient = result.projectedGradientNorm / bNorm;
-  result.activeCount = static_cast<int>((p.array() == 0.0).count());
+  result.activeCount = static_cast<int>(reduceBlocks<1>(n, partial_, {0.0},
+                                                        [&](Eigen::Index begin, Eigen::Index end, auto& acc) {
+    for (Eigen::Index i = begin; i < end; ++i) acc[0] += p[i] == 0.0 ? 1.0 : 0.0;
+  }, kAdd)[0]);
   return result;
 }
 

@@ -102,10 +102,12 @@ class BoundQpSolver {
  private:
   void setFace(const Eigen::VectorXd& p, QpFacePreconditioner* preconditioner);
   void precondition(QpFacePreconditioner* preconditioner);  // z_ from g_ on the current face
+  double dot(const Eigen::VectorXd& x, const Eigen::VectorXd& y);  // blocked, deterministic
 
   bool jacobi_ = false;  // built-in Jacobi (no preconditioner passed, Jacobi requested)
   std::vector<std::uint8_t> free_;
   Eigen::VectorXd g_, z_, d_, Ad_, invDiagonal_;
+  std::vector<double> partial_;  // per-block partial sums of the vector loops
 };
 
 }  // namespace msim::numerics

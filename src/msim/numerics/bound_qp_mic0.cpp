@@ -6,6 +6,10 @@
 #include <string>
 #include <utility>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
 namespace msim::numerics {
 
 namespace {
@@ -30,10 +34,20 @@ std::array<std::size_t, D> checkStencil(const char* who, const IVec<D>& res,
       throw std::invalid_argument(std::string(who) + ": lower weights of axis " + std::to_string(a) + " have " +
                                   std::to_string(lower[a].size()) + " entries, grid has " + std::to_string(n) +
                                   " cells");
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!(diagonal[i] > 0.0)) throw std::invalid_argument(std::string(who) + ": diagonal must be > 0");
-    for (int a = 0; a < D; ++a)
-      if (!(lower[a][i] >= 0.0)) throw std::invalid_argument(std::string(who) + ": face weights must be >= 0");
+  const bool ok = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, n, 1 << 14), true,
+      [&](const tbb::blocked_range<std::size_t>& r, bool good) {
+        for (std::size_t i = r.begin(); i != r.end() && good; ++i) {
+          good = diagonal[i] > 0.0;
+          for (int a = 0; a < D; ++a) good = good && lower[a][i] >= 0.0;
+        }
+        return good;
+      },
+      [](bool a, bool b) { return a && b; });
+  if (!ok) {
+    for (std::size_t i = 0; i < n; ++i)
+      if (!(diagonal[i] > 0.0)) throw std::invalid_argument(std::string(who) + ": diagonal must be > 0");
+    throw std::invalid_argument(std::string(who) + ": face weights must be >= 0");
   }
   return stride;
 }
@@ -56,6 +70,50 @@ void retreat(IVec<D>& c, const IVec<D>& res) {
   }
 }
 
+// Coordinates of cell i (x fastest).
+template <int D>
+IVec<D> coordOf(std::size_t i, const IVec<D>& res) {
+  IVec<D> c;
+  for (int a = 0; a < D; ++a) {
+    c[a] = static_cast<int>(i % static_cast<std::size_t>(res[a]));
+    i /= static_cast<std::size_t>(res[a]);
+  }
+  return c;
+}
+
+// Parallel copy (same size) for large arrays.
+void copyInto(const std::vector<double>& from, std::vector<double>& to) {
+  to.resize(from.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, from.size(), 1 << 15), [&](const tbb::blocked_range<std::size_t>& r) {
+    std::copy(from.begin() + r.begin(), from.begin() + r.end(), to.begin() + r.begin());
+  });
+}
+
+// f(c, i) over the cells [begin, end) of the slowest axis' slices, in x-fastest order.
+template <int D, typename F>
+void forSlices(const IVec<D>& res, std::size_t sliceSize, int begin, int end, const F& f) {
+  IVec<D> c = IVec<D>::Zero();
+  c[D - 1] = begin;
+  const std::size_t stop = static_cast<std::size_t>(end) * sliceSize;
+  for (std::size_t i = static_cast<std::size_t>(begin) * sliceSize; i < stop; advance<D>(c, res), ++i) f(c, i);
+}
+
+// f(c, i) over all cells; parallel over slices of the slowest axis for large grids (each cell is
+// independent, so the result does not depend on the split).
+template <int D, typename F>
+void forCells(const IVec<D>& res, const F& f) {
+  std::size_t slice = 1;
+  for (int a = 0; a + 1 < D; ++a) slice *= static_cast<std::size_t>(res[a]);
+  const std::size_t n = slice * static_cast<std::size_t>(res[D - 1]);
+  if (n < (1u << 15)) {
+    forSlices<D>(res, slice, 0, res[D - 1], f);
+    return;
+  }
+  const int grain = static_cast<int>(std::max<std::size_t>(1, (1u << 13) / slice));
+  tbb::parallel_for(tbb::blocked_range<int>(0, res[D - 1], grain),
+                    [&](const tbb::blocked_range<int>& r) { forSlices<D>(res, slice, r.begin(), r.end(), f); });
+}
+
 }  // namespace
 
 template <int D>
@@ -65,28 +123,56 @@ GridPoissonQpOperator<D>::GridPoissonQpOperator(const IVec<D>& res, std::array<s
       stride_(checkStencil<D>("GridPoissonQpOperator", res, lowerWeight, diagonal)),
       lower_(std::move(lowerWeight)),
       diagonal_(std::move(diagonal)) {
-  IVec<D> c = IVec<D>::Zero();
-  for (std::size_t i = 0; i < diagonal_.size(); advance<D>(c, res_), ++i) {
-    double sum = std::abs(diagonal_[i]);
-    for (int a = 0; a < D; ++a) {
-      if (c[a] > 0) sum += lower_[a][i];
-      if (c[a] + 1 < res_[a]) sum += lower_[a][i + stride_[a]];
-    }
-    normBound_ = std::max(normBound_, sum);
-  }
+  computeNormBound();
+}
+
+template <int D>
+void GridPoissonQpOperator<D>::assign(const std::array<std::vector<double>, D>& lowerWeight,
+                                      const std::vector<double>& diagonal) {
+  assign(res_, lowerWeight, diagonal);
+}
+
+template <int D>
+void GridPoissonQpOperator<D>::assign(const IVec<D>& res, const std::array<std::vector<double>, D>& lowerWeight,
+                                      const std::vector<double>& diagonal) {
+  stride_ = checkStencil<D>("GridPoissonQpOperator::assign", res, lowerWeight, diagonal);
+  res_ = res;
+  for (int a = 0; a < D; ++a) copyInto(lowerWeight[a], lower_[a]);
+  copyInto(diagonal, diagonal_);
+  computeNormBound();
+}
+
+template <int D>
+void GridPoissonQpOperator<D>::computeNormBound() {
+  // Per-slice maxima, combined with max: independent of the split.
+  std::size_t slice = 1;
+  for (int a = 0; a + 1 < D; ++a) slice *= static_cast<std::size_t>(res_[a]);
+  normBound_ = tbb::parallel_reduce(
+      tbb::blocked_range<int>(0, res_[D - 1], static_cast<int>(std::max<std::size_t>(1, (1u << 13) / slice))), 0.0,
+      [&](const tbb::blocked_range<int>& r, double m) {
+        forSlices<D>(res_, slice, r.begin(), r.end(), [&](const IVec<D>& c, std::size_t i) {
+          double sum = std::abs(diagonal_[i]);
+          for (int a = 0; a < D; ++a) {
+            if (c[a] > 0) sum += lower_[a][i];
+            if (c[a] + 1 < res_[a]) sum += lower_[a][i + stride_[a]];
+          }
+          m = std::max(m, sum);
+        });
+        return m;
+      },
+      [](double a, double b) { return std::max(a, b); });
 }
 
 template <int D>
 void GridPoissonQpOperator<D>::apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
-  IVec<D> c = IVec<D>::Zero();
-  for (std::size_t i = 0; i < diagonal_.size(); advance<D>(c, res_), ++i) {
+  forCells<D>(res_, [&](const IVec<D>& c, std::size_t i) {
     double s = diagonal_[i] * x[i];
     for (int a = 0; a < D; ++a) {
       if (c[a] > 0) s -= lower_[a][i] * x[i - stride_[a]];
       if (c[a] + 1 < res_[a]) s -= lower_[a][i + stride_[a]] * x[i + stride_[a]];
     }
     y[i] = s;
-  }
+  });
 }
 
 template <int D>
@@ -106,7 +192,9 @@ GridMic0FacePreconditioner<D>::GridMic0FacePreconditioner(const IVec<D>& res,
       settings_(settings),
       free_(diagonal_.size(), 1),
       precon_(diagonal_.size(), 0.0),
-      q_(Eigen::VectorXd::Zero(static_cast<Eigen::Index>(diagonal_.size()))) {
+      q_(diagonal_.size(), 0.0) {
+  freeList_.reserve(diagonal_.size());
+  for (std::size_t i = 0; i < diagonal_.size(); ++i) freeList_.push_back(i);
   if (!(settings.tau >= 0.0 && settings.tau <= 1.0) || !(settings.sigma >= 0.0 && settings.sigma <= 1.0))
     throw std::invalid_argument("GridMic0FacePreconditioner: need 0 <= tau <= 1 and 0 <= sigma <= 1");
   factor();
@@ -117,11 +205,40 @@ void GridMic0FacePreconditioner<D>::setFace(const std::vector<std::uint8_t>& fre
   if (free.size() != free_.size())
     throw std::invalid_argument("GridMic0FacePreconditioner: face mask has " + std::to_string(free.size()) +
                                 " entries, grid has " + std::to_string(free_.size()) + " cells");
-  bool same = true;
-  for (std::size_t i = 0; i < free.size() && same; ++i) same = (free[i] != 0) == (free_[i] != 0);
-  if (same) return;
-  for (std::size_t i = 0; i < free.size(); ++i) free_[i] = free[i] ? 1 : 0;
+  if (!stale_ && std::equal(free.begin(), free.end(), free_.begin(),
+                            [](std::uint8_t a, std::uint8_t b) { return (a != 0) == (b != 0); }))
+    return;
+  for (std::size_t i : freeList_) precon_[i] = 0.0;  // the old face; the new one is factored below
+  freeList_.clear();
+  for (std::size_t i = 0; i < free.size(); ++i) {
+    free_[i] = free[i] ? 1 : 0;
+    if (free_[i]) freeList_.push_back(i);
+  }
   factor();
+}
+
+template <int D>
+void GridMic0FacePreconditioner<D>::assign(const std::array<std::vector<double>, D>& lowerWeight,
+                                           const std::vector<double>& diagonal) {
+  assign(res_, lowerWeight, diagonal);
+}
+
+template <int D>
+void GridMic0FacePreconditioner<D>::assign(const IVec<D>& res, const std::array<std::vector<double>, D>& lowerWeight,
+                                           const std::vector<double>& diagonal) {
+  stride_ = checkStencil<D>("GridMic0FacePreconditioner::assign", res, lowerWeight, diagonal);
+  for (int a = 0; a < D; ++a) copyInto(lowerWeight[a], lower_[a]);
+  copyInto(diagonal, diagonal_);
+  if (res != res_) {  // a new grid: every cell free until the next setFace()
+    res_ = res;
+    const std::size_t n = diagonal_.size();
+    free_.assign(n, 1);
+    precon_.assign(n, 0.0);
+    q_.assign(n, 0.0);
+    freeList_.clear();
+    for (std::size_t i = 0; i < n; ++i) freeList_.push_back(i);
+  }
+  stale_ = true;
 }
 
 // Bridson's MIC(0) (fluid notes fig. 4.2) of A_FF: for each free cell i in order, with the
@@ -134,12 +251,10 @@ void GridMic0FacePreconditioner<D>::setFace(const std::vector<std::uint8_t>& fre
 template <int D>
 void GridMic0FacePreconditioner<D>::factor() {
   const double tau = settings_.tau, sigma = settings_.sigma;
-  IVec<D> c = IVec<D>::Zero();
-  for (std::size_t i = 0; i < diagonal_.size(); advance<D>(c, res_), ++i) {
-    if (!free_[i]) {
-      precon_[i] = 0.0;
-      continue;
-    }
+  // Held cells keep precon = 0 (setFace() zeroes the old face), so only the free cells, in
+  // increasing order, need the sweep.
+  for (const std::size_t i : freeList_) {
+    const IVec<D> c = coordOf<D>(i, res_);
     double e = diagonal_[i];
     for (int a = 0; a < D; ++a) {
       if (c[a] == 0) continue;
@@ -159,24 +274,29 @@ void GridMic0FacePreconditioner<D>::factor() {
     precon_[i] = 1.0 / std::sqrt(e);
   }
   ++factorizations_;
+  stale_ = false;
 }
 
 // L(i, i) = 1 / precon_i and L(i, i - e_a) = -w_a(i) precon_{i - e_a}; both vanish off the face,
-// so the solves need no mask: q and z come out 0 on held cells.
+// so the solves only visit the free cells (in x-fastest order and back), O(|F|) plus clearing z.
 template <int D>
 void GridMic0FacePreconditioner<D>::apply(const Eigen::VectorXd& g, Eigen::VectorXd& z) {
-  const std::size_t n = diagonal_.size();
+  if (stale_) factor();
   const double* pc = precon_.data();
   double* q = q_.data();
-  IVec<D> c = IVec<D>::Zero();
-  for (std::size_t i = 0; i < n; advance<D>(c, res_), ++i) {  // L q = g
+  // Only the free cells carry values: q on held cells may be stale but is multiplied by their
+  // precon = 0, and z is zeroed first so the held neighbours contribute nothing to L^T z = q.
+  z.setZero();
+  for (const std::size_t i : freeList_) {  // L q = g
+    const IVec<D> c = coordOf<D>(i, res_);
     double t = g[i];
     for (int a = 0; a < D; ++a)
       if (c[a] > 0) t += lower_[a][i] * pc[i - stride_[a]] * q[i - stride_[a]];
     q[i] = t * pc[i];
   }
-  c = res_ - IVec<D>::Ones();
-  for (std::size_t i = n; i-- > 0; retreat<D>(c, res_)) {  // L^T z = q, reverse order
+  for (auto it = freeList_.rbegin(); it != freeList_.rend(); ++it) {  // L^T z = q, reverse order
+    const std::size_t i = *it;
+    const IVec<D> c = coordOf<D>(i, res_);
     double t = q[i];
     for (int a = 0; a < D; ++a)
       if (c[a] + 1 < res_[a]) t += lower_[a][i + stride_[a]] * pc[i] * z[i + stride_[a]];

@@ -41,8 +41,19 @@ class GridPoissonQpOperator final : public QpOperator {
   void diagonal(Eigen::VectorXd& d) const override;
   // Gershgorin: max_i (|a_ii| + sum_j |a_ij|).
   double normUpperBound() const override { return normBound_; }
+  // Replaces the stencil by one of the same resolution, copying into the existing storage (no
+  // allocation), for operators that change every time step (e.g. the crowd pressure, whose face
+  // weights are the density). Same checks as the constructor.
+  void assign(const std::array<std::vector<double>, D>& lowerWeight, const std::vector<double>& diagonal);
+  // The same for a stencil of another resolution (e.g. the bounding box of the cells a problem
+  // needs): the storage only grows past its largest size so far.
+  void assign(const IVec<D>& res, const std::array<std::vector<double>, D>& lowerWeight,
+              const std::vector<double>& diagonal);
+  const IVec<D>& resolution() const { return res_; }
 
  private:
+  void computeNormBound();
+
   IVec<D> res_;
   std::array<std::size_t, D> stride_{};
   std::array<std::vector<double>, D> lower_;
@@ -55,10 +66,11 @@ struct GridMic0Settings {
   double sigma = 0.25;  // a pivot below sigma * A_ii falls back to A_ii (Bridson's safety factor)
 };
 
-// M_FF = L L^T, the MIC(0) factor of A_FF. setFace() refactors in O(n) (one sweep over the cells,
-// no allocation after construction), but only when the free mask differs from the last one: MPRGP
-// announces a face after every expansion and proportioning step, and the face often does not
-// change. apply() is a forward and a backward triangular solve, sequential in x-fastest order.
+// M_FF = L L^T, the MIC(0) factor of A_FF. setFace() compares the mask (O(n)) and, only when it
+// differs from the last one, rebuilds the list of free cells and refactors over them (O(|F|); no
+// allocation after construction): MPRGP announces a face after every expansion and proportioning
+// step, and the face often does not change. apply() is a forward and a backward triangular solve
+// over the free cells only, sequential in x-fastest order, O(|F|) plus clearing z.
 template <int D>
 class GridMic0FacePreconditioner final : public QpFacePreconditioner {
  public:
@@ -73,6 +85,13 @@ class GridMic0FacePreconditioner final : public QpFacePreconditioner {
   // Number of factorisations so far (the constructor's included); setFace() with an unchanged
   // mask does not add one.
   int factorizations() const { return factorizations_; }
+  // Replaces the stencil (same resolution, no allocation; same checks as the constructor). The
+  // factor is rebuilt lazily, on the next setFace() or apply(), whatever the mask.
+  void assign(const std::array<std::vector<double>, D>& lowerWeight, const std::vector<double>& diagonal);
+  // The same for a stencil of another resolution; a new resolution frees every cell (as after
+  // construction). The storage only grows past its largest size so far.
+  void assign(const IVec<D>& res, const std::array<std::vector<double>, D>& lowerWeight,
+              const std::vector<double>& diagonal);
 
  private:
   void factor();
@@ -84,8 +103,10 @@ class GridMic0FacePreconditioner final : public QpFacePreconditioner {
   GridMic0Settings settings_;
   std::vector<std::uint8_t> free_;
   std::vector<double> precon_;  // 1 / L_ii on the face, 0 off it
-  Eigen::VectorXd q_;           // L q = g
+  std::vector<std::size_t> freeList_;  // the free cells in increasing order
+  std::vector<double> q_;       // L q = g (meaningful on the face only)
   int factorizations_ = 0;
+  bool stale_ = false;          // stencil replaced since the last factorisation
 };
 
 }  // namespace msim::numerics

@@ -24,6 +24,9 @@ class Phenomenon {
   virtual void step(double dt) = 0;
   // Throws SimulationError naming the field and `stepIndex` if the state is not finite.
   virtual void checkFinite(long stepIndex, double time) const = 0;
+  // Called once after the last substep of every frame, before its outputs (per-frame
+  // measurements that the outputs and statistics() then report). Nothing by default.
+  virtual void endFrame() {}
   // Frame outputs. Each call writes one complete file (the runner makes it atomic).
   virtual void writeVolume(const std::filesystem::path& vdbFile) const = 0;
   virtual io::Image preview() const = 0;
@@ -31,6 +34,14 @@ class Phenomenon {
   virtual void restore(const std::filesystem::path& vdbFile, double time) = 0;
   // Summary numbers of the current state, one JSON object of named numbers.
   virtual nlohmann::json statistics() const = 0;
+  // Per-frame files besides the VDB and the preview (a crowd's trajectory rows), written before
+  // the VDB so that a frame whose VDB exists has them too (--resume). None by default.
+  virtual void writeFrameData(const std::filesystem::path& /*runDir*/, int /*frame*/) const {}
+  // The run is complete: summary files (plots, joined tables) in runDir from the statistics of
+  // every frame (run.json's "frames"). Returns named results stored in run.json as "results".
+  virtual nlohmann::json finishRun(const std::filesystem::path& /*runDir*/, const nlohmann::json& /*frames*/) {
+    return nlohmann::json::object();
+  }
 };
 
 // A kind of phenomenon the scene key "phenomenon" can name.

@@ -1,3 +1,4 @@
+#include "msim/scene/crowd_phenomenon.hpp"
 #include "msim/scene/gas_phenomenon.hpp"
 #include "msim/scene/phenomenon.hpp"
 #include "msim/scene/smoke_phenomenon.hpp"
@@ -5,7 +6,7 @@
 namespace msim::scene {
 
 const std::vector<PhenomenonType>& phenomenonTypes() {
-  static const std::vector<PhenomenonType> types = {gasPhenomenonType(), smokePhenomenonType()};
+  static const std::vector<PhenomenonType> types = {gasPhenomenonType(), smokePhenomenonType(), crowdPhenomenonType()};
   return types;
 }
 

@@ -143,6 +143,8 @@ class RunRecord {
     writeStatsCsv(statsPath_, doc_["frames"]);
   }
   void note(const std::string& key, const std::string& value) { doc_[key] = value; }
+  void results(nlohmann::json value) { doc_["results"] = std::move(value); }
+  const json& frames() const { return doc_["frames"]; }
 
  private:
   fs::path path_, statsPath_;
@@ -219,6 +221,11 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
         ScopedStage stage(timers, "check finite");
         phenomenon->checkFinite(stepIndex, frameEnd);
       }
+      phenomenon->endFrame();
+      {
+        ScopedStage stage(timers, "write frame data");
+        phenomenon->writeFrameData(layout.root, frame);
+      }
       if (layout.vdb) {
         ScopedStage stage(timers, "write vdb");
         phenomenon->writeVolume(frameFile(layout.vdbDir, layout.name, frame, "vdb"));
@@ -251,6 +258,10 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
   }
   if (options.showProgress) progress.finish();
 
+  if (status == RunStatus::Complete) {
+    ScopedStage stage(timers, "finish run");
+    record.results(phenomenon->finishRun(layout.root, record.frames()));
+  }
   if (status == RunStatus::Complete && layout.mp4) {
     ScopedStage stage(timers, "encode mp4");
     std::vector<fs::path> frames;

@@ -78,6 +78,14 @@ Schema& Schema::string(std::string name, std::string description) {
   return addField(std::move(name), std::move(s));
 }
 
+Schema Schema::vectorItem(std::string unit, int length, std::string description) {
+  Schema s(SchemaType::Vector, std::move(description));
+  s.unit_ = std::move(unit);
+  s.lengths_ = {length};
+  s.required_ = true;
+  return s;
+}
+
 Schema& Schema::vector(std::string name, std::string unit, std::vector<double> defaultValue, std::string description) {
   Schema s(SchemaType::Vector, std::move(description));
   s.unit_ = std::move(unit);

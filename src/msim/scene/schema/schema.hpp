@@ -49,6 +49,8 @@ class Schema {
   static Schema array(Schema item, std::string description = {});
   // An object whose "type" key picks one of the alternatives added with alternative().
   static Schema variant(std::string description = {});
+  // A fixed-length vector of numbers on its own, e.g. the item of an array of polygon vertices.
+  static Schema vectorItem(std::string unit, int length, std::string description = {});
 
   // ---- Object builders: add a field and return its schema. Overloads without a default make
   // the field required.

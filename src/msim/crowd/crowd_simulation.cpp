@@ -1,0 +1,297 @@
+#include "msim/crowd/crowd_simulation.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "msim/core/error.hpp"
+#include "msim/core/parallel.hpp"
+
+namespace msim::crowd {
+namespace {
+
+constexpr int kRelaxSweeps = 50;
+
+// Largest radius and speed over the initial agents and every agent an inflow will create.
+void extremes(const Agents& agents, const std::vector<Inflow>& inflows, float& radius, float& speed) {
+  radius = 0.0f;
+  speed = 0.0f;
+  for (std::size_t i = 0; i < agents.size(); ++i) {
+    radius = std::max(radius, agents.radius[i]);
+    speed = std::max(speed, agents.maxSpeed[i]);
+  }
+  for (const Inflow& f : inflows) {
+    radius = std::max(radius, f.agent.radius);
+    speed = std::max(speed, f.agent.maxSpeed);
+  }
+}
+
+float obstacleReach(const Agents& agents, const std::vector<Inflow>& inflows, const OrcaParams& orca) {
+  float radius = 0.0f, speed = 0.0f;
+  extremes(agents, inflows, radius, speed);
+  return std::max(radius, speed * orca.timeHorizonObst + radius) + 1e-3f;
+}
+
+}  // namespace
+
+CrowdSimulation::CrowdSimulation(const CrowdSettings& settings, std::vector<Polygon> obstacles, std::vector<Goal> goals,
+                                 std::shared_ptr<const GlobalPlanner> planner, Agents agents, std::vector<Inflow> inflows,
+                                 std::vector<Script> scripts)
+    : settings_(settings),
+      obstacles_(std::move(obstacles)),
+      goals_(std::move(goals)),
+      planner_(std::move(planner)),
+      agents_(std::move(agents)),
+      inflows_(std::move(inflows)),
+      inflowCredit_(inflows_.size(), 0.0),
+      scripts_(std::move(scripts)),
+      scriptProgress_(scripts_.size(), 0),
+      rng_(settings.seed),
+      staticObstacles_(obstacles_, obstacleReach(agents_, inflows_, settings.orca)),
+      freeArea_(settings.grid),
+      uic_(settings.grid, settings.uicSettings) {
+  if (!planner_ || planner_->goalCount() != goals_.size())
+    throw InputError("crowd: the planner does not answer for the scene's goals");
+  for (std::size_t k = 0; k < obstacles_.size(); ++k) {
+    validateSimple(obstacles_[k], fmt::format("obstacles[{}]", k));
+    freeArea_.addStaticObstacle(obstacles_[k]);
+  }
+  for (std::size_t i = 0; i < agents_.size(); ++i) validateAgent(i, fmt::format("agent {}", agents_.id[i]));
+  // Agents placed at random overlap; separate them before the first step so that the overlap
+  // statistics measure the simulation, not the placement.
+  CollisionResolutionParams relax = settings_.collision;
+  relax.iterations = kRelaxSweeps;
+  resolver_.resolve(agents_, staticObstacles_, DomainBox{settings_.lo.cast<float>(), settings_.hi.cast<float>()}, relax);
+  for (std::size_t k = 0; k < inflows_.size(); ++k) {
+    const Inflow& f = inflows_[k];
+    validateSimple(f.region, fmt::format("inflows[{}].region", k));
+    Vec2 lo, hi;
+    bounds(f.region, lo, hi);
+    if ((lo.array() < settings_.lo.array()).any() || (hi.array() > settings_.hi.array()).any())
+      throw InputError(fmt::format("inflows[{}].region: it reaches outside the domain [{}, {}] x [{}, {}]", k,
+                                   settings_.lo.x(), settings_.hi.x(), settings_.lo.y(), settings_.hi.y()));
+    if (!(f.rate > 0.0) || !std::isfinite(f.rate))
+      throw InputError(fmt::format("inflows[{}].rate: expected a positive number of agents per second", k));
+    if (f.agent.goal >= goals_.size())
+      throw InputError(fmt::format("inflows[{}].goal: there is no goal {}", k, f.agent.goal));
+  }
+  for (std::size_t s = 0; s < scripts_.size(); ++s) {
+    const auto it = std::find(agents_.id.begin(), agents_.id.end(), scripts_[s].agentId);
+    if (it == agents_.id.end() || agents_.model[it - agents_.id.begin()] != AgentModel::Scripted)
+      throw InputError(fmt::format("scripts[{}]: agent {} is not a scripted agent of the scene", s, scripts_[s].agentId));
+    if (scripts_[s].waypoints.empty()) throw InputError(fmt::format("scripts[{}]: no waypoints", s));
+  }
+}
+
+void CrowdSimulation::validateAgent(std::size_t i, const std::string& what) const {
+  const Vec2 x = agents_.position[i].cast<double>();
+  if (!x.allFinite() || (x.array() < settings_.lo.array()).any() || (x.array() > settings_.hi.array()).any())
+    throw InputError(fmt::format("{}: position ({}, {}) is outside the domain [{}, {}] x [{}, {}]", what, x.x(), x.y(),
+                                 settings_.lo.x(), settings_.hi.x(), settings_.lo.y(), settings_.hi.y()));
+  if (!(agents_.radius[i] > 0.0f) || !(agents_.maxSpeed[i] >= 0.0f) || !std::isfinite(agents_.maxSpeed[i]))
+    throw InputError(fmt::format("{}: radius must be > 0 and max speed >= 0", what));
+  for (std::size_t k = 0; k < obstacles_.size(); ++k)
+    if (contains(obstacles_[k], x))
+      throw InputError(fmt::format("{}: position ({}, {}) is inside obstacles[{}]", what, x.x(), x.y(), k));
+  if (agents_.model[i] == AgentModel::Scripted) return;
+  if (agents_.goal[i] >= goals_.size()) throw InputError(fmt::format("{}: there is no goal {}", what, agents_.goal[i]));
+  if (!std::isfinite(planner_->distance(agents_.goal[i], x)))
+    throw InputError(fmt::format("{}: goal {} cannot be reached from ({}, {})", what, agents_.goal[i], x.x(), x.y()));
+}
+
+double CrowdSimulation::maxSpeed() const {
+  float radius = 0.0f, speed = 0.0f;
+  extremes(agents_, inflows_, radius, speed);
+  return speed;
+}
+
+void CrowdSimulation::plan() {
+  // Preferred velocity along the planned path at the agent's maximum speed, slowed on the last
+  // stretch to a point goal so that it stops there instead of oscillating around it.
+  parallelFor(0, agents_.size(), [&](std::size_t i) {
+    if (agents_.model[i] == AgentModel::Scripted) return;
+    const std::uint32_t g = agents_.goal[i];
+    const Vec2 x = agents_.position[i].cast<double>();
+    const Goal& goal = goals_[g];
+    if (!goal.exit && goal.reached(x)) {
+      agents_.preferredVelocity[i].setZero();
+      return;
+    }
+    double speed = agents_.maxSpeed[i];
+    if (goal.kind == Goal::Kind::Point && !goal.exit) speed = std::min(speed, (goal.point - x).norm());
+    agents_.preferredVelocity[i] = (speed * planner_->direction(g, x)).cast<float>();
+  });
+}
+
+void CrowdSimulation::moveScripted(double dt) {
+  for (std::size_t s = 0; s < scripts_.size(); ++s) {
+    Script& script = scripts_[s];
+    const auto it = std::find(agents_.id.begin(), agents_.id.end(), script.agentId);
+    if (it == agents_.id.end()) continue;
+    const std::size_t i = it - agents_.id.begin();
+    double budget = agents_.maxSpeed[i] * dt;
+    Vec2 x = agents_.position[i].cast<double>();
+    const Vec2 start = x;
+    std::size_t& next = scriptProgress_[s];
+    while (budget > 0.0 && next < script.waypoints.size()) {
+      const Vec2 d = script.waypoints[next] - x;
+      const double len = d.norm();
+      if (len <= budget) {
+        x = script.waypoints[next];
+        budget -= len;
+        ++next;
+        if (next == script.waypoints.size() && script.loop) next = 0;
+        if (len == 0.0 && script.loop && script.waypoints.size() == 1) break;
+      } else {
+        x += d * (budget / len);
+        budget = 0.0;
+      }
+    }
+    agents_.velocity[i] = ((x - start) / dt).cast<float>();
+    agents_.position[i] = x.cast<float>();
+  }
+}
+
+void CrowdSimulation::moveOrca(double dt) {
+  if (stats_.orcaAgents == 0) return;
+  orcaVelocity_.resize(agents_.size());
+  orca_.computeVelocities(agents_, staticObstacles_, settings_.orca, static_cast<float>(dt), orcaVelocity_);
+  const float h = static_cast<float>(dt);
+  parallelFor(0, agents_.size(), [&](std::size_t i) {
+    if (agents_.model[i] != AgentModel::Orca) return;
+    agents_.velocity[i] = orcaVelocity_[i];
+    agents_.position[i] += h * orcaVelocity_[i];
+  });
+}
+
+void CrowdSimulation::moveUic(double dt) {
+  // Compact the UIC agents into contiguous arrays for the grid transfers.
+  uicIndex_.clear();
+  discCentres_.clear();
+  discRadii_.clear();
+  for (std::size_t i = 0; i < agents_.size(); ++i) {
+    if (agents_.model[i] == AgentModel::Uic) {
+      uicIndex_.push_back(static_cast<std::uint32_t>(i));
+    } else {
+      // Individually controlled agents are obstacles of the continuum (ch. 4.4.3).
+      discCentres_.push_back(agents_.position[i]);
+      discRadii_.push_back(agents_.radius[i]);
+    }
+  }
+  const std::size_t n = uicIndex_.size();
+  uicPosition_.resize(n);
+  uicPreferred_.resize(n);
+  uicSpeed_.resize(n);
+  uicVelocity_.resize(n);
+  parallelFor(0, n, [&](std::size_t k) {
+    const std::size_t i = uicIndex_[k];
+    uicPosition_[k] = agents_.position[i];
+    uicPreferred_[k] = agents_.preferredVelocity[i];
+    uicSpeed_[k] = agents_.maxSpeed[i];
+  });
+  if (n > 0 && settings_.uic) {
+    freeArea_.update(discCentres_, discRadii_);
+    stats_.uic = uic_.project(uicPosition_, uicPreferred_, uicSpeed_, freeArea_.fraction(), dt, uicVelocity_);
+  } else {
+    std::copy(uicPreferred_.begin(), uicPreferred_.end(), uicVelocity_.begin());
+    stats_.uic = UicStats{};
+  }
+  const float h = static_cast<float>(dt);
+  parallelFor(0, n, [&](std::size_t k) {
+    const std::size_t i = uicIndex_[k];
+    // Eq. 4.7 is the optimum under |v| <= v_max. The outer psolve of eq. 4.20 comes after renorm
+    // and corrects last step's overdensity within one step, which can ask for several times v_max
+    // where a crowd presses into a bottleneck (3 m/s at the 95th percentile at a 1.2 m door);
+    // people cannot walk that fast, so the correction is spread over several steps instead.
+    const float speed = uicVelocity_[k].norm();
+    if (speed > agents_.maxSpeed[i]) uicVelocity_[k] *= agents_.maxSpeed[i] / speed;
+    agents_.velocity[i] = uicVelocity_[k];
+    agents_.position[i] += h * uicVelocity_[k];
+  });
+}
+
+void CrowdSimulation::arriveAndSpawn(double dt) {
+  remove_.assign(agents_.size(), 0);
+  std::size_t exited = 0;
+  for (std::size_t i = 0; i < agents_.size(); ++i) {
+    if (agents_.model[i] == AgentModel::Scripted) continue;
+    const Goal& goal = goals_[agents_.goal[i]];
+    if (goal.exit && goal.reached(agents_.position[i].cast<double>())) {
+      remove_[i] = 1;
+      exits_.push_back(ExitEvent{agents_.id[i], agents_.goal[i], time_});
+      ++exited;
+    }
+  }
+  if (exited > 0) agents_.removeFlagged(remove_);
+  stats_.exited = exited;
+
+  stats_.spawned = 0;
+  for (std::size_t k = 0; k < inflows_.size(); ++k) {
+    const Inflow& f = inflows_[k];
+    const double open = std::max(0.0, std::min(time_, f.stop) - std::max(time_ - dt, f.start));
+    inflowCredit_[k] += f.rate * open;
+    Vec2 lo, hi;
+    bounds(f.region, lo, hi);
+    // The tolerance keeps round-off (rate x dt summed over many steps, or a credit saved as float
+    // for --resume) from delaying an agent by a step.
+    while (inflowCredit_[k] >= 1.0 - 1e-6) {
+      inflowCredit_[k] -= 1.0;
+      // Uniform in the region by rejection from its bounds (regions are checked to have area). The
+      // stream depends only on the seed and the new agent's id, so a resumed run spawns the same.
+      Rng rng = rng_.split(agents_.nextId);
+      Vec2 x;
+      do {
+        x = Vec2(rng.uniform(lo.x(), hi.x()), rng.uniform(lo.y(), hi.y()));
+      } while (!contains(f.region, x));
+      AgentSpec spec = f.agent;
+      spec.position = x.cast<float>();
+      agents_.add(spec);
+      ++stats_.spawned;
+    }
+  }
+}
+
+void CrowdSimulation::step(double dt, StageTimers* timers) {
+  StageTimers local;
+  StageTimers& t = timers ? *timers : local;
+  if (!(dt > 0.0) || !std::isfinite(dt)) throw SimulationError(fmt::format("crowd: invalid time step {}", dt));
+  stats_.agents = agents_.size();
+  stats_.uicAgents = stats_.orcaAgents = stats_.scriptedAgents = 0;
+  for (AgentModel m : agents_.model) {
+    if (m == AgentModel::Uic) ++stats_.uicAgents;
+    else if (m == AgentModel::Orca) ++stats_.orcaAgents;
+    else ++stats_.scriptedAgents;
+  }
+  {
+    ScopedStage s(t, "crowd: planning");
+    plan();
+  }
+  {
+    ScopedStage s(t, "crowd: scripted + orca");
+    moveScripted(dt);
+    moveOrca(dt);
+  }
+  {
+    ScopedStage s(t, "crowd: uic");
+    moveUic(dt);
+  }
+  // The domain's sides are walls, whether or not collision resolution runs.
+  const Vec2f lo = settings_.lo.cast<float>(), hi = settings_.hi.cast<float>();
+  parallelFor(0, agents_.size(), [&](std::size_t i) {
+    agents_.position[i] = agents_.position[i].cwiseMax(lo + Vec2f::Constant(agents_.radius[i]))
+                              .cwiseMin(hi - Vec2f::Constant(agents_.radius[i]));
+  });
+  if (settings_.collisionResolution) {
+    ScopedStage s(t, "crowd: collisions");
+    resolver_.resolve(agents_, staticObstacles_,
+                      DomainBox{settings_.lo.cast<float>(), settings_.hi.cast<float>()}, settings_.collision);
+  }
+  time_ += dt;
+  {
+    ScopedStage s(t, "crowd: exits + inflows");
+    arriveAndSpawn(dt);
+  }
+}
+
+}  // namespace msim::crowd

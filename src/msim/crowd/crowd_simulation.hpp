@@ -1,0 +1,135 @@
+#pragma once
+// The crowd time step of Narain 2011 ch. 4.4.4, with the agent kinds of ch. 4.4.3 mixed in one
+// scene:
+//   1. global planning: preferred velocities v~_i from the planner (cached fields or roadmap);
+//   2. individually controlled agents first: scripted agents follow their waypoints, ORCA agents
+//      avoid everybody by ORCA; both then count as moving obstacles of the continuum;
+//   3. free-area fractions f of the grid (static obstacles precomputed, moving ones per step);
+//   4. the UIC projection v = psolve(renorm(psolve(v~))) (eq. 4.20) and agent velocities (4.3);
+//   5. x_i += v_i dt;
+//   6. pairwise collision resolution, out of obstacles, inside the domain;
+//   7. arrivals (agents at an exit goal leave) and inflows (agents/s into spawn regions).
+// Each part can be switched off (uic, collision resolution) to reproduce Fig. 4.3.
+#include <limits>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "msim/core/rng.hpp"
+#include "msim/core/timer.hpp"
+#include "msim/crowd/agents.hpp"
+#include "msim/crowd/collision_resolution.hpp"
+#include "msim/crowd/free_area.hpp"
+#include "msim/crowd/goal.hpp"
+#include "msim/crowd/orca.hpp"
+#include "msim/crowd/planner.hpp"
+#include "msim/crowd/uic_projection.hpp"
+
+namespace msim::crowd {
+
+// Agents entering through a region at a steady rate (the four-way crossing of Fig. 4.6).
+struct Inflow {
+  Polygon region;
+  double rate = 1.0;  // [agents/s]
+  double start = 0.0, stop = std::numeric_limits<double>::infinity();  // [s]
+  AgentSpec agent;    // goal, radius, speed, model, group of the new agents (position ignored)
+};
+
+// A scripted agent walks its waypoints in order at its maximum speed and then stands (or loops).
+struct Script {
+  std::uint64_t agentId = 0;
+  std::vector<Vec2> waypoints;
+  bool loop = false;
+};
+
+struct CrowdSettings {
+  Vec2 lo = Vec2::Zero(), hi = Vec2::Ones();  // walkable box; its sides are walls [m]
+  GridSpec<2> grid;                           // the continuum grid of the UIC
+  bool uic = true;                            // off: agents walk their preferred velocity (Fig. 4.3b)
+  UicSettings uicSettings;
+  bool collisionResolution = true;            // off: Fig. 4.3c
+  CollisionResolutionParams collision;
+  OrcaParams orca;
+  std::uint64_t seed = 1;                     // inflow positions (one stream per new agent id)
+};
+
+struct CrowdStepStats {
+  std::size_t agents = 0, uicAgents = 0, orcaAgents = 0, scriptedAgents = 0;
+  std::size_t spawned = 0, exited = 0;  // this step
+  UicStats uic;                         // the last projection (zeros when off or no UIC agents)
+};
+
+// An agent that left through an exit: the evacuation-time metrics read these.
+struct ExitEvent {
+  std::uint64_t agentId = 0;
+  std::uint32_t goal = 0;
+  double time = 0.0;  // [s]
+};
+
+class CrowdSimulation {
+ public:
+  // `planner` answers for `goals` (same indices). Throws InputError naming the object for an
+  // agent outside the domain or inside an obstacle, a goal index out of range, an unreachable
+  // goal, a script for an unknown or non-scripted agent, or an inflow region outside the domain.
+  CrowdSimulation(const CrowdSettings& settings, std::vector<Polygon> obstacles, std::vector<Goal> goals,
+                  std::shared_ptr<const GlobalPlanner> planner, Agents agents, std::vector<Inflow> inflows = {},
+                  std::vector<Script> scripts = {});
+
+  void step(double dt, StageTimers* timers = nullptr);
+
+  const Agents& agents() const { return agents_; }
+  Agents& mutableAgents() { return agents_; }  // for restoring a saved state
+  double time() const { return time_; }
+  void setTime(double t) { time_ = t; }
+  const CrowdSettings& settings() const { return settings_; }
+  const std::vector<Polygon>& obstacles() const { return obstacles_; }
+  const std::vector<Goal>& goals() const { return goals_; }
+  const CrowdStepStats& lastStep() const { return stats_; }
+  const UicProjection& uic() const { return uic_; }
+  const FreeArea& freeArea() const { return freeArea_; }
+  // Exits since the start (kept for the whole run).
+  const std::vector<ExitEvent>& exits() const { return exits_; }
+  // Inflow bookkeeping, for restoring a saved state: agents owed to each inflow (fractional).
+  std::vector<double>& inflowCredit() { return inflowCredit_; }
+  // Next waypoint of each script, for saving and restoring a run.
+  std::vector<std::size_t>& scriptProgress() { return scriptProgress_; }
+  const std::vector<Script>& scripts() const { return scripts_; }
+  // The fastest an agent may walk [m/s] (for CFL-like time step limits).
+  double maxSpeed() const;
+
+ private:
+  void validateAgent(std::size_t i, const std::string& what) const;
+  void plan();
+  void moveScripted(double dt);
+  void moveOrca(double dt);
+  void moveUic(double dt);
+  void arriveAndSpawn(double dt);
+
+  CrowdSettings settings_;
+  std::vector<Polygon> obstacles_;
+  std::vector<Goal> goals_;
+  std::shared_ptr<const GlobalPlanner> planner_;
+  Agents agents_;
+  std::vector<Inflow> inflows_;
+  std::vector<double> inflowCredit_;
+  std::vector<Script> scripts_;
+  std::vector<std::size_t> scriptProgress_;  // next waypoint per script
+  double time_ = 0.0;
+  Rng rng_;
+
+  StaticObstacles staticObstacles_;
+  FreeArea freeArea_;
+  UicProjection uic_;
+  OrcaSolver orca_;
+  CollisionResolver resolver_;
+  CrowdStepStats stats_;
+  std::vector<ExitEvent> exits_;
+
+  // Per-step scratch, kept to avoid allocation.
+  std::vector<Vec2f> orcaVelocity_, discCentres_, uicPosition_, uicPreferred_, uicVelocity_;
+  std::vector<float> discRadii_, uicSpeed_;
+  std::vector<std::uint32_t> uicIndex_;
+  std::vector<std::uint8_t> remove_;
+};
+
+}  // namespace msim::crowd

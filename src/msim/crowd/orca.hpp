@@ -1,0 +1,72 @@
+#pragma once
+// Optimal reciprocal collision avoidance (van den Berg, Guy, Lin, Manocha, "Reciprocal n-body
+// collision avoidance", ISRR 2011), the per-agent local planner the seed compares against
+// (ch. 4.5.1: the RVO baseline failed past 70k agents; this one runs at 1M). Each ORCA agent takes
+// the velocity closest to its preferred one that lies in its max-speed disc and in the
+// half-planes ORCA_{i|j} of its nearest neighbours and of the nearby static obstacle edges.
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <tbb/enumerable_thread_specific.h>
+
+#include "msim/crowd/agents.hpp"
+#include "msim/crowd/collision_resolution.hpp"
+#include "msim/crowd/neighbour_grid.hpp"
+
+namespace msim::crowd {
+
+struct OrcaParams {
+  float neighbourDist = 3.0f;    // agents farther than this (centre to centre) are ignored [m]
+  int maxNeighbours = 10;        // only the closest ones within neighbourDist count
+  float timeHorizon = 2.0f;      // tau: avoid collisions with agents within this time [s]
+  float timeHorizonObst = 1.0f;  // tau for static obstacles [s]
+};
+
+// A velocity half-plane {v : (v - point) . normal >= 0}, normal of unit length.
+struct HalfPlane {
+  Vec2f point, normal;
+};
+
+// The incremental linear programs of the paper (sec. 5.2), exposed for testing. Velocity closest
+// to `preferred` within |v| <= maxSpeed and all half-planes; when they have no common point, the
+// velocity minimising the largest penetration into the half-planes after the first `hard` ones
+// (the obstacle constraints, which stay strict). Deterministic: constraints in the given order.
+Vec2f solveOrcaProgram(std::span<const HalfPlane> planes, std::size_t hard, const Vec2f& preferred, float maxSpeed,
+                       std::vector<HalfPlane>& scratch);
+
+class OrcaSolver {
+ public:
+  // New velocities of the agents whose model is Orca, written to out[i] (out.size() ==
+  // agents.size(); other entries untouched), from the positions, last velocities and preferred
+  // velocities in `agents`. dt is the coming time step: overlapping pairs aim to separate within
+  // it (paper sec. 5.1). Parallel over agents; reads only old state, so the result does not depend
+  // on the thread count. `obstacles` must have been built with reach >= the largest
+  // maxSpeed * timeHorizonObst + radius. No allocation per agent (thread-local scratch).
+  void computeVelocities(const Agents& agents, const StaticObstacles& obstacles, const OrcaParams& params, float dt,
+                         std::span<Vec2f> out);
+
+ private:
+  struct Neighbour {
+    float d2;            // squared distance
+    std::uint32_t id;    // agent index (ties are broken by it)
+    std::uint32_t slot;  // cell-ordered slot
+  };
+  struct Scratch {
+    std::vector<Neighbour> nearest;  // closest first
+    std::vector<HalfPlane> planes;
+    std::vector<HalfPlane> projected;
+  };
+  NeighbourGrid grid_;
+  // Per-agent data gathered in the grid's cell order once per call, so neighbour reads are
+  // contiguous (agents are stored in age order, which scatters neighbours over memory).
+  struct Slot {
+    Vec2f velocity;
+    float radius;
+    float share;  // 1/2 towards ORCA agents, 1 towards the others (they do not reciprocate)
+  };
+  std::vector<Slot> slots_;
+  tbb::enumerable_thread_specific<Scratch> scratch_;
+};
+
+}  // namespace msim::crowd

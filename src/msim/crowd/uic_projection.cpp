@@ -1,0 +1,541 @@
+#include "msim/crowd/uic_projection.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include "msim/core/error.hpp"
+#include "msim/core/parallel.hpp"
+
+namespace msim::crowd {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds(Clock::time_point since) { return std::chrono::duration<double>(Clock::now() - since).count(); }
+
+const GridSpec<2>& checkedGrid(const GridSpec<2>& grid, const UicSettings& s) {
+  if (!(grid.dx > 0.0) || !std::isfinite(grid.dx) || grid.res.minCoeff() < 1)
+    throw std::invalid_argument("UicProjection: the grid needs dx > 0 and at least one cell per axis");
+  if (!(s.rhoMax > 0.0) || !std::isfinite(s.rhoMax))
+    throw std::invalid_argument(fmt::format("UicProjection: rhoMax must be a positive number, got {}", s.rhoMax));
+  if (!(s.tolerance > 0.0) || s.maxIterations < 1 || !(s.regularization >= 0.0) || !(s.renormMinFraction >= 0.0))
+    throw std::invalid_argument("UicProjection: need tolerance > 0, maxIterations >= 1, regularization >= 0 "
+                                "and renormMinFraction >= 0");
+  return grid;
+}
+
+// Smallest index i < n with bad(i), or n. Parallel; the minimum makes the answer deterministic.
+template <typename Bad>
+std::size_t firstBad(std::size_t n, const Bad& bad) {
+  return tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, n, 4096), n,
+      [&](const tbb::blocked_range<std::size_t>& r, std::size_t found) {
+        for (std::size_t i = r.begin(); i != r.end() && i < found; ++i)
+          if (bad(i)) return i;
+        return found;
+      },
+      [](std::size_t a, std::size_t b) { return std::min(a, b); });
+}
+
+void scale(MacGrid<2>& g, float s) {
+  for (int a = 0; a < 2; ++a) {
+    auto& c = g.component(a);
+    parallelFor(0, c.count(), [&](std::size_t i) { c[i] *= s; });
+  }
+}
+
+}  // namespace
+
+// f(local index in the box, grid index) over the QP box.
+template <typename F>
+void UicProjection::forBox(const F& f) const {
+  const int bx = boxRes_.x();
+  const std::size_t nx = static_cast<std::size_t>(grid_.res.x());
+  tbb::parallel_for(tbb::blocked_range<int>(0, boxRes_.y(), 16), [&](const tbb::blocked_range<int>& r) {
+    for (int j = r.begin(); j != r.end(); ++j) {
+      const std::size_t local = static_cast<std::size_t>(j) * bx;
+      const std::size_t k = (static_cast<std::size_t>(j) + boxOrigin_.y()) * nx + boxOrigin_.x();
+      for (int i = 0; i < bx; ++i) f(local + i, k + i);
+    }
+  });
+}
+
+UicProjection::UicProjection(const GridSpec<2>& grid, const UicSettings& settings)
+    : grid_(checkedGrid(grid, settings)),
+      settings_(settings),
+      density_(grid),
+      pressure_(grid),
+      predicted_(grid),
+      freeArea_(grid, 1.0f),
+      ratio_(grid),
+      faceDensity_(grid),
+      preferred_(grid),
+      speed_(grid),
+      inner_(grid),
+      renormed_(grid),
+      velocity_(grid),
+      lowerWeight_{std::vector<double>(grid.cellCount(), 0.0), std::vector<double>(grid.cellCount(), 0.0)},
+      diagonal_(grid.cellCount(), 1.0),
+      excluded_(grid.cellCount(), 1),
+      operator_(grid.res, lowerWeight_, diagonal_),
+      preconditioner_(grid.res, lowerWeight_, diagonal_),
+      rhs_(Eigen::VectorXd::Zero(static_cast<Eigen::Index>(grid.cellCount()))),
+      innerPressure_(Eigen::VectorXd::Zero(rhs_.size())),
+      outerPressure_(Eigen::VectorXd::Zero(rhs_.size())) {}
+
+void UicProjection::validate(std::span<const Vec2f> positions, std::span<const Vec2f> preferredVelocities,
+                             std::span<const float> maxSpeeds, const Grid<float, 2>& freeArea, double dt,
+                             std::span<Vec2f> velocities) const {
+  const std::size_t n = positions.size();
+  if (preferredVelocities.size() != n || maxSpeeds.size() != n || velocities.size() != n)
+    throw InputError(fmt::format("UIC projection: {} positions but {} preferred velocities, {} speeds and {} outputs",
+                                 n, preferredVelocities.size(), maxSpeeds.size(), velocities.size()));
+  if (!(dt > 0.0) || !std::isfinite(dt)) throw InputError(fmt::format("UIC projection: dt must be > 0, got {}", dt));
+  if (!freeArea.sameLayout(density_))
+    throw InputError("UIC projection: the free-area grid does not match the crowd grid's cells");
+  const Vec2 lo = grid_.origin, hi = grid_.upper();
+  const std::size_t bad = firstBad(n, [&](std::size_t i) {
+    const Vec2f& x = positions[i];
+    return !x.allFinite() || !preferredVelocities[i].allFinite() || !std::isfinite(maxSpeeds[i]) ||
+           maxSpeeds[i] < 0.0f || x.x() < lo.x() || x.y() < lo.y() || x.x() > hi.x() || x.y() > hi.y();
+  });
+  if (bad < n)
+    throw InputError(fmt::format("UIC projection: agent {} at ({}, {}) with preferred velocity ({}, {}) and speed {} "
+                                 "is non-finite, has a negative speed or lies outside the grid [{}, {}] x [{}, {}]",
+                                 bad, positions[bad].x(), positions[bad].y(), preferredVelocities[bad].x(),
+                                 preferredVelocities[bad].y(), maxSpeeds[bad], lo.x(), hi.x(), lo.y(), hi.y()));
+  const std::size_t badCell = firstBad(freeArea.count(), [&](std::size_t i) {
+    return !(freeArea[i] >= 0.0f && freeArea[i] <= 1.0f);
+  });
+  if (badCell < freeArea.count())
+    throw InputError(fmt::format("UIC projection: free area {} of cell {} is outside [0, 1]", freeArea[badCell], badCell));
+}
+
+namespace {
+
+// Linear (tent) taps along one axis of a grid with n samples, sample coordinate s: the two folded
+// sample indices and their weights (taps outside the grid fold onto the border sample, as in
+// core/transfer.hpp).
+struct Taps {
+  int at[2];
+  double w[2];
+  Taps(double s, int n) {
+    const double first = std::floor(s);
+    const double t = s - first;
+    const int f = static_cast<int>(first);
+    at[0] = std::clamp(f, 0, n - 1);
+    at[1] = std::clamp(f + 1, 0, n - 1);
+    w[0] = 1.0 - t;
+    w[1] = t;
+  }
+};
+
+constexpr std::size_t kBucketBlock = 1 << 16;
+
+}  // namespace
+
+// Agents bucketed once per projection into slabs of kSlabRows cell rows (stable counting sort with
+// per-block histograms, independent of the thread count). An agent in cell row r touches rows r - 1
+// to r + 1 of the cell and x-face grids and r to r + 1 of the y-face grid, so slabs two apart
+// never share a sample: even slabs run in parallel, then odd ones, each in input order, and every
+// sample sums its contributions in the same order whatever the thread count.
+void UicProjection::bucketAgents(std::span<const Vec2f> positions) {
+  const std::size_t n = positions.size();
+  const int ny = grid_.res.y();
+  const std::size_t slabs = static_cast<std::size_t>((ny + kSlabRows - 1) / kSlabRows);
+  const std::size_t blocks = (n + kBucketBlock - 1) / kBucketBlock;
+  slabOf_.resize(n);
+  order_.resize(n);
+  blockCursor_.assign(blocks * slabs, 0);
+  slabBegin_.assign(slabs + 1, 0);
+  const double oy = grid_.origin.y(), invDx = 1.0 / grid_.dx;
+  tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
+    std::size_t* count = &blockCursor_[b * slabs];
+    const std::size_t end = std::min(n, (b + 1) * kBucketBlock);
+    for (std::size_t i = b * kBucketBlock; i < end; ++i) {
+      const int row = std::clamp(static_cast<int>(std::floor((double(positions[i].y()) - oy) * invDx)), 0, ny - 1);
+      slabOf_[i] = static_cast<std::uint32_t>(row / kSlabRows);
+      ++count[slabOf_[i]];
+    }
+  });
+  std::size_t running = 0;
+  for (std::size_t sl = 0; sl < slabs; ++sl) {
+    slabBegin_[sl] = running;
+    for (std::size_t b = 0; b < blocks; ++b) {
+      const std::size_t count = blockCursor_[b * slabs + sl];
+      blockCursor_[b * slabs + sl] = running;
+      running += count;
+    }
+  }
+  slabBegin_[slabs] = running;
+  tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
+    std::size_t* cursor = &blockCursor_[b * slabs];
+    const std::size_t end = std::min(n, (b + 1) * kBucketBlock);
+    for (std::size_t i = b * kBucketBlock; i < end; ++i) order_[cursor[slabOf_[i]]++] = static_cast<std::uint32_t>(i);
+  });
+}
+
+// Eqs. 4.1-4.2 with the Linear (bilinear) kernel, all fields in one pass over the bucketed agents:
+// unit masses onto the cells and both face grids (Sum), and v~ (and the speeds, if they differ)
+// onto the faces, normalised by the face weight sums, which are the face masses.
+void UicProjection::splatAgents(std::span<const Vec2f> positions, std::span<const Vec2f> preferredVelocities,
+                                std::span<const float> maxSpeeds) {
+  const std::size_t n = positions.size();
+  const int nx = grid_.res.x(), ny = grid_.res.y();
+  const float perArea = static_cast<float>(1.0 / (grid_.dx * grid_.dx));
+  // The Normalized splat of a common speed is that speed wherever agents are, and renorm reads
+  // v_max only there: skip the speed sums for uniform speeds (the usual case).
+  const double fastest = parallelMax(n, [&](std::size_t i) { return maxSpeeds[i]; });
+  const double spread = parallelMax(n, [&](std::size_t i) { return fastest - maxSpeeds[i]; });
+  const bool speeds = spread != 0.0;
+
+  const std::size_t cells = density_.count(), xFaces = faceDensity_.component(0).count(),
+                    yFaces = faceDensity_.component(1).count();
+  auto zeroed = [](std::vector<double>& v, std::size_t size) {
+    v.resize(size);
+    parallelFor(0, size, [&](std::size_t i) { v[i] = 0.0; }, 1 << 14);
+  };
+  zeroed(cellMass_, cells);
+  for (int a = 0; a < 2; ++a) {
+    const std::size_t size = a == 0 ? xFaces : yFaces;
+    zeroed(faceMass_[a], size);
+    zeroed(faceFlow_[a], size);
+    zeroed(faceSpeed_[a], speeds ? size : 0);
+  }
+  bucketAgents(positions);
+
+  const double ox = grid_.origin.x(), oy = grid_.origin.y(), invDx = 1.0 / grid_.dx;
+  const std::size_t slabs = slabBegin_.size() - 1;
+  const std::size_t xStride = static_cast<std::size_t>(nx) + 1, yStride = static_cast<std::size_t>(nx);
+  for (std::size_t colour = 0; colour < 2; ++colour) {
+    tbb::parallel_for(std::size_t(0), (slabs + 1 - colour) / 2, [&](std::size_t j) {
+      const std::size_t slab = 2 * j + colour;
+      for (std::size_t k = slabBegin_[slab]; k < slabBegin_[slab + 1]; ++k) {
+        const std::uint32_t p = order_[k];
+        const double sx = (double(positions[p].x()) - ox) * invDx, sy = (double(positions[p].y()) - oy) * invDx;
+        const Taps cx(sx - 0.5, nx), cy(sy - 0.5, ny), fx(sx, nx + 1), fy(sy, ny + 1);
+        const double vx = preferredVelocities[p].x(), vy = preferredVelocities[p].y();
+        const double speed = maxSpeeds[p];
+        for (int b = 0; b < 2; ++b)
+          for (int c = 0; c < 2; ++c) {
+            const double wc = cy.w[b] * cx.w[c];
+            cellMass_[static_cast<std::size_t>(cy.at[b]) * yStride + cx.at[c]] += wc;
+            const std::size_t xi = static_cast<std::size_t>(cy.at[b]) * xStride + fx.at[c];
+            const double wx = cy.w[b] * fx.w[c];
+            faceMass_[0][xi] += wx;
+            faceFlow_[0][xi] += wx * vx;
+            const std::size_t yi = static_cast<std::size_t>(fy.at[b]) * yStride + cx.at[c];
+            const double wy = fy.w[b] * cx.w[c];
+            faceMass_[1][yi] += wy;
+            faceFlow_[1][yi] += wy * vy;
+            if (speeds) {
+              faceSpeed_[0][xi] += wx * speed;
+              faceSpeed_[1][yi] += wy * speed;
+            }
+          }
+      }
+    });
+  }
+
+  parallelFor(0, cells, [&](std::size_t i) { density_[i] = static_cast<float>(cellMass_[i]) * perArea; }, 1 << 14);
+  for (int a = 0; a < 2; ++a) {
+    auto& rho = faceDensity_.component(a);
+    auto& v = preferred_.component(a);
+    auto& vmax = speed_.component(a);
+    const auto& mass = faceMass_[a];
+    const auto& flow = faceFlow_[a];
+    const auto& speedSum = faceSpeed_[a];
+    const float common = static_cast<float>(fastest);
+    parallelFor(0, rho.count(), [&](std::size_t i) {
+      const double m = mass[i];
+      rho[i] = static_cast<float>(m) * perArea;
+      v[i] = m > 0.0 ? static_cast<float>(flow[i] / m) : 0.0f;
+      vmax[i] = speeds ? (m > 0.0 ? static_cast<float>(speedSum[i] / m) : 0.0f) : common;
+    }, 1 << 14);
+  }
+}
+
+// A of eq. 4.18: face weights rho_face dt / dx^2 on interior faces, walls (0) on the domain boundary.
+void UicProjection::buildStencil(double dt) {
+  const int nx = grid_.res.x(), ny = grid_.res.y();
+  const double c = dt / (grid_.dx * grid_.dx);
+  const double shift = settings_.regularization * settings_.rhoMax * c;
+  const auto& fx = faceDensity_.component(0);
+  const auto& fy = faceDensity_.component(1);
+  parallelForCells<2>(grid_.res, [&](const IVec2& cell, std::size_t k) {
+    const int i = cell.x(), j = cell.y();
+    const std::size_t xf = static_cast<std::size_t>(j) * (nx + 1) + i, yf = k;
+    const double wl = i > 0 ? fx[xf] * c : 0.0, wr = i + 1 < nx ? fx[xf + 1] * c : 0.0;
+    const double wb = j > 0 ? fy[yf] * c : 0.0, wt = j + 1 < ny ? fy[yf + nx] * c : 0.0;
+    lowerWeight_[0][k] = wl;
+    lowerWeight_[1][k] = wb;
+    const double sum = wl + wr + wb + wt;
+    excluded_[k] = sum == 0.0;
+    diagonal_[k] = sum == 0.0 ? 1.0 : sum + shift;
+  });
+  // Bounding box of the cells the QP needs (A_ii > 0); every cell outside it is excluded and, since
+  // excluded cells have only zero-weight faces, the box problem is exactly the full one restricted.
+  struct Box { int lo[2], hi[2]; };
+  const Box none{{nx, ny}, {-1, -1}};
+  const Box box = tbb::parallel_reduce(
+      tbb::blocked_range<int>(0, ny, 8), none,
+      [&](const tbb::blocked_range<int>& r, Box b) {
+        for (int j = r.begin(); j != r.end(); ++j) {
+          const std::uint8_t* row = &excluded_[static_cast<std::size_t>(j) * nx];
+          int first = 0, last = nx - 1;
+          while (first < nx && row[first]) ++first;
+          if (first == nx) continue;
+          while (row[last]) --last;
+          b.lo[0] = std::min(b.lo[0], first);
+          b.hi[0] = std::max(b.hi[0], last);
+          b.lo[1] = std::min(b.lo[1], j);
+          b.hi[1] = std::max(b.hi[1], j);
+        }
+        return b;
+      },
+      [](Box a, const Box& b) {
+        for (int d = 0; d < 2; ++d) {
+          a.lo[d] = std::min(a.lo[d], b.lo[d]);
+          a.hi[d] = std::max(a.hi[d], b.hi[d]);
+        }
+        return a;
+      });
+  boxEmpty_ = box.hi[0] < 0;
+  if (boxEmpty_) return;
+  boxOrigin_ = IVec2(box.lo[0], box.lo[1]);
+  boxRes_ = IVec2(box.hi[0] - box.lo[0] + 1, box.hi[1] - box.lo[1] + 1);
+  const std::size_t boxCells = static_cast<std::size_t>(boxRes_.x()) * boxRes_.y();
+  for (auto& w : boxLower_) w.resize(boxCells);
+  boxDiagonal_.resize(boxCells);
+  forBox([&](std::size_t local, std::size_t k) {
+    boxLower_[0][local] = lowerWeight_[0][k];
+    boxLower_[1][local] = lowerWeight_[1][k];
+    boxDiagonal_[local] = diagonal_[k];
+  });
+  operator_.assign(boxRes_, boxLower_, boxDiagonal_);
+  preconditioner_.assign(boxRes_, boxLower_, boxDiagonal_);
+}
+
+// Solver right-hand side: minus b of eq. 4.17 with sigma = f rho_max - rho (ch. 4.4.3); the
+// divergence is the flux sum of eq. 4.13 with no flux through the walls.
+void UicProjection::assembleRhs(const MacGrid<2>& u, double dt, bool clampSigma, Eigen::VectorXd& rhs) const {
+  const int nx = grid_.res.x(), ny = grid_.res.y();
+  const auto& rx = faceDensity_.component(0);
+  const auto& ry = faceDensity_.component(1);
+  const auto& ux = u.component(0);
+  const auto& uy = u.component(1);
+  const double rhoMax = settings_.rhoMax, dtOverDx = dt / grid_.dx;
+  parallelForCells<2>(grid_.res, [&](const IVec2& cell, std::size_t k) {
+    if (excluded_[k]) {
+      rhs[k] = 0.0;
+      return;
+    }
+    const int i = cell.x(), j = cell.y();
+    const std::size_t xf = static_cast<std::size_t>(j) * (nx + 1) + i;
+    const double left = i > 0 ? double(rx[xf]) * ux[xf] : 0.0;
+    const double right = i + 1 < nx ? double(rx[xf + 1]) * ux[xf + 1] : 0.0;
+    const double bottom = j > 0 ? double(ry[k]) * uy[k] : 0.0;
+    const double top = j + 1 < ny ? double(ry[k + nx]) * uy[k + nx] : 0.0;
+    double sigma = freeArea_[k] * rhoMax - density_[k];
+    if (clampSigma) sigma = std::max(sigma, 0.0);
+    rhs[k] = -(sigma + (right - left + top - bottom) * dtOverDx);
+  });
+}
+
+numerics::BoundQpResult UicProjection::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& p) {
+  parallelFor(0, excluded_.size(), [&](std::size_t k) {
+    if (excluded_[k]) p[k] = 0.0;
+  });
+  if (boxEmpty_) {  // no agents: p = 0 solves the (empty) problem
+    numerics::BoundQpResult none;
+    none.converged = true;
+    return none;
+  }
+  // The QP over the bounding box of the included cells, warm-started from p there.
+  const Eigen::Index boxCells = static_cast<Eigen::Index>(boxRes_.x()) * boxRes_.y();
+  boxRhs_.resize(boxCells);
+  boxPressure_.resize(boxCells);
+  forBox([&](std::size_t local, std::size_t k) {
+    boxRhs_[static_cast<Eigen::Index>(local)] = rhs[static_cast<Eigen::Index>(k)];
+    boxPressure_[static_cast<Eigen::Index>(local)] = p[static_cast<Eigen::Index>(k)];
+  });
+  numerics::BoundQpSettings qp;
+  const double norm = std::sqrt(parallelSum(static_cast<std::size_t>(boxCells), [&](std::size_t i) {
+    return boxRhs_[static_cast<Eigen::Index>(i)] * boxRhs_[static_cast<Eigen::Index>(i)];
+  }));
+  // Absolute density tolerance (see UicSettings::tolerance) expressed relative to ||b||.
+  qp.tolerance = norm > 0.0 ? settings_.tolerance * settings_.rhoMax / norm : 1.0;
+  qp.maxIterations = settings_.maxIterations;
+  const auto result = solver_.solve(operator_, boxRhs_, boxPressure_, qp, &preconditioner_);
+  forBox([&](std::size_t local, std::size_t k) {
+    p[static_cast<Eigen::Index>(k)] = boxPressure_[static_cast<Eigen::Index>(local)];
+  });
+  return result;
+}
+
+// psolve (eq. 4.5): u - grad p on the interior faces, zero normal velocity on the walls.
+void UicProjection::subtractGradient(const MacGrid<2>& u, const Eigen::VectorXd& p, MacGrid<2>& out) const {
+  const int nx = grid_.res.x();
+  const double invDx = 1.0 / grid_.dx;
+  for (int a = 0; a < 2; ++a) {
+    const auto& in = u.component(a);
+    auto& o = out.component(a);
+    const std::size_t stride = a == 0 ? 1 : static_cast<std::size_t>(nx);
+    parallelForCells<2>(o.size(), [&](const IVec2& f, std::size_t idx) {
+      if (f[a] == 0 || f[a] == grid_.res[a]) {
+        o[idx] = 0.0f;
+        return;
+      }
+      const std::size_t upper = static_cast<std::size_t>(f.y()) * nx + f.x();  // cell above/right of the face
+      o[idx] = static_cast<float>(in[idx] - (p[upper] - p[upper - stride]) * invDx);
+    });
+  }
+}
+
+// renorm (eq. 4.11): scale the face velocity vector to v_max on faces that carry agents. The
+// tangential component is the density-weighted mean of the four neighbouring faces of the other
+// axis, so a uniform field is reproduced exactly and empty faces do not bias it towards zero.
+void UicProjection::renorm(const MacGrid<2>& u, MacGrid<2>& out) const {
+  const int nx = grid_.res.x();
+  const float minFraction = static_cast<float>(settings_.renormMinFraction);
+  for (int a = 0; a < 2; ++a) {
+    const int b = 1 - a;
+    const auto& in = u.component(a);
+    const auto& rho = faceDensity_.component(a);
+    const auto& vmax = speed_.component(a);
+    const auto& other = u.component(b);
+    const auto& otherRho = faceDensity_.component(b);
+    auto& o = out.component(a);
+    parallelForCells<2>(o.size(), [&](const IVec2& f, std::size_t idx) {
+      if (f[a] == 0 || f[a] == grid_.res[a]) {
+        o[idx] = 0.0f;
+        return;
+      }
+      o[idx] = in[idx];
+      if (!(rho[idx] > 0.0f)) return;
+      // The other-axis faces of the two cells sharing this face: cells f - e_a and f, lower and
+      // upper face along b.
+      float wSum = 0.0f, wv = 0.0f;
+      for (int side = 0; side < 2; ++side)
+        for (int up = 0; up < 2; ++up) {
+          IVec2 g = f;
+          g[a] -= 1 - side;
+          g[b] += up;
+          const std::size_t gi = a == 0 ? static_cast<std::size_t>(g.y()) * nx + g.x()
+                                        : static_cast<std::size_t>(g.y()) * (nx + 1) + g.x();
+          wSum += otherRho[gi];
+          wv += otherRho[gi] * other[gi];
+        }
+      const float tangential = wSum > 0.0f ? wv / wSum : 0.0f;
+      const float speed = std::hypot(in[idx], tangential);
+      if (vmax[idx] > 0.0f && speed > minFraction * vmax[idx]) o[idx] = in[idx] * (vmax[idx] / speed);
+    });
+  }
+}
+
+// Density after one step with the final v (eq. 4.14) and the before/after ratio statistics.
+void UicProjection::predict(double dt) {
+  const int nx = grid_.res.x(), ny = grid_.res.y();
+  const auto& rx = faceDensity_.component(0);
+  const auto& ry = faceDensity_.component(1);
+  const auto& ux = velocity_.component(0);
+  const auto& uy = velocity_.component(1);
+  const double dtOverDx = dt / grid_.dx;
+  parallelForCells<2>(grid_.res, [&](const IVec2& cell, std::size_t k) {
+    const int i = cell.x(), j = cell.y();
+    const std::size_t xf = static_cast<std::size_t>(j) * (nx + 1) + i;
+    const double left = i > 0 ? double(rx[xf]) * ux[xf] : 0.0;
+    const double right = i + 1 < nx ? double(rx[xf + 1]) * ux[xf + 1] : 0.0;
+    const double bottom = j > 0 ? double(ry[k]) * uy[k] : 0.0;
+    const double top = j + 1 < ny ? double(ry[k + nx]) * uy[k + nx] : 0.0;
+    predicted_[k] = static_cast<float>(density_[k] - (right - left + top - bottom) * dtOverDx);
+  });
+  const double rhoMax = settings_.rhoMax;
+  auto ratio = [&](const Grid<float, 2>& rho) {
+    return parallelMax(rho.count(), [&](std::size_t k) {
+      return freeArea_[k] > 0.0f ? std::max(0.0, double(rho[k])) / (freeArea_[k] * rhoMax) : 0.0;
+    });
+  };
+  stats_.maxRatioBefore = ratio(density_);
+  stats_.maxRatioAfter = ratio(predicted_);
+}
+
+// Eq. 4.3 with the ratio rho / (f rho_max) formed per cell, clamped to [0, 1] (a fully covered
+// cell holding agents counts as saturated), and interpolated bilinearly to the agents.
+void UicProjection::agentVelocities(std::span<const Vec2f> positions, std::span<const Vec2f> preferredVelocities,
+                                    std::span<Vec2f> velocities) {
+  const float rhoMax = static_cast<float>(settings_.rhoMax);
+  parallelFor(0, ratio_.count(), [&](std::size_t k) {
+    const float cap = freeArea_[k] * rhoMax;
+    ratio_[k] = cap > 0.0f ? std::min(density_[k] / cap, 1.0f) : (density_[k] > 0.0f ? 1.0f : 0.0f);
+  });
+  // One pass over the agents: r from the cells, v from both face grids (bilinear, folded taps as
+  // in core/transfer.hpp's gather).
+  const int nx = grid_.res.x(), ny = grid_.res.y();
+  const double ox = grid_.origin.x(), oy = grid_.origin.y(), invDx = 1.0 / grid_.dx;
+  const float* rc = ratio_.data().data();
+  const float* ux = velocity_.component(0).data().data();
+  const float* uy = velocity_.component(1).data().data();
+  const std::size_t xStride = static_cast<std::size_t>(nx) + 1, yStride = static_cast<std::size_t>(nx);
+  parallelFor(0, positions.size(), [&](std::size_t i) {
+    const double sx = (double(positions[i].x()) - ox) * invDx, sy = (double(positions[i].y()) - oy) * invDx;
+    const Taps cx(sx - 0.5, nx), cy(sy - 0.5, ny), fx(sx, nx + 1), fy(sy, ny + 1);
+    double r = 0.0, vx = 0.0, vy = 0.0;
+    for (int b = 0; b < 2; ++b)
+      for (int c = 0; c < 2; ++c) {
+        r += cy.w[b] * cx.w[c] * rc[static_cast<std::size_t>(cy.at[b]) * yStride + cx.at[c]];
+        vx += cy.w[b] * fx.w[c] * ux[static_cast<std::size_t>(cy.at[b]) * xStride + fx.at[c]];
+        vy += fy.w[b] * cx.w[c] * uy[static_cast<std::size_t>(fy.at[b]) * yStride + cx.at[c]];
+      }
+    const float ratio = std::clamp(static_cast<float>(r), 0.0f, 1.0f);
+    const Vec2f flow(static_cast<float>(vx), static_cast<float>(vy));
+    velocities[i] = preferredVelocities[i] + ratio * (flow - preferredVelocities[i]);
+  }, 2048);
+}
+
+const UicStats& UicProjection::project(std::span<const Vec2f> positions, std::span<const Vec2f> preferredVelocities,
+                                       std::span<const float> maxSpeeds, const Grid<float, 2>& freeArea, double dt,
+                                       std::span<Vec2f> velocities) {
+  const auto start = Clock::now();
+  validate(positions, preferredVelocities, maxSpeeds, freeArea, dt, velocities);
+  stats_ = UicStats{};
+  std::copy(freeArea.data().begin(), freeArea.data().end(), freeArea_.data().begin());
+  splatAgents(positions, preferredVelocities, maxSpeeds);
+  stats_.splatSeconds = seconds(start);
+
+  const auto solveStart = Clock::now();
+  buildStencil(dt);
+  // Inner psolve with sigma^n clamped to >= 0 (the remark after eq. 4.20), then renorm.
+  assembleRhs(preferred_, dt, true, rhs_);
+  const auto inner = solve(rhs_, innerPressure_);
+  subtractGradient(preferred_, innerPressure_, inner_);
+  renorm(inner_, renormed_);
+  // Outer psolve on the renormalised velocities with the full sigma^n.
+  assembleRhs(renormed_, dt, false, rhs_);
+  const auto outer = solve(rhs_, outerPressure_);
+  subtractGradient(renormed_, outerPressure_, velocity_);
+  stats_.innerIterations = inner.iterations;
+  stats_.outerIterations = outer.iterations;
+  stats_.converged = inner.converged && outer.converged;
+  parallelFor(0, pressure_.count(), [&](std::size_t k) { pressure_[k] = static_cast<float>(outerPressure_[k]); });
+  stats_.activeCells = static_cast<int>(
+      parallelSum(pressure_.count(), [&](std::size_t k) { return outerPressure_[k] > 0.0 ? 1.0 : 0.0; }));
+  predict(dt);
+  stats_.solveSeconds = seconds(solveStart);
+
+  const auto agentStart = Clock::now();
+  agentVelocities(positions, preferredVelocities, velocities);
+  stats_.agentSeconds = seconds(agentStart);
+  stats_.totalSeconds = seconds(start);
+  return stats_;
+}
+
+}  // namespace msim::crowd

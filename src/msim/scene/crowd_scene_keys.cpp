@@ -1,0 +1,427 @@
+#include "msim/scene/crowd_scene_keys.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "msim/core/error.hpp"
+#include "msim/core/log.hpp"
+#include "msim/core/rng.hpp"
+#include "msim/crowd/direct_planner.hpp"
+#include "msim/crowd/navigation_field.hpp"
+#include "msim/crowd/roadmap.hpp"
+#include "msim/scene/json_vectors.hpp"
+#include "msim/scene/scene_file.hpp"
+
+namespace msim::scene {
+namespace {
+
+using nlohmann::json;
+using crowd::Polygon;
+
+// Planar regions: obstacles, goal regions, spawn and inflow regions.
+Schema regionSchema(std::string description, bool withPoint) {
+  Schema box = Schema::object("axis-aligned rectangle");
+  box.vector("min", "m", 2, "lower corner");
+  box.vector("max", "m", 2, "upper corner");
+  Schema circle = Schema::object("disc (a 32-sided polygon as an obstacle)");
+  circle.vector("center", "m", 2, "centre");
+  circle.number("radius", "m", "radius").min(0.0, Bound::Exclusive);
+  Schema polygon = Schema::object("simple polygon, vertices in order (either orientation)");
+  polygon.array("vertices", Schema::vectorItem("m", 2, "vertex"), "the corners").items(3);
+  Schema shape = Schema::variant(std::move(description));
+  if (withPoint) {
+    Schema point = Schema::object("a point; agents arrive within the radius");
+    point.vector("position", "m", 2, "the point");
+    point.number("radius", "m", 0.5, "arrival radius").min(0.0, Bound::Exclusive);
+    shape.alternative("point", std::move(point));
+  }
+  shape.alternative("box", std::move(box)).alternative("circle", std::move(circle)).alternative("polygon", std::move(polygon));
+  return shape;
+}
+
+void agentKeys(Schema& s) {
+  s.string("goal", "name of a goal in goals[], or 'opposite': the point mirrored through the group's region centre "
+                   "(each agent its own goal, as in the circle scene of Fig. 4.5)").required();
+  s.string("model", "uic", "uic: the continuum (ch. 4.4); orca: per-agent ORCA; scripted: walks 'waypoints'")
+      .choices({"uic", "orca", "scripted"});
+  s.number("radius", "m", 0.0, "body radius; 0 = crowd.agent.radius").min(0.0);
+  s.number("max_speed", "m/s", 0.0, "walking speed; 0 = crowd.agent.max_speed").min(0.0);
+}
+
+Schema crowdKeys() {
+  Schema c = Schema::object("dense crowds: agents with a continuum (Narain 2011, ch. 4)");
+  Schema agent = Schema::object("defaults for every agent");
+  agent.number("radius", "m", 0.25, "body radius; d_min = 2 radius between two agents").min(0.0, Bound::Exclusive);
+  agent.number("max_speed", "m/s", 1.4, "preferred walking speed (1.34 m/s: Weidmann 1993)").min(0.0, Bound::Exclusive);
+  c.field("agent", agent);
+  Schema uic = Schema::object("the unilateral incompressibility constraint (ch. 4.4)");
+  uic.boolean("enabled", true, "project the crowd flow (off: agents walk their preferred velocity, Fig. 4.3b)");
+  uic.number("packing", "", 0.64,
+             "alpha of eq. 4.4, the fraction of hexagonal close packing a crowd reaches; 0.64 = (1/1.25)^2 puts "
+             "neighbours 1.25 d_min apart at rho_max, the spacing the seed measured (ch. 4.5.1)").min(0.0, Bound::Exclusive).max(1.0);
+  uic.number("rho_max", "1/m^2", 0.0, "maximum density; 0 = eq. 4.4, 2 alpha / (sqrt(3) d_min^2)").min(0.0);
+  uic.number("tolerance", "", 5e-3, "QP tolerance: overdensity left per cell, relative to rho_max").min(0.0, Bound::Exclusive);
+  uic.integer("max_iterations", 500, "MPRGP iterations per solve").min(1);
+  c.field("uic", uic);
+  Schema col = Schema::object("pairwise collision resolution after each step (ch. 4.3.3)");
+  col.boolean("enabled", true, "push overlapping agents apart (off: Fig. 4.3c)");
+  col.number("separation", "", 1.2, "pairs closer than this x d_min are pushed to it (ch. 4.5.1: 'somewhat larger')").min(1.0).max(2.0);
+  col.integer("iterations", 12, "Jacobi sweeps per step").min(1).max(100);
+  c.field("collision_resolution", col);
+  Schema orca = Schema::object("ORCA agents (van den Berg et al. 2011)");
+  orca.number("neighbour_distance", "m", 3.0, "neighbours farther than this are ignored").min(0.0, Bound::Exclusive);
+  orca.integer("max_neighbours", 10, "closest neighbours considered").min(1);
+  orca.number("time_horizon", "s", 2.0, "avoid agents this far ahead in time").min(0.0, Bound::Exclusive);
+  orca.number("time_horizon_obstacles", "s", 1.0, "avoid obstacles this far ahead in time").min(0.0, Bound::Exclusive);
+  c.field("orca", orca);
+  Schema planner = Schema::object("global planning (ch. 4.3.1)");
+  planner.string("type", "auto", "auto: direct without obstacles, else navigation_field; roadmap: the seed's CDT roadmap")
+      .choices({"auto", "direct", "navigation_field", "roadmap"});
+  planner.number("cell_size", "m", 0.25, "navigation field cell").min(0.0, Bound::Exclusive);
+  c.field("planner", planner);
+  c.number("max_step", "s", 0.1, "longest time step").min(0.0, Bound::Exclusive);
+  c.number("grid_cfl", "", 0.5, "grid cells the fastest agent may cross in one step (eq. 4.14 is first order)")
+      .min(0.0, Bound::Exclusive);
+  c.integer("seed", 1, "random placement of agents (groups, inflows)").min(0);
+  c.string("colour_by", "speed", "colour of the agents in the pictures").choices({"speed", "density", "group"});
+  c.boolean("trajectories", true, "write trajectories.csv (frame,id,x,y,vx,vy)");
+  c.number("dense_fraction", "", 0.8, "'densest regions' of the nearest-neighbour metric: density >= this x rho_max")
+      .min(0.0)
+      .max(1.0);
+  return c;
+}
+
+Schema groupSchema() {
+  Schema g = Schema::object("agents placed at the start");
+  g.integer("count", "number of agents").min(1).required();
+  g.field("region", regionSchema("where they stand (uniformly at random, then relaxed apart)", false).required());
+  agentKeys(g);
+  g.array("waypoints", Schema::vectorItem("m", 2, "waypoint"),
+          "scripted agents: the path, relative to the region centre (each agent keeps its offset)");
+  g.boolean("loop", false, "scripted agents: start over after the last waypoint");
+  return g;
+}
+
+Schema inflowSchema() {
+  Schema f = Schema::object("agents entering at a steady rate");
+  f.field("region", regionSchema("where they appear", false).required());
+  f.number("rate", "1/s", "agents per second").min(0.0, Bound::Exclusive).required();
+  f.number("start", "s", 0.0, "first agent").min(0.0);
+  f.number("stop", "s", 1e30, "no agents after this").min(0.0);
+  agentKeys(f);
+  return f;
+}
+
+Polygon regionPolygon(const json& shape) {
+  const std::string type = shape.at("type").get<std::string>();
+  if (type == "box") return crowd::rectangle(sceneVector<2>(shape.at("min")), sceneVector<2>(shape.at("max")));
+  if (type == "circle") return crowd::regularPolygon(sceneVector<2>(shape.at("center")), shape.at("radius").get<double>(), 32);
+  Polygon p;
+  for (const json& v : shape.at("vertices")) p.vertices.push_back(sceneVector<2>(v));
+  return p;
+}
+
+Vec2 regionCentre(const json& shape, const Polygon& polygon) {
+  const std::string type = shape.at("type").get<std::string>();
+  if (type == "circle") return sceneVector<2>(shape.at("center"));
+  Vec2 lo, hi;
+  crowd::bounds(polygon, lo, hi);
+  return 0.5 * (lo + hi);
+}
+
+crowd::AgentModel modelOf(const std::string& name) {
+  if (name == "orca") return crowd::AgentModel::Orca;
+  if (name == "scripted") return crowd::AgentModel::Scripted;
+  return crowd::AgentModel::Uic;
+}
+
+struct Builder {
+  const Scene& scene;
+  const json& r;
+  std::string source;
+  CrowdSceneSetup out;
+  std::vector<std::string> goalNames;
+
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
+    throw InputError(fmt::format("{}: '{}' {}", source, key, what));
+  }
+
+  void requireInside(const Polygon& p, const std::string& key) const {
+    Vec2 lo, hi;
+    crowd::bounds(p, lo, hi);
+    if ((lo.array() < out.settings.lo.array() - 1e-9).any() || (hi.array() > out.settings.hi.array() + 1e-9).any())
+      fail(key, fmt::format("reaches outside the domain [{}, {}] x [{}, {}]", out.settings.lo.x(), out.settings.hi.x(),
+                            out.settings.lo.y(), out.settings.hi.y()));
+  }
+
+  void domainAndGrid() {
+    if (scene.dimensions != 2) fail("domain.min", "crowds are planar: give 2 numbers for domain.min and domain.max");
+    out.settings.lo = sceneVector<2>(r.at("domain").at("min"));
+    out.settings.grid = scene.gridSpec<2>();
+    out.settings.hi = out.settings.lo + out.settings.grid.extent();
+  }
+
+  void settings() {
+    const json& c = r.at("crowd");
+    const double radius = c.at("agent").at("radius").get<double>();
+    out.dMin = 2.0 * radius;
+    const json& u = c.at("uic");
+    out.settings.uic = u.at("enabled").get<bool>();
+    // Eq. 4.4: hexagonal close packing of discs of diameter d_min, scaled by alpha.
+    const double closePacking = 2.0 / (std::sqrt(3.0) * out.dMin * out.dMin);
+    double rhoMax = u.at("rho_max").get<double>();
+    if (rhoMax == 0.0) rhoMax = u.at("packing").get<double>() * closePacking;
+    if (rhoMax > closePacking * (1.0 + 1e-9))
+      fail("crowd.uic.rho_max", fmt::format("= {:.4g} agents/m^2 exceeds the hexagonal close packing 2/(sqrt(3) d_min^2) = "
+                                            "{:.4g} of agents of radius {} m (eq. 4.4): agents would have to overlap",
+                                            rhoMax, closePacking, radius));
+    if (rhoMax < 0.25 * closePacking)
+      logger().warn("{}: crowd.uic.rho_max = {:.3g} agents/m^2 is below a quarter of the close packing {:.3g} of agents "
+                    "of radius {} m: the crowd will jam far from contact",
+                    source, rhoMax, closePacking, radius);
+    out.settings.uicSettings.rhoMax = rhoMax;
+    out.settings.uicSettings.tolerance = u.at("tolerance").get<double>();
+    out.settings.uicSettings.maxIterations = u.at("max_iterations").get<int>();
+    const json& col = c.at("collision_resolution");
+    out.settings.collisionResolution = col.at("enabled").get<bool>();
+    out.settings.collision.separation = col.at("separation").get<float>();
+    out.settings.collision.iterations = col.at("iterations").get<int>();
+    const json& o = c.at("orca");
+    out.settings.orca.neighbourDist = o.at("neighbour_distance").get<float>();
+    out.settings.orca.maxNeighbours = o.at("max_neighbours").get<int>();
+    out.settings.orca.timeHorizon = o.at("time_horizon").get<float>();
+    out.settings.orca.timeHorizonObst = o.at("time_horizon_obstacles").get<float>();
+    out.settings.seed = c.at("seed").get<std::uint64_t>();
+    out.maxStep = c.at("max_step").get<double>();
+    out.gridCfl = c.at("grid_cfl").get<double>();
+    out.colourBy = c.at("colour_by").get<std::string>();
+    out.trajectories = c.at("trajectories").get<bool>();
+    out.denseFraction = c.at("dense_fraction").get<double>();
+  }
+
+  void obstacles() {
+    const json& list = r.at("obstacles");
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      const std::string key = fmt::format("obstacles[{}]", k);
+      Polygon p = regionPolygon(list[k].at("shape"));
+      crowd::validateSimple(p, fmt::format("{}: '{}.shape'", source, key));
+      requireInside(p, key + ".shape");
+      out.obstacles.push_back(std::move(p));
+    }
+  }
+
+  void goals() {
+    const json& list = r.at("goals");
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      const std::string key = fmt::format("goals[{}]", k);
+      const std::string name = list[k].at("name").get<std::string>();
+      if (name.empty() || name == "opposite") fail(key + ".name", "must be a non-empty name other than 'opposite'");
+      if (std::find(goalNames.begin(), goalNames.end(), name) != goalNames.end())
+        fail(key + ".name", fmt::format("'{}' names two goals", name));
+      crowd::Goal g;
+      g.exit = list[k].at("exit").get<bool>();
+      const json& shape = list[k].at("shape");
+      if (shape.at("type") == "point") {
+        g.point = sceneVector<2>(shape.at("position"));
+        g.arrivalRadius = shape.at("radius").get<double>();
+        requireInside(crowd::regularPolygon(g.point, 1e-6, 3), key + ".shape.position");
+      } else {
+        g.kind = crowd::Goal::Kind::Region;
+        g.region = regionPolygon(shape);
+        crowd::validateSimple(g.region, fmt::format("{}: '{}.shape'", source, key));
+        requireInside(g.region, key + ".shape");
+      }
+      goalNames.push_back(name);
+      out.goals.push_back(std::move(g));
+    }
+  }
+
+  std::uint32_t goalIndex(const json& entry, const std::string& key) const {
+    const std::string name = entry.at("goal").get<std::string>();
+    const auto it = std::find(goalNames.begin(), goalNames.end(), name);
+    if (it == goalNames.end()) {
+      std::string known;
+      for (const auto& n : goalNames) known += (known.empty() ? "'" : ", '") + n + "'";
+      fail(key + ".goal", fmt::format("names no goal: '{}' (goals: {}; or 'opposite')", name,
+                                      known.empty() ? std::string("none") : known));
+    }
+    return static_cast<std::uint32_t>(it - goalNames.begin());
+  }
+
+  crowd::AgentSpec agentSpec(const json& entry, std::uint32_t group) const {
+    const json& c = r.at("crowd").at("agent");
+    crowd::AgentSpec a;
+    a.model = modelOf(entry.at("model").get<std::string>());
+    const double radius = entry.at("radius").get<double>();
+    const double speed = entry.at("max_speed").get<double>();
+    a.radius = static_cast<float>(radius > 0.0 ? radius : c.at("radius").get<double>());
+    a.maxSpeed = static_cast<float>(speed > 0.0 ? speed : c.at("max_speed").get<double>());
+    a.group = group;
+    return a;
+  }
+
+  // Uniform random points in the region, outside every obstacle.
+  Vec2 randomPoint(Rng& rng, const Polygon& region, const std::string& key) const {
+    Vec2 lo, hi;
+    crowd::bounds(region, lo, hi);
+    for (int attempt = 0; attempt < 100000; ++attempt) {
+      const Vec2 x(rng.uniform(lo.x(), hi.x()), rng.uniform(lo.y(), hi.y()));
+      if (!crowd::contains(region, x)) continue;
+      bool free = true;
+      for (const Polygon& o : out.obstacles) free = free && !crowd::contains(o, x);
+      if (free) return x;
+    }
+    fail(key, "has no free room: it lies inside obstacles");
+  }
+
+  void groups() {
+    const json& list = r.at("groups");
+    Rng rng(out.settings.seed);
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      const json& g = list[k];
+      const std::string key = fmt::format("groups[{}]", k);
+      const Polygon region = regionPolygon(g.at("region"));
+      crowd::validateSimple(region, fmt::format("{}: '{}.region'", source, key));
+      requireInside(region, key + ".region");
+      const crowd::AgentSpec base = agentSpec(g, static_cast<std::uint32_t>(k));
+      const long long count = g.at("count").get<long long>();
+      // The group must fit at the maximum density, or the crowd starts overlapping for good.
+      const double area = std::abs(crowd::signedArea(region));
+      const double capacity = area * out.settings.uicSettings.rhoMax;
+      if (static_cast<double>(count) > capacity)
+        fail(key + ".count", fmt::format("= {} agents do not fit in the region's {:.4g} m^2 at rho_max = {:.3g} agents/m^2 "
+                                         "(at most {:.0f})", count, area, out.settings.uicSettings.rhoMax, capacity));
+      const bool opposite = g.at("goal").get<std::string>() == "opposite";
+      const bool scripted = base.model == crowd::AgentModel::Scripted;
+      if (scripted && g.at("waypoints").empty()) fail(key + ".waypoints", "scripted agents need at least one waypoint");
+      if (!scripted && !g.at("waypoints").empty()) fail(key + ".waypoints", "only scripted agents follow waypoints");
+      const std::uint32_t goal = opposite ? 0 : goalIndex(g, key);
+      const Vec2 centre = regionCentre(g.at("region"), region);
+      Rng groupRng = rng.split(k);
+      for (long long n = 0; n < count; ++n) {
+        crowd::AgentSpec a = base;
+        const Vec2 x = randomPoint(groupRng, region, key + ".region");
+        a.position = x.cast<float>();
+        a.goal = goal;
+        if (opposite && !scripted) {
+          crowd::Goal mirrored;
+          mirrored.point = 2.0 * centre - x;
+          mirrored.arrivalRadius = 0.1;
+          a.goal = static_cast<std::uint32_t>(out.goals.size());
+          out.goals.push_back(mirrored);
+        }
+        const std::size_t i = out.agents.add(a);
+        if (scripted) {
+          crowd::Script s;
+          s.agentId = out.agents.id[i];
+          for (const json& w : g.at("waypoints")) s.waypoints.push_back(sceneVector<2>(w) + (x - centre) + centre);
+          s.loop = g.at("loop").get<bool>();
+          out.scripts.push_back(std::move(s));
+        }
+      }
+    }
+  }
+
+  void inflows() {
+    const json& list = r.at("inflows");
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      const json& f = list[k];
+      const std::string key = fmt::format("inflows[{}]", k);
+      crowd::Inflow in;
+      in.region = regionPolygon(f.at("region"));
+      crowd::validateSimple(in.region, fmt::format("{}: '{}.region'", source, key));
+      requireInside(in.region, key + ".region");
+      in.rate = f.at("rate").get<double>();
+      in.start = f.at("start").get<double>();
+      in.stop = f.at("stop").get<double>();
+      if (in.stop <= in.start) fail(key + ".stop", "must come after 'start'");
+      in.agent = agentSpec(f, static_cast<std::uint32_t>(r.at("groups").size() + k));
+      if (in.agent.model == crowd::AgentModel::Scripted) fail(key + ".model", "inflow agents cannot be scripted");
+      if (f.at("goal").get<std::string>() == "opposite") fail(key + ".goal", "inflow agents need a named goal");
+      in.agent.goal = goalIndex(f, key);
+      out.inflows.push_back(std::move(in));
+    }
+  }
+
+  void lines() {
+    const json& list = r.at("measurement_lines");
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      CrowdMeasurementLine l;
+      l.name = list[k].at("name").get<std::string>();
+      l.from = sceneVector<2>(list[k].at("from"));
+      l.to = sceneVector<2>(list[k].at("to"));
+      if ((l.to - l.from).norm() <= 0.0) fail(fmt::format("measurement_lines[{}]", k), "has zero length");
+      out.lines.push_back(std::move(l));
+    }
+  }
+
+  void planner() {
+    std::string type = r.at("crowd").at("planner").at("type").get<std::string>();
+    if (type == "auto") type = out.obstacles.empty() ? "direct" : "navigation_field";
+    out.plannerName = type;
+    const std::size_t named = goalNames.size();
+    if (type == "direct") {
+      if (!out.obstacles.empty())
+        logger().warn("{}: crowd.planner.type = 'direct' walks straight at goals through {} obstacles; agents will "
+                      "press against them", source, out.obstacles.size());
+      out.planner = std::make_shared<crowd::DirectPlanner>(out.goals);
+      return;
+    }
+    if (out.goals.size() > named)
+      fail("crowd.planner.type", fmt::format("'{}' plans for a few shared goals, but groups with goal 'opposite' give every "
+                                             "agent its own; use 'direct' (scenes without obstacles)", type));
+    if (type == "roadmap") {
+      crowd::RoadmapOptions o;
+      o.lo = out.settings.lo;
+      o.hi = out.settings.hi;
+      out.planner = std::make_shared<crowd::Roadmap>(out.goals, out.obstacles, o);
+      return;
+    }
+    crowd::NavigationFieldOptions o;
+    o.lo = out.settings.lo;
+    o.hi = out.settings.hi;
+    o.cellSize = r.at("crowd").at("planner").at("cell_size").get<double>();
+    o.clearance = r.at("crowd").at("agent").at("radius").get<double>();
+    out.planner = std::make_shared<crowd::NavigationField>(out.goals, out.obstacles, o);
+  }
+};
+
+}  // namespace
+
+void declareCrowdKeys(Schema& root) {
+  root.field("crowd", crowdKeys());
+  Schema goal = Schema::object("a place agents walk to");
+  goal.string("name", "referred to by groups[].goal and inflows[].goal").required();
+  goal.field("shape", regionSchema("the goal: a point or a region", true).required());
+  goal.boolean("exit", false, "agents that arrive leave the scene (evacuations)");
+  root.array("goals", goal, "destinations");
+  Schema obstacle = Schema::object("static obstacle");
+  obstacle.field("shape", regionSchema("its outline", false).required());
+  root.array("obstacles", obstacle, "walls, pillars, stands: polygons agents walk around");
+  root.array("groups", groupSchema(), "agents placed at t = 0");
+  root.array("inflows", inflowSchema(), "agents entering during the run (Fig. 4.6)");
+  Schema line = Schema::object("a line counting the agents that cross it");
+  line.string("name", "line", "column name in run.json and stats.csv");
+  line.vector("from", "m", 2, "one end");
+  line.vector("to", "m", 2, "other end; crossings to the left of from->to count positive");
+  root.array("measurement_lines", line, "flow measurement (agents/s and agents/(m s))");
+}
+
+CrowdSceneSetup buildCrowdScene(const Scene& scene) {
+  Builder b{scene, scene.resolved, scene.file.string(), {}, {}};
+  b.domainAndGrid();
+  b.settings();
+  b.obstacles();
+  b.goals();
+  b.groups();
+  b.inflows();
+  b.lines();
+  b.out.groupCount = scene.resolved.at("groups").size() + scene.resolved.at("inflows").size();
+  if (b.out.agents.empty() && b.out.inflows.empty())
+    throw InputError(b.source + ": the scene has no agents: add 'groups' or 'inflows'");
+  b.planner();
+  return std::move(b.out);
+}
+
+}  // namespace msim::scene

@@ -1,0 +1,180 @@
+// The "crowd" phenomenon end to end: the seed's validation (Narain 2011, ch. 4.5.1: nearest-neighbour
+// spacing in the circle scene; Fig. 4.3: UIC and pairwise resolution are both needed at a doorway),
+// the outputs a run writes, --resume, and bad input that names its key.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_harness.hpp"
+#include "msim/io/csv.hpp"
+#include "msim/io/vdb.hpp"
+
+namespace {
+
+using nlohmann::json;
+
+json readJson(const fs::path& file) {
+  std::ifstream in(file);
+  return json::parse(in);
+}
+
+json runScene(const std::string& name, const std::string& sceneFile, const std::string& extra) {
+  const fs::path dir = scratch(name);
+  const Result r = runMsim("run " + sceneFile + " -q --out " + (dir / "out").string() + " " + extra);
+  EXPECT_EQ(r.exitCode, 0) << r.output;
+  return r.exitCode == 0 ? readJson(dir / "out" / "run.json") : json::object();
+}
+
+// Fig. 4.3: a 20 m room whose right wall has a 1.2 m door; 400 agents head for an exit behind it.
+std::string doorway(const std::string& extra = "") {
+  return R"({
+  "name": "door", "phenomenon": "crowd",
+  "domain": {"min": [0, 0], "max": [20, 20], "resolution": 40},
+  "time": {"duration": 20, "fps": 2},
+  "goals": [{"name": "out", "shape": {"type": "box", "min": [17, 7], "max": [20, 13]}, "exit": true}],
+  "obstacles": [{"shape": {"type": "box", "min": [15, 0], "max": [15.5, 9.4]}},
+                {"shape": {"type": "box", "min": [15, 10.6], "max": [15.5, 20]}}],
+  "groups": [{"count": 400, "region": {"type": "box", "min": [1, 1], "max": [14, 19]}, "goal": "out"}],
+  "outputs": {"mp4": false, "vdb": false, "png": false}, "crowd": {"trajectories": false})" +
+         extra + "}\n";
+}
+
+double doorwayOverlapFraction(const std::string& name, const std::string& variant) {
+  const fs::path dir = scratch(name);
+  writeText(dir / "s.json", doorway());
+  const Result r = runMsim("run " + (dir / "s.json").string() + " -q --out " + (dir / "out").string() + " " + variant);
+  EXPECT_EQ(r.exitCode, 0) << r.output;
+  if (r.exitCode != 0) return -1.0;
+  return readJson(dir / "out" / "run.json").at("results").at("nearest_neighbour").at("fraction_closer_than_dmin").get<double>();
+}
+
+}  // namespace
+
+TEST(CrowdCli, CircleKeepsTheSeedsSpacing) {
+  // Fig. 4.5, 10,000 agents on 40 x 40 cells, the first 30 s (they meet in the middle at ~15 s).
+  const json run = runScene("crowd_circle", std::string(MSIM_SOURCE_DIR) + "/scenes/crowd_circle.json",
+                            "--frames 150 --set outputs.png=false --set outputs.vdb=false --set outputs.mp4=false "
+                            "--set crowd.trajectories=false");
+  ASSERT_TRUE(run.contains("results"));
+  const json& nn = run.at("results").at("nearest_neighbour");
+  const double closer = nn.at("fraction_closer_than_dmin").get<double>();
+  const double spacing = nn.at("dense_mean_distance_over_dmin").get<double>();
+  std::printf("circle: %.4f%% of agent-frames closer than d_min (seed < 0.12%%), mean nearest distance in dense "
+              "regions %.3f d_min (seed 1.25) over %.0f dense agent-frames\n",
+              100 * closer, spacing, nn.at("dense_agent_frames").get<double>());
+  EXPECT_LT(closer, 0.005);
+  EXPECT_GT(spacing, 1.1);
+  EXPECT_LT(spacing, 1.35);
+  // The crowd did get dense, and the continuum kept the grid density at f rho_max (within 5%).
+  EXPECT_GT(nn.at("dense_agent_frames").get<double>(), 0.5 * nn.at("agent_frames").get<double>());
+  double worst = 0.0;
+  for (const json& f : run.at("frames")) worst = std::max(worst, f.at("uic_density_ratio_max").get<double>());
+  EXPECT_LE(worst, 1.05);
+  EXPECT_GT(worst, 0.95);
+}
+
+TEST(CrowdCli, DoorwayNeedsBothUicAndPairwiseResolution) {
+  // Fig. 4.3 (a) both, (b) without UIC, (c) without collision resolution: agents overlap unless both act.
+  const double both = doorwayOverlapFraction("door_both", "");
+  const double noUic = doorwayOverlapFraction("door_no_uic", "--set crowd.uic.enabled=false");
+  const double noResolution =
+      doorwayOverlapFraction("door_no_resolution", "--set crowd.collision_resolution.enabled=false");
+  std::printf("doorway: agent-frames closer than d_min: both %.3f%%, without UIC %.1f%%, without resolution %.1f%%\n",
+              100 * both, 100 * noUic, 100 * noResolution);
+  EXPECT_LT(both, 0.005);
+  EXPECT_GT(noUic, 0.05);
+  EXPECT_GT(noResolution, 0.05);
+}
+
+TEST(CrowdCli, RunWritesAgentsTrajectoriesPlotsAndFlows) {
+  const fs::path dir = scratch("crowd_outputs");
+  writeText(dir / "s.json", R"({
+  "name": "hall", "phenomenon": "crowd",
+  "domain": {"min": [0, 0], "max": [30, 20], "resolution": 30},
+  "time": {"duration": 4, "fps": 5},
+  "goals": [{"name": "east", "shape": {"type": "box", "min": [27, 0], "max": [30, 20]}, "exit": true},
+            {"name": "corner", "shape": {"type": "point", "position": [2, 18], "radius": 0.5}}],
+  "obstacles": [{"shape": {"type": "polygon", "vertices": [[14, 8], [16, 8], [16, 12], [14, 12]]}}],
+  "groups": [{"count": 60, "region": {"type": "box", "min": [2, 2], "max": [10, 18]}, "goal": "east"},
+             {"count": 20, "region": {"type": "circle", "center": [22, 10], "radius": 3}, "goal": "corner",
+              "model": "orca"}],
+  "inflows": [{"region": {"type": "box", "min": [0.5, 0.5], "max": [2, 19.5]}, "rate": 5, "goal": "east"}],
+  "measurement_lines": [{"name": "mid", "from": [12, 0], "to": [12, 20]}],
+  "outputs": {"mp4": false}
+})");
+  const Result r = runMsim("run " + (dir / "s.json").string() + " -q --out " + (dir / "out").string());
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  const fs::path out = dir / "out";
+  const json run = readJson(out / "run.json");
+  ASSERT_EQ(run.at("frames").size(), 20u);
+  // Inflow at 5 agents/s for 4 s: exactly 20 spawned (fractional credit carried between steps).
+  EXPECT_EQ(run.at("frames").back().at("spawned_total").get<int>(), 20);
+  // Agents as VDB points with their attributes, and the continuum's grids.
+  const auto points = msim::io::readPoints(out / "vdb" / "hall_0020.vdb", "agents");
+  EXPECT_EQ(static_cast<double>(points.positions.size()), run.at("frames").back().at("agents").get<double>());
+  for (const char* a : {"id", "vx", "vy", "radius", "max_speed", "goal", "group", "model"})
+    EXPECT_NE(points.find(a), nullptr) << a;
+  const auto grids = msim::io::listVdbGrids(out / "vdb" / "hall_0020.vdb");
+  for (const char* g : {"density", "pressure", "free_area"})
+    EXPECT_NE(std::find(grids.begin(), grids.end(), g), grids.end()) << g;
+  // One trajectory row per agent and frame.
+  const auto table = msim::io::readCsv(out / "trajectories.csv");
+  EXPECT_EQ(table.columns, (std::vector<std::string>{"frame", "id", "x", "y", "vx", "vy"}));
+  double agentFrames = 0;
+  for (const json& f : run.at("frames")) agentFrames += f.at("agents").get<double>();
+  EXPECT_EQ(static_cast<double>(table.rows.size()), agentFrames);
+  EXPECT_TRUE(fs::exists(out / "trajectories" / "frame_00020.csv"));  // per-frame parts, kept for --resume
+  for (const char* f : {"png/hall_0020.png", "fundamental_diagram.png", "time_series.png", "stats.csv"})
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+  // The crowd walked east through the measurement line.
+  EXPECT_GT(run.at("results").at("measurement_lines").at("mid").at("net_crossings").get<double>(), 0.0);
+  EXPECT_FALSE(run.at("results").at("fundamental_diagram").empty());
+}
+
+TEST(CrowdCli, ResumeContinuesFromTheLastCompleteFrame) {
+  const fs::path dir = scratch("crowd_resume");
+  writeText(dir / "s.json", replaced(doorway(), R"("outputs": {"mp4": false, "vdb": false, "png": false}, "crowd": {"trajectories": false})",
+                                     R"("outputs": {"mp4": false}, "inflows": [{"region": {"type": "box", "min": [1, 1], "max": [3, 19]}, "rate": 3, "goal": "out"}])"));
+  const std::string run = "run " + (dir / "s.json").string() + " -q --out " + (dir / "out").string();
+  ASSERT_EQ(runMsim(run + " --frames 6").exitCode, 0);
+  const Result resumed = runMsim(run + " --resume");
+  ASSERT_EQ(resumed.exitCode, 0) << resumed.output;
+  const json record = readJson(dir / "out" / "run.json");
+  ASSERT_EQ(record.at("frames").size(), 40u);
+  // The inflow keeps its pace across the resume: 3 agents/s over 20 s.
+  EXPECT_EQ(record.at("frames").back().at("spawned_total").get<int>(), 60);
+  const auto table = msim::io::readCsv(dir / "out" / "trajectories.csv");
+  double agentFrames = 0;
+  for (const json& f : record.at("frames")) agentFrames += f.at("agents").get<double>();
+  EXPECT_EQ(static_cast<double>(table.rows.size()), agentFrames);
+}
+
+TEST(CrowdCli, BadInputNamesTheKey) {
+  expectInputError("crowd_3d",
+                   replaced(doorway(), R"("min": [0, 0], "max": [20, 20], "resolution")",
+                            R"("min": [0, 0, 0], "max": [20, 20, 20], "resolution")"),
+                   {"crowds are planar"});
+  expectInputError("crowd_region_outside", replaced(doorway(), "[1, 1], \"max\": [14, 19]", "[1, 1], \"max\": [24, 19]"),
+                   {"groups[0].region", "outside the domain"});
+  expectInputError("crowd_inside_obstacle",
+                   replaced(doorway(), R"("count": 400, "region": {"type": "box", "min": [1, 1], "max": [14, 19]})",
+                            R"("count": 3, "region": {"type": "box", "min": [15.1, 1], "max": [15.4, 9]})"),
+                   {"groups[0].region", "inside obstacles"});
+  expectInputError("crowd_self_intersecting",
+                   replaced(doorway(), R"({"type": "box", "min": [15, 0], "max": [15.5, 9.4]})",
+                            R"({"type": "polygon", "vertices": [[15, 0], [15.5, 9], [15.5, 0], [15, 4]]})"),
+                   {"obstacles[0]", "edges 0 and 2 intersect"});
+  expectInputError("crowd_rho_max", doorway(R"(, "crowd": {"uic": {"rho_max": 6.0}})"),
+                   {"crowd.uic.rho_max", "close packing"});
+  expectInputError("crowd_unknown_goal", replaced(doorway(), R"("goal": "out")", R"("goal": "exit")"),
+                   {"groups[0].goal", "'exit'"});
+  // A goal walled in on all four sides cannot be reached from the room.
+  expectInputError("crowd_unreachable",
+                   replaced(doorway(), R"("obstacles": [)",
+                            R"("obstacles": [{"shape": {"type": "box", "min": [16.5, 6.5], "max": [20, 7]}},
+                                {"shape": {"type": "box", "min": [16.5, 13], "max": [20, 13.5]}},
+                                {"shape": {"type": "box", "min": [16.5, 7], "max": [17, 13]}},)"),
+                   {"cannot be reached"});
+  expectInputError("crowd_too_many", replaced(doorway(), R"("count": 400)", R"("count": 4000)"),
+                   {"groups[0].count", "do not fit"});
+}
