@@ -4,6 +4,10 @@
 #include <cmath>
 #include <limits>
 
+#if defined(__AVX2__)
+#include <immintrin.h>
+#endif
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
 
@@ -138,17 +142,20 @@ Vec2f StaticObstacles::pushOut(Vec2f p, float radius) const {
   return p;
 }
 
-void CollisionResolver::bucket(std::span<const Vec2f> position, const Agents& agents, float cellSize) {
-  grid_.build(position, cellSize);
+constexpr std::size_t kPad = 8;
+
+void CollisionResolver::bucket(const Agents& agents, float cellSize) {
+  grid_.build(agents.position, cellSize);
   ++bucketings_;
-  const std::size_t n = position.size();
+  const std::size_t n = agents.size();
   const std::span<const std::uint32_t> order = grid_.cellOrder();
   const std::span<const Vec2f> sorted = grid_.sortedPoints();
-  current_.resize(n);
-  next_.resize(n);
+  // Padding: far away (the squared distance overflows to inf), so never within range.
+  for (auto* v : {&x_, &y_, &nextX_, &nextY_}) v->resize(n + kPad, 1e30f);
+  for (auto* v : {&radius_, &yield_, &tmpRadius_, &tmpYield_}) v->resize(n + kPad, 0.0f);
   bucketed_.resize(n);
-  radius_.resize(n);
   scripted_.resize(n);
+  agent_.resize(n);
   const std::size_t cells = static_cast<std::size_t>(grid_.cellsX()) * grid_.cellsY();
   moved_.resize(cells);
   movedNext_.resize(cells);
@@ -156,12 +163,117 @@ void CollisionResolver::bucket(std::span<const Vec2f> position, const Agents& ag
       0, n,
       [&](std::size_t k) {
         const std::uint32_t i = order[k];
-        current_[k] = bucketed_[k] = sorted[k];
+        agent_[k] = i;
+        bucketed_[k] = sorted[k];
+        x_[k] = sorted[k].x();
+        y_[k] = sorted[k].y();
         radius_[k] = agents.radius[i];
         scripted_[k] = agents.model[i] == AgentModel::Scripted ? 1 : 0;
+        yield_[k] = scripted_[k] ? 1.0f : 0.5f;
       },
       4096);
 }
+
+void CollisionResolver::rebucket(float cellSize) {
+  // The slots are already roughly in cell order, so re-sorting them reads nearby memory, unlike
+  // a gather from the agents (age order).
+  const std::size_t n = agent_.size();
+  points_.resize(n);
+  parallelFor(
+      0, n, [&](std::size_t k) { points_[k] = Vec2f(x_[k], y_[k]); }, 4096);
+  grid_.build(points_, cellSize);
+  ++bucketings_;
+  const std::span<const std::uint32_t> from = grid_.cellOrder();
+  const std::span<const Vec2f> sorted = grid_.sortedPoints();
+  tmpScripted_.resize(n);
+  tmpAgent_.resize(n);
+  const std::size_t cells = static_cast<std::size_t>(grid_.cellsX()) * grid_.cellsY();
+  moved_.resize(cells);
+  movedNext_.resize(cells);
+  parallelFor(
+      0, n,
+      [&](std::size_t k) {
+        const std::uint32_t old = from[k];
+        bucketed_[k] = sorted[k];
+        x_[k] = sorted[k].x();
+        y_[k] = sorted[k].y();
+        tmpRadius_[k] = radius_[old];
+        tmpYield_[k] = yield_[old];
+        tmpScripted_[k] = scripted_[old];
+        tmpAgent_[k] = agent_[old];
+      },
+      4096);
+  radius_.swap(tmpRadius_);
+  yield_.swap(tmpYield_);
+  scripted_.swap(tmpScripted_);
+  agent_.swap(tmpAgent_);
+}
+
+namespace {
+
+// Sum over j in [lo, hi), j != k, of the push on agent k (at xi, radius ri) from agent j:
+// yield[j] * (target - dist) along (x_i - x_j) / dist for pairs closer than target = s (r_i + r_j).
+// Pairs closer than 1e-7 target (coincident) are counted in `coincident`, not pushed. The same
+// arithmetic for (k, j) and (j, k) up to the sign of the difference: pushes are equal and opposite.
+inline void pushScalar(const float* xs, const float* ys, const float* rad, const float* yield, std::uint32_t lo,
+                       std::uint32_t hi, std::uint32_t k, float xi, float yi, float ri, float s, float& dx, float& dy,
+                       int& coincident) {
+  for (std::uint32_t j = lo; j < hi; ++j) {
+    const float ex = xi - xs[j], ey = yi - ys[j];
+    const float target = s * (ri + rad[j]);
+    const float d2 = ex * ex + ey * ey;
+    const float t2 = target * target;
+    if (d2 >= t2 || j == k) continue;
+    if (!(d2 > 1e-14f * t2)) {
+      ++coincident;
+      continue;
+    }
+    const float dist = std::sqrt(d2);
+    const float f = yield[j] * (target - dist) / dist;
+    dx += f * ex;
+    dy += f * ey;
+  }
+}
+
+#if defined(__AVX2__)
+// pushScalar, eight neighbours at a time (reads up to 7 slots past hi, masked off).
+inline void pushAvx(const float* xs, const float* ys, const float* rad, const float* yield, std::uint32_t lo,
+                    std::uint32_t hi, std::uint32_t k, float xi, float yi, float ri, float s, __m256& ax, __m256& ay,
+                    int& close) {
+  const __m256 xv = _mm256_set1_ps(xi), yv = _mm256_set1_ps(yi), rv = _mm256_set1_ps(ri), sv = _mm256_set1_ps(s);
+  const __m256 eps = _mm256_set1_ps(1e-14f);
+  const __m256i hiv = _mm256_set1_epi32(static_cast<int>(hi)), kv = _mm256_set1_epi32(static_cast<int>(k));
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  for (std::uint32_t j = lo; j < hi; j += 8) {
+    // Lanes in range, other than k itself.
+    const __m256i idx = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int>(j)), lane);
+    const __m256 valid = _mm256_castsi256_ps(
+        _mm256_andnot_si256(_mm256_cmpeq_epi32(idx, kv), _mm256_cmpgt_epi32(hiv, idx)));
+    const __m256 ex = _mm256_sub_ps(xv, _mm256_loadu_ps(xs + j));
+    const __m256 ey = _mm256_sub_ps(yv, _mm256_loadu_ps(ys + j));
+    const __m256 d2 = _mm256_add_ps(_mm256_mul_ps(ex, ex), _mm256_mul_ps(ey, ey));
+    const __m256 target = _mm256_mul_ps(sv, _mm256_add_ps(rv, _mm256_loadu_ps(rad + j)));
+    const __m256 t2 = _mm256_mul_ps(target, target);
+    const __m256 in = _mm256_and_ps(valid, _mm256_cmp_ps(d2, t2, _CMP_LT_OQ));
+    if (_mm256_testz_ps(in, in)) continue;
+    const __m256 apart = _mm256_cmp_ps(d2, _mm256_mul_ps(eps, t2), _CMP_GT_OQ);
+    close += __builtin_popcount(static_cast<unsigned>(_mm256_movemask_ps(_mm256_andnot_ps(apart, in))));
+    const __m256 dist = _mm256_sqrt_ps(d2);
+    const __m256 f = _mm256_div_ps(_mm256_mul_ps(_mm256_loadu_ps(yield + j), _mm256_sub_ps(target, dist)), dist);
+    const __m256 m = _mm256_and_ps(in, apart);
+    ax = _mm256_add_ps(ax, _mm256_and_ps(m, _mm256_mul_ps(f, ex)));
+    ay = _mm256_add_ps(ay, _mm256_and_ps(m, _mm256_mul_ps(f, ey)));
+  }
+}
+
+inline float sum8(__m256 v) {
+  alignas(32) float l[8];
+  _mm256_store_ps(l, v);
+  return ((l[0] + l[1]) + (l[2] + l[3])) + ((l[4] + l[5]) + (l[6] + l[7]));
+}
+#endif
+
+}  // namespace
 
 void CollisionResolver::resolve(Agents& agents, const StaticObstacles& obstacles, const DomainBox& domain,
                                 const CollisionResolutionParams& params) {
@@ -175,24 +287,28 @@ void CollisionResolver::resolve(Agents& agents, const StaticObstacles& obstacles
   // agents may move a little before the buckets have to be redone.
   const float range = s * 2.0f * rmax;
   constexpr float kSkin = 0.3f;
-  bucket(agents.position, agents, range * (1.0f + kSkin));
-  int bucketedAt = 0;         // the first sweep on the current buckets
+  bucket(agents, range * (1.0f + kSkin));
+  int bucketedAt = 0;           // the first sweep on the current buckets
   float movedSinceBucket2 = 0;  // largest squared displacement since then
 
   for (int it = 0; it < params.iterations; ++it) {
     const int nx = grid_.cellsX(), ny = grid_.cellsY();
-    const std::span<const std::uint32_t> order = grid_.cellOrder();
-    const Vec2f* cur = current_.data();
-    Vec2f* next = next_.data();
+    const std::uint32_t* agent = agent_.data();
+    const float* xs = x_.data();
+    const float* ys = y_.data();
+    float* nextX = nextX_.data();
+    float* nextY = nextY_.data();
     const Vec2f* bucketed = bucketed_.data();
     const float* rad = radius_.data();
+    const float* yield = yield_.data();
     const std::uint8_t* scripted = scripted_.data();
     const std::uint8_t* moved = moved_.data();
     std::uint8_t* movedNext = movedNext_.data();
     const bool everything = it == bucketedAt;  // no earlier sweep on these buckets to compare with
 
-    // The agents of one cell: next from cur. Their neighbours are the three contiguous slot ranges
-    // of the stencil. worst: the largest squared displacement since bucketing of those that move.
+    // The agents of one cell: next from current positions. Their neighbours are the three
+    // contiguous slot ranges of the stencil. worst: the largest squared displacement since
+    // bucketing of those that move.
     auto sweepCell = [&](std::uint32_t first, std::uint32_t last, const NeighbourGrid::Stencil& st, float& worst) {
       // Nothing in the stencil moved in the last sweep: its agents' inputs are those of that
       // sweep, in which they did not move, so they do not move now (skipping is exact).
@@ -201,36 +317,44 @@ void CollisionResolver::resolve(Agents& agents, const StaticObstacles& obstacles
         for (int cy = st.y0; cy <= st.y1; ++cy)
           for (int cx = st.x0; cx <= st.x1; ++cx) dirty |= moved[static_cast<std::size_t>(cy) * nx + cx] != 0;
         if (!dirty) {
-          std::copy(cur + first, cur + last, next + first);
+          std::copy(xs + first, xs + last, nextX + first);
+          std::copy(ys + first, ys + last, nextY + first);
           movedNext[st.cell] = 0;
           return;
         }
       }
       std::uint8_t cellMoved = 0;
       for (std::uint32_t k = first; k < last; ++k) {
-        const Vec2f xi = cur[k];
-        next[k] = xi;
+        const Vec2f xi(xs[k], ys[k]);
+        nextX[k] = xi.x();
+        nextY[k] = xi.y();
         if (scripted[k]) continue;
         const float ri = rad[k];
         float dx = 0.0f, dy = 0.0f;
-        for (int q = 0; q < st.count; ++q) {
-          for (std::uint32_t j = st.lo[q]; j < st.hi[q]; ++j) {
-            const float ex = xi.x() - cur[j].x(), ey = xi.y() - cur[j].y();
-            const float target = s * (ri + rad[j]);
-            const float d2 = ex * ex + ey * ey;
-            if (d2 >= target * target || j == k) continue;
-            const float dist = std::sqrt(d2);
-            // Symmetric halves; a scripted agent does not yield, so i takes all of it.
-            const float push = (scripted[j] ? 1.0f : 0.5f) * (target - dist);
-            if (dist > 1e-7f * target) {
-              dx += push * (ex / dist);
-              dy += push * (ey / dist);
-            } else {
-              const Vec2f dir = coincidentDirection(order[k], order[j]);
+        int coincident = 0;
+#if defined(__AVX2__)
+        __m256 ax = _mm256_setzero_ps(), ay = _mm256_setzero_ps();
+        for (int q = 0; q < st.count; ++q)
+          pushAvx(xs, ys, rad, yield, st.lo[q], st.hi[q], k, xi.x(), xi.y(), ri, s, ax, ay, coincident);
+        dx = sum8(ax);
+        dy = sum8(ay);
+#else
+        for (int q = 0; q < st.count; ++q)
+          pushScalar(xs, ys, rad, yield, st.lo[q], st.hi[q], k, xi.x(), xi.y(), ri, s, dx, dy, coincident);
+#endif
+        if (coincident > 0) {
+          // Coincident pairs: a direction hashed from the pair, opposite for the two (rare).
+          for (int q = 0; q < st.count; ++q)
+            for (std::uint32_t j = st.lo[q]; j < st.hi[q]; ++j) {
+              const float ex = xi.x() - xs[j], ey = xi.y() - ys[j];
+              const float target = s * (ri + rad[j]);
+              const float d2 = ex * ex + ey * ey, t2 = target * target;
+              if (j == k || d2 >= t2 || d2 > 1e-14f * t2) continue;
+              const Vec2f dir = coincidentDirection(agent[k], agent[j]);
+              const float push = yield[j] * (target - std::sqrt(d2));
               dx += push * dir.x();
               dy += push * dir.y();
             }
-          }
         }
         Vec2f x(xi.x() + dx, xi.y() + dy);
         if (!obstacles.empty()) x = obstacles.pushOut(x, ri);
@@ -239,7 +363,8 @@ void CollisionResolver::resolve(Agents& agents, const StaticObstacles& obstacles
           x[a] = lo <= hi ? std::clamp(x[a], lo, hi) : 0.5f * (domain.lo[a] + domain.hi[a]);
         }
         if (x == xi) continue;
-        next[k] = x;
+        nextX[k] = x.x();
+        nextY[k] = x.y();
         cellMoved = 1;
         worst = std::max(worst, (x - bucketed[k]).squaredNorm());
       }
@@ -258,26 +383,27 @@ void CollisionResolver::resolve(Agents& agents, const StaticObstacles& obstacles
           return worst;
         },
         [](float a, float b) { return std::max(a, b); });
-    current_.swap(next_);
+    x_.swap(nextX_);
+    y_.swap(nextY_);
     moved_.swap(movedNext_);
     if (it + 1 == params.iterations) break;
     // A pair within range now was within range + 2 * max displacement when bucketed: still in
     // each other's stencil while that fits in a cell (with a margin for round-off). Otherwise the
-    // agents are bucketed again where they are now.
-    // (An agent that did not move in a sweep has the displacement of the last sweep it moved in.)
+    // agents are bucketed again where they are now. (An agent that did not move in a sweep has
+    // the displacement of the last sweep it moved in.)
     movedSinceBucket2 = std::max(movedSinceBucket2, moved2);
     if (range + 2.0f * std::sqrt(movedSinceBucket2) * 1.001f + 1e-6f * range >= grid_.cellSize()) {
-      const std::span<const std::uint32_t> ord = grid_.cellOrder();
-      parallelFor(
-          0, n, [&](std::size_t k) { agents.position[ord[k]] = current_[k]; }, 4096);
-      bucket(agents.position, agents, range * (1.0f + kSkin));
+      rebucket(range * (1.0f + kSkin));
       bucketedAt = it + 1;
       movedSinceBucket2 = 0.0f;
     }
   }
-  const std::span<const std::uint32_t> order = grid_.cellOrder();
+  scatter(agents);
+}
+
+void CollisionResolver::scatter(Agents& agents) const {
   parallelFor(
-      0, n, [&](std::size_t k) { agents.position[order[k]] = current_[k]; }, 4096);
+      0, agent_.size(), [&](std::size_t k) { agents.position[agent_[k]] = Vec2f(x_[k], y_[k]); }, 4096);
 }
 
 }  // namespace msim::crowd

@@ -90,14 +90,24 @@ class CollisionResolver {
   int lastBucketings() const { return bucketings_; }
 
  private:
-  void bucket(std::span<const Vec2f> position, const Agents& agents, float cellSize);
+  void bucket(const Agents& agents, float cellSize);  // from the agents
+  void rebucket(float cellSize);                       // from the current cell-ordered copy
+  void scatter(Agents& agents) const;                  // positions back to agent order
 
   NeighbourGrid grid_;
-  // Cell-ordered copies (slot k is agent grid_.cellOrder()[k]).
-  std::vector<Vec2f> current_, next_;  // positions before / after a sweep
-  std::vector<Vec2f> bucketed_;        // positions when bucketed
+  // Cell-ordered copies (slot k is agent agent_[k]).
+  // Structure of arrays, padded with kPad far-away slots so the vector loops may read past a range.
+  std::vector<float> x_, y_, nextX_, nextY_;  // positions before / after a sweep
+  std::vector<Vec2f> bucketed_;              // positions when bucketed
   std::vector<float> radius_;
+  std::vector<float> yield_;  // share of a push a neighbour of this agent takes: 1/2, or 1 if this one is scripted
   std::vector<std::uint8_t> scripted_;
+  std::vector<std::uint32_t> agent_;  // agent index of each slot
+  // Rebucketing scratch: positions to bucket, and the permuted copies before they are swapped in.
+  std::vector<Vec2f> points_;
+  std::vector<float> tmpRadius_, tmpYield_;
+  std::vector<std::uint8_t> tmpScripted_;
+  std::vector<std::uint32_t> tmpAgent_;
   // Per cell: whether any of its agents moved in the last sweep (and in the one being computed).
   // A cell whose whole stencil did not move is skipped: its agents would not move either.
   std::vector<std::uint8_t> moved_, movedNext_;

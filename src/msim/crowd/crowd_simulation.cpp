@@ -12,6 +12,7 @@ namespace msim::crowd {
 namespace {
 
 constexpr int kRelaxSweeps = 50;
+constexpr int kPlacementAttempts = 100000;
 
 // Largest radius and speed over the initial agents and every agent an inflow will create.
 void extremes(const Agents& agents, const std::vector<Inflow>& inflows, float& radius, float& speed) {
@@ -75,6 +76,13 @@ CrowdSimulation::CrowdSimulation(const CrowdSettings& settings, std::vector<Poly
       throw InputError(fmt::format("inflows[{}].rate: expected a positive number of agents per second", k));
     if (f.agent.goal >= goals_.size())
       throw InputError(fmt::format("inflows[{}].goal: there is no goal {}", k, f.agent.goal));
+    Rng probe = rng_.split(~std::uint64_t(k));
+    const Vec2 x = freePoint(probe, f.region, f.agent.radius);
+    if (!x.allFinite())
+      throw InputError(fmt::format("inflows[{}].region: no room for an agent of radius {} m outside the obstacles", k,
+                                   f.agent.radius));
+    if (!std::isfinite(planner_->distance(f.agent.goal, x)))
+      throw InputError(fmt::format("inflows[{}].goal: goal {} cannot be reached from the inflow region", k, f.agent.goal));
   }
   for (std::size_t s = 0; s < scripts_.size(); ++s) {
     const auto it = std::find(agents_.id.begin(), agents_.id.end(), scripts_[s].agentId);
@@ -82,6 +90,17 @@ CrowdSimulation::CrowdSimulation(const CrowdSettings& settings, std::vector<Poly
       throw InputError(fmt::format("scripts[{}]: agent {} is not a scripted agent of the scene", s, scripts_[s].agentId));
     if (scripts_[s].waypoints.empty()) throw InputError(fmt::format("scripts[{}]: no waypoints", s));
   }
+}
+
+Vec2 CrowdSimulation::freePoint(Rng& rng, const Polygon& region, float radius) const {
+  Vec2 lo, hi;
+  bounds(region, lo, hi);
+  for (int attempt = 0; attempt < kPlacementAttempts; ++attempt) {
+    const Vec2 x(rng.uniform(lo.x(), hi.x()), rng.uniform(lo.y(), hi.y()));
+    const Vec2f xf = x.cast<float>();
+    if (contains(region, x) && (staticObstacles_.empty() || staticObstacles_.pushOut(xf, radius) == xf)) return x;
+  }
+  return Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
 }
 
 void CrowdSimulation::validateAgent(std::size_t i, const std::string& what) const {
@@ -240,10 +259,9 @@ void CrowdSimulation::arriveAndSpawn(double dt) {
       // Uniform in the region by rejection from its bounds (regions are checked to have area). The
       // stream depends only on the seed and the new agent's id, so a resumed run spawns the same.
       Rng rng = rng_.split(agents_.nextId);
-      Vec2 x;
-      do {
-        x = Vec2(rng.uniform(lo.x(), hi.x()), rng.uniform(lo.y(), hi.y()));
-      } while (!contains(f.region, x));
+      const Vec2 x = freePoint(rng, f.region, f.agent.radius);
+      if (!x.allFinite())
+        throw SimulationError(fmt::format("inflows[{}]: no free room for a new agent in the region", k));
       AgentSpec spec = f.agent;
       spec.position = x.cast<float>();
       agents_.add(spec);

@@ -436,7 +436,11 @@ void UicProjection::renorm(const MacGrid<2>& u, MacGrid<2>& out) const {
         }
       const float tangential = wSum > 0.0f ? wv / wSum : 0.0f;
       const float speed = std::hypot(in[idx], tangential);
-      if (vmax[idx] > 0.0f && speed > minFraction * vmax[idx]) o[idx] = in[idx] * (vmax[idx] / speed);
+      const float target =
+          settings_.weidmannSpeeds
+              ? static_cast<float>(vmax[idx] * weidmannSpeed(rho[idx], settings_.weidmann) / settings_.weidmann.v0)
+              : vmax[idx];
+      if (vmax[idx] > 0.0f && speed > minFraction * vmax[idx]) o[idx] = in[idx] * (target / speed);
     });
   }
 }

@@ -39,6 +39,7 @@
 #include "msim/core/mac_grid.hpp"
 #include "msim/core/transfer.hpp"
 #include "msim/crowd/agents.hpp"
+#include "msim/crowd/fundamental_diagram.hpp"
 #include "msim/numerics/bound_qp.hpp"
 #include "msim/numerics/bound_qp_mic0.hpp"
 
@@ -57,6 +58,14 @@ struct UicSettings {
   // Faces whose pressure-corrected speed is below this fraction of v_max keep their velocity in
   // renorm: their direction is noise (e.g. opposing streams cancelling).
   double renormMinFraction = 1e-3;
+  // Density-dependent walking speed, the extension ch. 4.4.1 suggests ("v_max ... can also be made
+  // variable for each grid cell, depending on the density ... agents in dense regions have been
+  // observed to walk more slowly (Fruin, 1971)"): renorm scales each face to
+  // v_max * v_W(rho_face) / v0 with Weidmann's fundamental diagram v_W (fundamental_diagram.hpp)
+  // instead of v_max. Off: the seed's constant v_max, under which a door at rho_max passes
+  // rho_max v_max (4 agents/(m s) at the defaults), two to three times what people achieve.
+  bool weidmannSpeeds = false;
+  WeidmannParams weidmann;
 };
 
 struct UicStats {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -12,16 +13,25 @@ namespace msim::render {
 
 namespace {
 
-// Even-odd rule: the ray towards +x crosses the polygon's edges an odd number of times inside.
-bool insidePolygon(const std::vector<Vec2>& poly, const Vec2& p) {
-  bool inside = false;
+// Columns of one pixel row inside the polygon by the even-odd rule at the pixel centres: a centre
+// is inside when the ray towards +x crosses an odd number of edges, i.e. when it lies between
+// crossing 2k and 2k + 1 of the sorted crossings of the row (scanline fill, O(edges) per row).
+template <typename Fill>
+void fillPolygonRow(const std::vector<Vec2>& poly, double y, double x0, double pixel, int width,
+                    std::vector<double>& crossings, Fill&& fill) {
+  crossings.clear();
   for (std::size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
     const Vec2& a = poly[i];
     const Vec2& b = poly[j];
-    if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x())
-      inside = !inside;
+    if ((a.y() > y) != (b.y() > y)) crossings.push_back((b.x() - a.x()) * (y - a.y()) / (b.y() - a.y()) + a.x());
   }
-  return inside;
+  std::sort(crossings.begin(), crossings.end());
+  for (std::size_t k = 0; k + 1 < crossings.size(); k += 2) {
+    // Centres x0 + (col + 0.5) pixel in [c_2k, c_2k+1).
+    const int first = std::max(0, static_cast<int>(std::ceil((crossings[k] - x0) / pixel - 0.5)));
+    const int last = std::min(width - 1, static_cast<int>(std::ceil((crossings[k + 1] - x0) / pixel - 0.5)) - 1);
+    for (int col = first; col <= last; ++col) fill(col);
+  }
 }
 
 std::uint8_t toSrgbByte(double linear) {
@@ -76,25 +86,43 @@ io::Image renderFloorPlan(const FloorPlan& plan, const Discs& discs, const std::
     for (int y = std::max(0, top); y <= std::min(height - 1, bottom); ++y) rows[static_cast<std::size_t>(y)].push_back(k);
   }
 
+  std::vector<Vec2> polygonLo(obstacles.size()), polygonHi(obstacles.size());
+  for (std::size_t k = 0; k < obstacles.size(); ++k) {
+    polygonLo[k] = Vec2::Constant(std::numeric_limits<double>::infinity());
+    polygonHi[k] = -polygonLo[k];
+    for (const Vec2& v : obstacles[k]) {
+      polygonLo[k] = polygonLo[k].cwiseMin(v);
+      polygonHi[k] = polygonHi[k].cwiseMax(v);
+    }
+  }
+
   io::Image image(plan.width, height);
   parallelFor(0, static_cast<std::size_t>(height), [&](std::size_t row) {
-    for (int col = 0; col < plan.width; ++col) {
-      const Vec2 p(plan.lo.x() + (col + 0.5) * pixel, plan.hi.y() - (static_cast<double>(row) + 0.5) * pixel);
-      Vec3 colour = plan.floor;
-      for (const auto& poly : obstacles)
-        if (poly.size() >= 3 && insidePolygon(poly, p)) colour = plan.obstacle;
-      // Discs in index order; each covers what is below it by the fraction of the pixel it covers,
-      // taken as the clamped signed distance of the pixel centre to the edge over the pixel size.
-      for (std::size_t k : rows[row]) {
-        const double coverage = std::clamp(0.5 - ((p - discs.centres[k]).norm() - radius(k)) / pixel, 0.0, 1.0);
-        if (coverage <= 0.0) continue;
-        const Vec3 disc = discs.values.empty()
-                              ? Vec3::Constant(0.35)
-                              : colourMap((discs.values[k] - plan.valueMin) / (plan.valueMax - plan.valueMin));
-        colour = (1.0 - coverage) * colour + coverage * disc;
+    const double y = plan.hi.y() - (static_cast<double>(row) + 0.5) * pixel;
+    std::vector<Vec3> colours(static_cast<std::size_t>(plan.width), plan.floor);
+    std::vector<double> crossings;
+    for (std::size_t k = 0; k < obstacles.size(); ++k)
+      if (obstacles[k].size() >= 3 && y >= polygonLo[k].y() && y <= polygonHi[k].y())
+        fillPolygonRow(obstacles[k], y, plan.lo.x(), pixel, plan.width, crossings,
+                       [&](int col) { colours[static_cast<std::size_t>(col)] = plan.obstacle; });
+    // Discs in index order; each covers what is below it by the fraction of the pixel it covers,
+    // taken as the clamped signed distance of the pixel centre to the edge over the pixel size.
+    for (std::size_t k : rows[row]) {
+      const double r = radius(k);
+      const Vec3 disc = discs.values.empty() ? Vec3::Constant(0.35)
+                                             : colourMap((discs.values[k] - plan.valueMin) / (plan.valueMax - plan.valueMin));
+      const double cx = discs.centres[k].x();
+      const int first = std::max(0, static_cast<int>(std::floor((cx - r - pixel - plan.lo.x()) / pixel)));
+      const int last = std::min(plan.width - 1, static_cast<int>(std::ceil((cx + r + pixel - plan.lo.x()) / pixel)));
+      for (int col = first; col <= last; ++col) {
+        const Vec2 p(plan.lo.x() + (col + 0.5) * pixel, y);
+        const double coverage = std::clamp(0.5 - ((p - discs.centres[k]).norm() - r) / pixel, 0.0, 1.0);
+        if (coverage > 0.0) colours[col] = (1.0 - coverage) * colours[col] + coverage * disc;
       }
+    }
+    for (int col = 0; col < plan.width; ++col) {
       std::uint8_t* px = image.pixel(col, static_cast<int>(row));
-      for (int c = 0; c < 3; ++c) px[c] = toSrgbByte(colour[c]);
+      for (int c = 0; c < 3; ++c) px[c] = toSrgbByte(colours[static_cast<std::size_t>(col)][c]);
     }
   }, 4);
   return image;

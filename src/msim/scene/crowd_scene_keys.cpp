@@ -7,6 +7,7 @@
 #include "msim/core/error.hpp"
 #include "msim/core/log.hpp"
 #include "msim/core/rng.hpp"
+#include "msim/crowd/collision_resolution.hpp"
 #include "msim/crowd/direct_planner.hpp"
 #include "msim/crowd/navigation_field.hpp"
 #include "msim/crowd/roadmap.hpp"
@@ -40,9 +41,11 @@ Schema regionSchema(std::string description, bool withPoint) {
   return shape;
 }
 
-void agentKeys(Schema& s) {
-  s.string("goal", "name of a goal in goals[], or 'opposite': the point mirrored through the group's region centre "
-                   "(each agent its own goal, as in the circle scene of Fig. 4.5)").required();
+void agentKeys(Schema& s, bool opposite) {
+  s.string("goal", opposite ? "name of a goal in goals[], or 'opposite': the point mirrored through the group's region "
+                              "centre (each agent its own goal, as in the circle scene of Fig. 4.5)"
+                            : "name of a goal in goals[]")
+      .required();
   s.string("model", "uic", "uic: the continuum (ch. 4.4); orca: per-agent ORCA; scripted: walks 'waypoints'")
       .choices({"uic", "orca", "scripted"});
   s.number("radius", "m", 0.0, "body radius; 0 = crowd.agent.radius").min(0.0);
@@ -63,6 +66,10 @@ Schema crowdKeys() {
   uic.number("rho_max", "1/m^2", 0.0, "maximum density; 0 = eq. 4.4, 2 alpha / (sqrt(3) d_min^2)").min(0.0);
   uic.number("tolerance", "", 5e-3, "QP tolerance: overdensity left per cell, relative to rho_max").min(0.0, Bound::Exclusive);
   uic.integer("max_iterations", 500, "MPRGP iterations per solve").min(1);
+  uic.string("speed_density", "constant",
+             "walking speed of the continuum: 'constant' max_speed (the seed), or 'weidmann': slower in dense "
+             "regions along Weidmann's (1993) fundamental diagram, as ch. 4.4.1 suggests")
+      .choices({"constant", "weidmann"});
   c.field("uic", uic);
   Schema col = Schema::object("pairwise collision resolution after each step (ch. 4.3.3)");
   col.boolean("enabled", true, "push overlapping agents apart (off: Fig. 4.3c)");
@@ -96,7 +103,7 @@ Schema groupSchema() {
   Schema g = Schema::object("agents placed at the start");
   g.integer("count", "number of agents").min(1).required();
   g.field("region", regionSchema("where they stand (uniformly at random, then relaxed apart)", false).required());
-  agentKeys(g);
+  agentKeys(g, true);
   g.array("waypoints", Schema::vectorItem("m", 2, "waypoint"),
           "scripted agents: the path, relative to the region centre (each agent keeps its offset)");
   g.boolean("loop", false, "scripted agents: start over after the last waypoint");
@@ -109,7 +116,7 @@ Schema inflowSchema() {
   f.number("rate", "1/s", "agents per second").min(0.0, Bound::Exclusive).required();
   f.number("start", "s", 0.0, "first agent").min(0.0);
   f.number("stop", "s", 1e30, "no agents after this").min(0.0);
-  agentKeys(f);
+  agentKeys(f, false);
   return f;
 }
 
@@ -142,6 +149,7 @@ struct Builder {
   std::string source;
   CrowdSceneSetup out;
   std::vector<std::string> goalNames;
+  crowd::StaticObstacles obstacleIndex;
 
   [[noreturn]] void fail(const std::string& key, const std::string& what) const {
     throw InputError(fmt::format("{}: '{}' {}", source, key, what));
@@ -183,6 +191,7 @@ struct Builder {
     out.settings.uicSettings.rhoMax = rhoMax;
     out.settings.uicSettings.tolerance = u.at("tolerance").get<double>();
     out.settings.uicSettings.maxIterations = u.at("max_iterations").get<int>();
+    out.settings.uicSettings.weidmannSpeeds = u.at("speed_density").get<std::string>() == "weidmann";
     const json& col = c.at("collision_resolution");
     out.settings.collisionResolution = col.at("enabled").get<bool>();
     out.settings.collision.separation = col.at("separation").get<float>();
@@ -209,6 +218,7 @@ struct Builder {
       requireInside(p, key + ".shape");
       out.obstacles.push_back(std::move(p));
     }
+    obstacleIndex = crowd::StaticObstacles(out.obstacles, largestRadius());
   }
 
   void goals() {
@@ -261,18 +271,38 @@ struct Builder {
     return a;
   }
 
-  // Uniform random points in the region, outside every obstacle.
-  Vec2 randomPoint(Rng& rng, const Polygon& region, const std::string& key) const {
+  // Uniform random points in the region where an agent of the radius clears every obstacle.
+  Vec2 randomPoint(Rng& rng, const Polygon& region, float radius, const std::string& key) const {
     Vec2 lo, hi;
     crowd::bounds(region, lo, hi);
     for (int attempt = 0; attempt < 100000; ++attempt) {
       const Vec2 x(rng.uniform(lo.x(), hi.x()), rng.uniform(lo.y(), hi.y()));
-      if (!crowd::contains(region, x)) continue;
-      bool free = true;
-      for (const Polygon& o : out.obstacles) free = free && !crowd::contains(o, x);
-      if (free) return x;
+      const crowd::Vec2f xf = x.cast<float>();
+      if (crowd::contains(region, x) && (obstacleIndex.empty() || obstacleIndex.pushOut(xf, radius) == xf)) return x;
     }
-    fail(key, "has no free room: it lies inside obstacles");
+    fail(key, fmt::format("has no free room for agents of radius {} m: it lies inside obstacles", radius));
+  }
+
+  // Largest agent radius any group or inflow asks for (the obstacle index answers up to it).
+  float largestRadius() const {
+    double largest = r.at("crowd").at("agent").at("radius").get<double>();
+    for (const char* list : {"groups", "inflows"})
+      for (const json& e : r.at(list)) largest = std::max(largest, e.at("radius").get<double>());
+    return static_cast<float>(largest);
+  }
+
+  // Every agent can reach its goal (the planner knows the obstacles); names the group and goal.
+  void checkReachable() const {
+    for (std::size_t i = 0; i < out.agents.size(); ++i) {
+      if (out.agents.model[i] == crowd::AgentModel::Scripted) continue;
+      const Vec2 x = out.agents.position[i].cast<double>();
+      const std::uint32_t g = out.agents.goal[i];
+      if (!std::isfinite(out.planner->distance(g, x)))
+        fail(fmt::format("groups[{}].goal", out.agents.group[i]),
+             fmt::format("'{}' cannot be reached from ({:.2f}, {:.2f}), where an agent of the group stands: walls "
+                         "enclose the goal or the agent",
+                         g < goalNames.size() ? goalNames[g] : std::string("opposite"), x.x(), x.y()));
+    }
   }
 
   void groups() {
@@ -301,7 +331,7 @@ struct Builder {
       Rng groupRng = rng.split(k);
       for (long long n = 0; n < count; ++n) {
         crowd::AgentSpec a = base;
-        const Vec2 x = randomPoint(groupRng, region, key + ".region");
+        const Vec2 x = randomPoint(groupRng, region, base.radius, key + ".region");
         a.position = x.cast<float>();
         a.goal = goal;
         if (opposite && !scripted) {
@@ -409,7 +439,7 @@ void declareCrowdKeys(Schema& root) {
 }
 
 CrowdSceneSetup buildCrowdScene(const Scene& scene) {
-  Builder b{scene, scene.resolved, scene.file.string(), {}, {}};
+  Builder b{scene, scene.resolved, scene.file.string(), {}, {}, {}};
   b.domainAndGrid();
   b.settings();
   b.obstacles();
@@ -421,6 +451,7 @@ CrowdSceneSetup buildCrowdScene(const Scene& scene) {
   if (b.out.agents.empty() && b.out.inflows.empty())
     throw InputError(b.source + ": the scene has no agents: add 'groups' or 'inflows'");
   b.planner();
+  b.checkReachable();
   return std::move(b.out);
 }
 

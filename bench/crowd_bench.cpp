@@ -1,0 +1,72 @@
+// Whole crowd steps (Narain 2011 ch. 4.4.4: planning, UIC projection, agent motion, pairwise
+// resolution, exits and inflows) of the scene files, as `msim run` steps them, without the frame
+// outputs. Table 4.1 scenes at their grids and agent counts, and the scaling curve of Fig. 4.11:
+// the circle of Fig. 4.5 grown to N agents at the same density and cell size, walked by UIC agents
+// and by ORCA agents.
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "msim/core/timer.hpp"
+#include "msim/scene/scene_file.hpp"
+
+using namespace msim;
+
+namespace {
+
+std::string scenePath(const std::string& name) { return std::string(MSIM_SOURCE_DIR) + "/scenes/" + name + ".json"; }
+
+// Runs `warmup` steps, then times steps; counters: agents and seconds per step of each stage.
+void stepScene(benchmark::State& state, const std::string& file, const std::vector<std::string>& overrides, int warmup) {
+  const scene::Scene s = scene::loadScene(file, overrides);
+  StageTimers timers;
+  auto phenomenon = s.type->create(s, timers);
+  for (int k = 0; k < warmup; ++k) phenomenon->step(phenomenon->stableTimestep());
+  timers.reset();
+  for (auto _ : state) phenomenon->step(phenomenon->stableTimestep());
+  for (const auto& stage : timers.table())
+    state.counters[stage.name] = stage.seconds / static_cast<double>(state.iterations());
+  state.counters["agents"] = phenomenon->statistics().at("agents").get<double>();
+}
+
+// Table 4.1. The circle is measured while the crowd is densest (t = 15-25 s: they meet in the
+// middle); the others after enough steps for their crowds to form queues.
+void BM_Circle10k(benchmark::State& state) { stepScene(state, scenePath("crowd_circle"), {}, 150); }
+void BM_Crossing(benchmark::State& state) { stepScene(state, scenePath("crowd_crossing"), {}, 400); }
+void BM_Building2k(benchmark::State& state) { stepScene(state, scenePath("crowd_building"), {}, 100); }
+void BM_TradeShow80k(benchmark::State& state) { stepScene(state, scenePath("crowd_trade_show"), {}, 20); }
+void BM_Campsite100k(benchmark::State& state) { stepScene(state, scenePath("crowd_campsite"), {}, 20); }
+void BM_Mosque25k(benchmark::State& state) { stepScene(state, scenePath("crowd_mosque"), {}, 50); }
+
+// Fig. 4.11: the circle with N agents (range 0, thousands), the disc and the domain grown by
+// sqrt(N / 10k) so density and cell size (2.5 m) stay those of the 10k scene; range 1 picks the
+// model (0 UIC, 1 ORCA). Timed from the start: at 1M agents the fronts need minutes to meet.
+void BM_CircleScaling(benchmark::State& state) {
+  const double n = 1000.0 * static_cast<double>(state.range(0));
+  const double scale = std::sqrt(n / 10000.0);
+  const std::vector<std::string> overrides = {
+      fmt::format("domain.max=[{},{}]", 100 * scale, 100 * scale),
+      fmt::format("domain.resolution={}", static_cast<int>(std::lround(40 * scale))),
+      fmt::format("groups[0].count={}", static_cast<long long>(n)),
+      fmt::format("groups[0].region.center=[{},{}]", 50 * scale, 50 * scale),
+      fmt::format("groups[0].region.radius={}", 40 * scale),
+      std::string("groups[0].model=") + (state.range(1) == 0 ? "uic" : "orca")};
+  stepScene(state, scenePath("crowd_circle"), overrides, 2);
+}
+
+}  // namespace
+
+BENCHMARK(BM_Circle10k)->Unit(benchmark::kMillisecond)->Iterations(100);
+BENCHMARK(BM_Crossing)->Unit(benchmark::kMillisecond)->Iterations(50);
+BENCHMARK(BM_Building2k)->Unit(benchmark::kMillisecond)->Iterations(50);
+BENCHMARK(BM_Mosque25k)->Unit(benchmark::kMillisecond)->Iterations(10);
+BENCHMARK(BM_TradeShow80k)->Unit(benchmark::kMillisecond)->Iterations(10);
+BENCHMARK(BM_Campsite100k)->Unit(benchmark::kMillisecond)->Iterations(10);
+BENCHMARK(BM_CircleScaling)
+    ->ArgsProduct({{10, 30, 100, 300, 1000}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(5);
