@@ -120,8 +120,10 @@ TEST(CollisionResolution, MatchesBruteForceSweeps) {
     Agents b = a;
     const DomainBox domain{Vec2f(-40, -40), Vec2f(40, 40)};  // wide: no coincident clamped agents
     CollisionResolver resolver;
-    resolver.resolve(a, StaticObstacles(), domain);
-    referenceResolve(b, domain, CollisionResolutionParams());
+    CollisionResolutionParams all;
+    all.tolerance = 0.0f;  // every sweep, as the reference
+    resolver.resolve(a, StaticObstacles(), domain, all);
+    referenceResolve(b, domain, all);
     double worst = 0.0;
     for (std::size_t i = 0; i < a.size(); ++i)
       worst = std::max(worst, static_cast<double>((a.position[i] - b.position[i]).norm()));
@@ -129,6 +131,22 @@ TEST(CollisionResolution, MatchesBruteForceSweeps) {
               << " bucketings in 12 sweeps, max |x - x_brute force| " << worst << " m\n";
     EXPECT_LT(worst, 1e-4);
   }
+}
+
+TEST(CollisionResolution, StopsOnceConverged) {
+  // Two overlapping agents far apart from three others: the first sweep pushes them exactly to
+  // 1.2 d_min, the second moves nobody, and resolve() stops there instead of running all 12.
+  Agents a;
+  for (const Vec2f& x : {Vec2f(0, 0), Vec2f(0.3f, 0), Vec2f(10, 10), Vec2f(12, 10), Vec2f(14, 10)}) {
+    AgentSpec s;
+    s.position = x;
+    a.add(s);
+  }
+  CollisionResolver resolver;
+  resolver.resolve(a, StaticObstacles(), kOpen);
+  EXPECT_EQ(resolver.lastSweeps(), 2);
+  EXPECT_NEAR((a.position[1] - a.position[0]).norm(), 1.2f * 0.5f, 1e-6);
+  EXPECT_EQ(a.position[2], Vec2f(10, 10));
 }
 
 TEST(CollisionResolution, IndependentOfThreadCount) {

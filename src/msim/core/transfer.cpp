@@ -92,49 +92,13 @@ decltype(auto) withKernel(TransferKernel kernel, F&& f) {
   return f(QuadraticBSplineKernel{});
 }
 
-constexpr std::size_t kBucketBlock = 1 << 16;
-
 }  // namespace
 
 template <int D>
 template <typename Kernel>
 void Splatter<D>::bucketBySlab(std::span<const Vecf<D>> positions, const Grid<float, D>& target) {
-  const std::size_t n = positions.size();
-  if (n > std::numeric_limits<std::uint32_t>::max())
-    throw std::length_error("Splatter: more than 2^32 particles in one splat (" + std::to_string(n) + ")");
   const std::size_t slabs = (target.size()[D - 1] + kSlabWidth - 1) / kSlabWidth;
-  const std::size_t blocks = (n + kBucketBlock - 1) / kBucketBlock;
-
-  slabOf_.resize(n);
-  order_.resize(n);
-  blockSlabCursor_.assign(blocks * slabs, 0);
-  slabBegin_.assign(slabs + 1, 0);
-
-  // Per-block histograms, so the counting sort is parallel yet independent of the thread count.
-  tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
-    std::size_t* count = &blockSlabCursor_[b * slabs];
-    const std::size_t end = std::min(n, (b + 1) * kBucketBlock);
-    for (std::size_t i = b * kBucketBlock; i < end; ++i) {
-      slabOf_[i] = slabOf<Kernel>(target, positions[i], kSlabWidth);
-      ++count[slabOf_[i]];
-    }
-  });
-  // Exclusive prefix in (slab, block) order turns the counts into each block's write cursor.
-  std::size_t running = 0;
-  for (std::size_t s = 0; s < slabs; ++s) {
-    slabBegin_[s] = running;
-    for (std::size_t b = 0; b < blocks; ++b) {
-      const std::size_t count = blockSlabCursor_[b * slabs + s];
-      blockSlabCursor_[b * slabs + s] = running;
-      running += count;
-    }
-  }
-  slabBegin_[slabs] = running;
-  tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
-    std::size_t* cursor = &blockSlabCursor_[b * slabs];
-    const std::size_t end = std::min(n, (b + 1) * kBucketBlock);
-    for (std::size_t i = b * kBucketBlock; i < end; ++i) order_[cursor[slabOf_[i]]++] = static_cast<std::uint32_t>(i);
-  });
+  buckets_.sort(positions.size(), slabs, [&](std::size_t i) { return slabOf<Kernel>(target, positions[i], kSlabWidth); });
 }
 
 template <int D>
@@ -153,15 +117,16 @@ void Splatter<D>::splatWith(std::span<const Vecf<D>> positions, const ValueOf& v
 
   bucketBySlab<Kernel>(positions, target);
 
-  const std::size_t slabs = slabBegin_.size() - 1;
+  const std::size_t slabs = buckets_.buckets();
+  const std::span<const std::uint32_t> order = buckets_.order();
   double* sum = weightedSum_.data();
   double* weight = weightSum_.data();
   for (std::size_t colour = 0; colour < 2; ++colour) {
     const std::size_t slabsOfColour = (slabs + 1 - colour) / 2;
     tbb::parallel_for(std::size_t(0), slabsOfColour, [&](std::size_t j) {
       const std::size_t slab = 2 * j + colour;
-      for (std::size_t k = slabBegin_[slab]; k < slabBegin_[slab + 1]; ++k) {
-        const std::uint32_t p = order_[k];
+      for (std::size_t k = buckets_.begin(slab); k < buckets_.begin(slab + 1); ++k) {
+        const std::uint32_t p = order[k];
         const double v = valueOf(p);
         const Stencil<Kernel, D> stencil(target, positions[p]);
         if (normalized)

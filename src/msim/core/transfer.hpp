@@ -25,6 +25,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "msim/core/bucket_sort.hpp"
 #include "msim/core/grid.hpp"
 #include "msim/core/mac_grid.hpp"
 
@@ -61,10 +62,7 @@ class Splatter {
 
   std::vector<double> weightedSum_;  // sum of w*v per sample
   std::vector<double> weightSum_;    // sum of w per sample (Normalized only)
-  std::vector<std::uint32_t> slabOf_;
-  std::vector<std::uint32_t> order_;          // particle indices grouped by slab, stable
-  std::vector<std::size_t> slabBegin_;        // slab s owns order_[slabBegin_[s], slabBegin_[s+1])
-  std::vector<std::size_t> blockSlabCursor_;  // counting-sort table [block][slab]
+  BucketSort buckets_;  // particle indices grouped by slab, stable
 };
 
 // One-off splat with a temporary Splatter (allocates; keep a Splatter for repeated splats).

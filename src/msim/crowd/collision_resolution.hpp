@@ -67,6 +67,10 @@ struct CollisionResolutionParams {
   float separation = 1.2f;
   // Jacobi sweeps; each resolves isolated pairs exactly, clusters converge geometrically.
   int iterations = 12;
+  // Sweeps stop early once none moves an agent by more than this fraction of d_min (the largest
+  // one's): after a step only a few pairs overlap, and those settle in a few sweeps. 0 = always
+  // run `iterations` sweeps.
+  float tolerance = 0.01f;
 };
 
 class CollisionResolver {
@@ -88,9 +92,12 @@ class CollisionResolver {
   // Times the agents were bucketed in the last resolve() (1 unless agents moved far), for tests
   // and benchmarks.
   int lastBucketings() const { return bucketings_; }
+  // Sweeps the last resolve() ran (<= iterations; fewer when it converged).
+  int lastSweeps() const { return sweeps_; }
 
  private:
   void bucket(const Agents& agents, float cellSize);  // from the agents
+  void resizeCellFlags();  // one moved flag per cell of the current buckets
   void rebucket(float cellSize);                       // from the current cell-ordered copy
   void scatter(Agents& agents) const;                  // positions back to agent order
 
@@ -112,6 +119,7 @@ class CollisionResolver {
   // A cell whose whole stencil did not move is skipped: its agents would not move either.
   std::vector<std::uint8_t> moved_, movedNext_;
   int bucketings_ = 0;
+  int sweeps_ = 0;
 };
 
 template <typename F>

@@ -45,13 +45,6 @@ std::size_t firstBad(std::size_t n, const Bad& bad) {
       [](std::size_t a, std::size_t b) { return std::min(a, b); });
 }
 
-void scale(MacGrid<2>& g, float s) {
-  for (int a = 0; a < 2; ++a) {
-    auto& c = g.component(a);
-    parallelFor(0, c.count(), [&](std::size_t i) { c[i] *= s; });
-  }
-}
-
 }  // namespace
 
 // f(local index in the box, grid index) over the QP box.
@@ -138,8 +131,6 @@ struct Taps {
   }
 };
 
-constexpr std::size_t kBucketBlock = 1 << 16;
-
 }  // namespace
 
 // Agents bucketed once per projection into slabs of kSlabRows cell rows (stable counting sort with
@@ -148,38 +139,11 @@ constexpr std::size_t kBucketBlock = 1 << 16;
 // never share a sample: even slabs run in parallel, then odd ones, each in input order, and every
 // sample sums its contributions in the same order whatever the thread count.
 void UicProjection::bucketAgents(std::span<const Vec2f> positions) {
-  const std::size_t n = positions.size();
   const int ny = grid_.res.y();
-  const std::size_t slabs = static_cast<std::size_t>((ny + kSlabRows - 1) / kSlabRows);
-  const std::size_t blocks = (n + kBucketBlock - 1) / kBucketBlock;
-  slabOf_.resize(n);
-  order_.resize(n);
-  blockCursor_.assign(blocks * slabs, 0);
-  slabBegin_.assign(slabs + 1, 0);
   const double oy = grid_.origin.y(), invDx = 1.0 / grid_.dx;
-  tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
-    std::size_t* count = &blockCursor_[b * slabs];
-    const std::size_t end = std::min(n, (b + 1) * kBucketBlock);
-    for (std::size_t i = b * kBucketBlock; i < end; ++i) {
-      const int row = std::clamp(static_cast<int>(std::floor((double(positions[i].y()) - oy) * invDx)), 0, ny - 1);
-      slabOf_[i] = static_cast<std::uint32_t>(row / kSlabRows);
-      ++count[slabOf_[i]];
-    }
-  });
-  std::size_t running = 0;
-  for (std::size_t sl = 0; sl < slabs; ++sl) {
-    slabBegin_[sl] = running;
-    for (std::size_t b = 0; b < blocks; ++b) {
-      const std::size_t count = blockCursor_[b * slabs + sl];
-      blockCursor_[b * slabs + sl] = running;
-      running += count;
-    }
-  }
-  slabBegin_[slabs] = running;
-  tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
-    std::size_t* cursor = &blockCursor_[b * slabs];
-    const std::size_t end = std::min(n, (b + 1) * kBucketBlock);
-    for (std::size_t i = b * kBucketBlock; i < end; ++i) order_[cursor[slabOf_[i]]++] = static_cast<std::uint32_t>(i);
+  buckets_.sort(positions.size(), static_cast<std::size_t>((ny + kSlabRows - 1) / kSlabRows), [&](std::size_t i) {
+    const int row = std::clamp(static_cast<int>(std::floor((double(positions[i].y()) - oy) * invDx)), 0, ny - 1);
+    return static_cast<std::size_t>(row / kSlabRows);
   });
 }
 
@@ -213,13 +177,14 @@ void UicProjection::splatAgents(std::span<const Vec2f> positions, std::span<cons
   bucketAgents(positions);
 
   const double ox = grid_.origin.x(), oy = grid_.origin.y(), invDx = 1.0 / grid_.dx;
-  const std::size_t slabs = slabBegin_.size() - 1;
+  const std::size_t slabs = buckets_.buckets();
+  const std::span<const std::uint32_t> order = buckets_.order();
   const std::size_t xStride = static_cast<std::size_t>(nx) + 1, yStride = static_cast<std::size_t>(nx);
   for (std::size_t colour = 0; colour < 2; ++colour) {
     tbb::parallel_for(std::size_t(0), (slabs + 1 - colour) / 2, [&](std::size_t j) {
       const std::size_t slab = 2 * j + colour;
-      for (std::size_t k = slabBegin_[slab]; k < slabBegin_[slab + 1]; ++k) {
-        const std::uint32_t p = order_[k];
+      for (std::size_t k = buckets_.begin(slab); k < buckets_.begin(slab + 1); ++k) {
+        const std::uint32_t p = order[k];
         const double sx = (double(positions[p].x()) - ox) * invDx, sy = (double(positions[p].y()) - oy) * invDx;
         const Taps cx(sx - 0.5, nx), cy(sy - 0.5, ny), fx(sx, nx + 1), fy(sy, ny + 1);
         const double vx = preferredVelocities[p].x(), vy = preferredVelocities[p].y();
@@ -324,29 +289,34 @@ void UicProjection::buildStencil(double dt) {
   preconditioner_.assign(boxRes_, boxLower_, boxDiagonal_);
 }
 
-// Solver right-hand side: minus b of eq. 4.17 with sigma = f rho_max - rho (ch. 4.4.3); the
-// divergence is the flux sum of eq. 4.13 with no flux through the walls.
-void UicProjection::assembleRhs(const MacGrid<2>& u, double dt, bool clampSigma, Eigen::VectorXd& rhs) const {
-  const int nx = grid_.res.x(), ny = grid_.res.y();
+// dx div(rho u) of cell `cell` (linear index k) by eq. 4.13: the net flux rho_face u_face out
+// through its four faces; domain walls carry none.
+double UicProjection::massOutflow(const MacGrid<2>& u, const IVec2& cell, std::size_t k) const {
+  const int nx = grid_.res.x(), ny = grid_.res.y(), i = cell.x(), j = cell.y();
   const auto& rx = faceDensity_.component(0);
   const auto& ry = faceDensity_.component(1);
   const auto& ux = u.component(0);
   const auto& uy = u.component(1);
+  const std::size_t xf = static_cast<std::size_t>(j) * (nx + 1) + i;
+  const double left = i > 0 ? double(rx[xf]) * ux[xf] : 0.0;
+  const double right = i + 1 < nx ? double(rx[xf + 1]) * ux[xf + 1] : 0.0;
+  const double bottom = j > 0 ? double(ry[k]) * uy[k] : 0.0;
+  const double top = j + 1 < ny ? double(ry[k + nx]) * uy[k + nx] : 0.0;
+  return right - left + top - bottom;
+}
+
+// Solver right-hand side: minus b of eq. 4.17 with sigma = f rho_max - rho (ch. 4.4.3); the
+// divergence is the flux sum of eq. 4.13 with no flux through the walls.
+void UicProjection::assembleRhs(const MacGrid<2>& u, double dt, bool clampSigma, Eigen::VectorXd& rhs) const {
   const double rhoMax = settings_.rhoMax, dtOverDx = dt / grid_.dx;
   parallelForCells<2>(grid_.res, [&](const IVec2& cell, std::size_t k) {
     if (excluded_[k]) {
       rhs[k] = 0.0;
       return;
     }
-    const int i = cell.x(), j = cell.y();
-    const std::size_t xf = static_cast<std::size_t>(j) * (nx + 1) + i;
-    const double left = i > 0 ? double(rx[xf]) * ux[xf] : 0.0;
-    const double right = i + 1 < nx ? double(rx[xf + 1]) * ux[xf + 1] : 0.0;
-    const double bottom = j > 0 ? double(ry[k]) * uy[k] : 0.0;
-    const double top = j + 1 < ny ? double(ry[k + nx]) * uy[k + nx] : 0.0;
     double sigma = freeArea_[k] * rhoMax - density_[k];
     if (clampSigma) sigma = std::max(sigma, 0.0);
-    rhs[k] = -(sigma + (right - left + top - bottom) * dtOverDx);
+    rhs[k] = -(sigma + massOutflow(u, cell, k) * dtOverDx);
   });
 }
 
@@ -447,20 +417,9 @@ void UicProjection::renorm(const MacGrid<2>& u, MacGrid<2>& out) const {
 
 // Density after one step with the final v (eq. 4.14) and the before/after ratio statistics.
 void UicProjection::predict(double dt) {
-  const int nx = grid_.res.x(), ny = grid_.res.y();
-  const auto& rx = faceDensity_.component(0);
-  const auto& ry = faceDensity_.component(1);
-  const auto& ux = velocity_.component(0);
-  const auto& uy = velocity_.component(1);
   const double dtOverDx = dt / grid_.dx;
   parallelForCells<2>(grid_.res, [&](const IVec2& cell, std::size_t k) {
-    const int i = cell.x(), j = cell.y();
-    const std::size_t xf = static_cast<std::size_t>(j) * (nx + 1) + i;
-    const double left = i > 0 ? double(rx[xf]) * ux[xf] : 0.0;
-    const double right = i + 1 < nx ? double(rx[xf + 1]) * ux[xf + 1] : 0.0;
-    const double bottom = j > 0 ? double(ry[k]) * uy[k] : 0.0;
-    const double top = j + 1 < ny ? double(ry[k + nx]) * uy[k + nx] : 0.0;
-    predicted_[k] = static_cast<float>(density_[k] - (right - left + top - bottom) * dtOverDx);
+    predicted_[k] = static_cast<float>(density_[k] - massOutflow(velocity_, cell, k) * dtOverDx);
   });
   const double rhoMax = settings_.rhoMax;
   auto ratio = [&](const Grid<float, 2>& rho) {

@@ -35,6 +35,7 @@
 #include <span>
 #include <vector>
 
+#include "msim/core/bucket_sort.hpp"
 #include "msim/core/grid.hpp"
 #include "msim/core/mac_grid.hpp"
 #include "msim/core/transfer.hpp"
@@ -120,6 +121,7 @@ class UicProjection {
   template <typename F>
   void forBox(const F& f) const;
   // b of eq. 4.17 for face velocity u, in the solver's sign (minus b), excluded cells 0.
+  double massOutflow(const MacGrid<2>& u, const IVec2& cell, std::size_t k) const;
   void assembleRhs(const MacGrid<2>& u, double dt, bool clampSigma, Eigen::VectorXd& rhs) const;
   numerics::BoundQpResult solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& p);
   void subtractGradient(const MacGrid<2>& u, const Eigen::VectorXd& p, MacGrid<2>& out) const;  // psolve
@@ -133,8 +135,7 @@ class UicProjection {
   UicStats stats_;
   // Fused splat: agents bucketed once into slabs of kSlabRows cell rows, double accumulators.
   static constexpr int kSlabRows = 4;
-  std::vector<std::uint32_t> slabOf_, order_;
-  std::vector<std::size_t> slabBegin_, blockCursor_;
+  BucketSort buckets_;
   std::vector<double> cellMass_;
   std::array<std::vector<double>, 2> faceMass_, faceFlow_, faceSpeed_;
 

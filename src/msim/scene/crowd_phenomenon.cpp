@@ -61,6 +61,7 @@ class CrowdPhenomenon final : public Phenomenon {
     sim_->step(dt, &timers_);
     ++stepsThisFrame_;
     uicIterations_ += sim_->lastStep().uic.innerIterations + sim_->lastStep().uic.outerIterations;
+    uicSolveSeconds_ += sim_->lastStep().uic.solveSeconds;
     // Flow through the measurement lines, step by step (crossings between frames would be missed).
     if (!lines_.empty()) {
       ScopedStage stage(timers_, "crowd: metrics");
@@ -74,8 +75,10 @@ class CrowdPhenomenon final : public Phenomenon {
 
   void endFrame() override {
     iterationsPerStep_ = stepsThisFrame_ > 0 ? double(uicIterations_) / stepsThisFrame_ : 0.0;
+    solveMsPerStep_ = stepsThisFrame_ > 0 ? 1e3 * uicSolveSeconds_ / stepsThisFrame_ : 0.0;
     stepsThisFrame_ = 0;
     uicIterations_ = 0;
+    uicSolveSeconds_ = 0.0;
     measureFrame();
   }
 
@@ -214,6 +217,7 @@ class CrowdPhenomenon final : public Phenomenon {
               {"uic_density_ratio_max", u.maxRatioAfter},
               {"uic_active_cells", u.activeCells},
               {"uic_iterations_per_step", iterationsPerStep_},
+              {"uic_solve_ms_per_step", solveMsPerStep_},
               {"nn_agents", nn_.agents},
               {"nn_closer_than_dmin", nn_.closer},
               {"nn_dense_agents", nn_.dense},
@@ -395,7 +399,9 @@ class CrowdPhenomenon final : public Phenomenon {
   double maxDensity_ = 0.0;
   int stepsThisFrame_ = 0;      // steps of the frame being simulated
   long uicIterations_ = 0;      // QP iterations of those steps
+  double uicSolveSeconds_ = 0.0;  // QP solve time of those steps (Fig. 4.10)
   double iterationsPerStep_ = 0.0;  // of the last complete frame
+  double solveMsPerStep_ = 0.0;     // of the last complete frame
 };
 
 void declare(Schema& root) { declareCrowdKeys(root); }

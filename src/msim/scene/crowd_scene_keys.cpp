@@ -74,7 +74,8 @@ Schema crowdKeys() {
   Schema col = Schema::object("pairwise collision resolution after each step (ch. 4.3.3)");
   col.boolean("enabled", true, "push overlapping agents apart (off: Fig. 4.3c)");
   col.number("separation", "", 1.2, "pairs closer than this x d_min are pushed to it (ch. 4.5.1: 'somewhat larger')").min(1.0).max(2.0);
-  col.integer("iterations", 12, "Jacobi sweeps per step").min(1).max(100);
+  col.integer("iterations", 12, "most Jacobi sweeps per step").min(1).max(100);
+  col.number("tolerance", "", 0.01, "stop the sweeps once none moves an agent farther than this x d_min").min(0.0);
   c.field("collision_resolution", col);
   Schema orca = Schema::object("ORCA agents (van den Berg et al. 2011)");
   orca.number("neighbour_distance", "m", 3.0, "neighbours farther than this are ignored").min(0.0, Bound::Exclusive);
@@ -196,6 +197,7 @@ struct Builder {
     out.settings.collisionResolution = col.at("enabled").get<bool>();
     out.settings.collision.separation = col.at("separation").get<float>();
     out.settings.collision.iterations = col.at("iterations").get<int>();
+    out.settings.collision.tolerance = col.at("tolerance").get<float>();
     const json& o = c.at("orca");
     out.settings.orca.neighbourDist = o.at("neighbour_distance").get<float>();
     out.settings.orca.maxNeighbours = o.at("max_neighbours").get<int>();
@@ -434,7 +436,7 @@ void declareCrowdKeys(Schema& root) {
   Schema line = Schema::object("a line counting the agents that cross it");
   line.string("name", "line", "column name in run.json and stats.csv");
   line.vector("from", "m", 2, "one end");
-  line.vector("to", "m", 2, "other end; crossings to the left of from->to count positive");
+  line.vector("to", "m", 2, "other end; agents crossing to the right of from->to count positive");
   root.array("measurement_lines", line, "flow measurement (agents/s and agents/(m s))");
 }
 

@@ -1,0 +1,216 @@
+// The crowd time step of ch. 4.4.4 as a whole: the density cap of the UIC after every projection
+// with obstacles (ch. 4.4.3), inflow rates and exits, scripted agents that walk their script and are
+// obstacles to the others, and UIC and ORCA agents sharing a scene (Fig. 4.4) without overlaps.
+#include "msim/crowd/crowd_simulation.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "msim/core/error.hpp"
+#include "msim/core/rng.hpp"
+#include "msim/crowd/direct_planner.hpp"
+#include "msim/crowd/metrics.hpp"
+#include "msim/crowd/navigation_field.hpp"
+
+using namespace msim;
+using namespace msim::crowd;
+
+namespace {
+
+constexpr float kRadius = 0.25f;
+
+CrowdSettings settings(const Vec2& hi, int resolutionX) {
+  CrowdSettings s;
+  s.lo = Vec2::Zero();
+  s.hi = hi;
+  const double dx = hi.x() / resolutionX;
+  s.grid = GridSpec<2>(Vec2::Zero(), dx, IVec2(resolutionX, static_cast<int>(std::lround(hi.y() / dx))));
+  s.uicSettings.rhoMax = 0.64 * 2.0 / (std::sqrt(3.0) * 4 * kRadius * kRadius);  // eq. 4.4, alpha 0.64
+  s.collision.separation = 1.2f;
+  s.collision.iterations = 12;
+  return s;
+}
+
+// Agents uniformly at random in [lo, hi] (relaxed apart by the simulation's constructor).
+Agents randomAgents(std::size_t n, const Vec2& lo, const Vec2& hi, std::uint32_t goal, AgentModel model,
+                    std::uint64_t seed) {
+  Rng rng(seed);
+  Agents a;
+  for (std::size_t i = 0; i < n; ++i) {
+    AgentSpec s;
+    s.position = Vec2f(float(rng.uniform(lo.x(), hi.x())), float(rng.uniform(lo.y(), hi.y())));
+    s.radius = kRadius;
+    s.goal = goal;
+    s.model = model;
+    a.add(s);
+  }
+  return a;
+}
+
+double closestPairRatio(const Agents& a) {
+  const NearestNeighbours nn = nearestNeighbours(a.position, a.radius, 4 * kRadius);
+  double worst = std::numeric_limits<double>::infinity();
+  for (double r : nn.ratio) worst = std::min(worst, r);
+  return worst;
+}
+
+}  // namespace
+
+TEST(CrowdSimulation, DensityStaysCappedAtTheFreeAreaLimitEveryStep) {
+  // A room whose right wall has a 1.2 m door (Fig. 4.3): 400 agents press towards an exit behind
+  // it. Obstacles cover parts of cells, so the cap f rho_max varies along the wall (ch. 4.4.3).
+  const Vec2 hi(20, 20);
+  std::vector<Polygon> walls = {rectangle(Vec2(15, 0), Vec2(15.5, 9.4)), rectangle(Vec2(15, 10.6), Vec2(15.5, 20))};
+  Goal exit;
+  exit.kind = Goal::Kind::Region;
+  exit.region = rectangle(Vec2(17, 7), Vec2(20, 13));
+  exit.exit = true;
+  NavigationFieldOptions nav;
+  nav.hi = hi;
+  auto planner = std::make_shared<NavigationField>(std::vector<Goal>{exit}, walls, nav);
+  CrowdSimulation sim(settings(hi, 20), walls, {exit}, planner, randomAgents(400, Vec2(1, 1), Vec2(14, 19), 0, AgentModel::Uic, 7));
+  double worstPredicted = 0.0, worstActual = 0.0, worstOpen = 0.0, worstCut = 0.0;
+  int activeSteps = 0;
+  for (int step = 0; step < 200; ++step) {
+    sim.step(0.1);
+    const UicStats& u = sim.lastStep().uic;
+    worstPredicted = std::max(worstPredicted, u.maxRatioAfter);
+    if (step > 0) worstActual = std::max(worstActual, u.maxRatioBefore);
+    {
+      const auto& rho = sim.uic().density();
+      const auto& f = sim.uic().freeArea();
+      for (std::size_t c = 0; c < rho.count(); ++c) {
+        const double r = rho[c] / (f[c] * sim.settings().uicSettings.rhoMax);
+        if (f[c] >= 0.999) worstOpen = std::max(worstOpen, r);
+        else if (f[c] > 0) worstCut = std::max(worstCut, r);
+      }
+    }
+    if (u.activeCells > 0) ++activeSteps;
+    ASSERT_LE(u.maxRatioAfter, 1.05) << "step " << step;
+  }
+  std::printf("doorway: max predicted rho / (f rho_max) after projection %.4f, max splatted before the next %.4f, "
+              "UIC active in %d of 200 steps, %zu agents left, %zu exited\n",
+              worstPredicted, worstActual, activeSteps, sim.agents().size(), sim.exits().size());
+  std::printf("open cells %.3f, cut cells %.3f\n", worstOpen, worstCut);
+  EXPECT_GT(activeSteps, 100);        // the queue at the door is at rho_max most of the time
+  EXPECT_GT(sim.exits().size(), 50u);  // and it drains through the door
+  EXPECT_EQ(sim.exits().size() + sim.agents().size(), 400u);
+  EXPECT_GT(closestPairRatio(sim.agents()), 0.9);
+}
+
+TEST(CrowdSimulation, InflowsSpawnAtTheirRateAndExitsRemoveAgents) {
+  const Vec2 hi(30, 10);
+  Goal east;
+  east.kind = Goal::Kind::Region;
+  east.region = rectangle(Vec2(28, 0), Vec2(30, 10));
+  east.exit = true;
+  Inflow in;
+  in.region = rectangle(Vec2(0.5, 0.5), Vec2(2, 9.5));
+  in.rate = 7.0;
+  in.start = 1.0;
+  in.stop = 11.0;
+  in.agent.goal = 0;
+  in.agent.radius = kRadius;
+  auto planner = std::make_shared<DirectPlanner>(std::vector<Goal>{east});
+  CrowdSimulation sim(settings(hi, 30), {}, {east}, planner, Agents{}, {in});
+  std::size_t spawned = 0;
+  for (int step = 0; step < 800; ++step) {
+    sim.step(0.05);
+    spawned += sim.lastStep().spawned;
+    // 7 agents/s from t = 1 s: exactly floor(7 (t - 1)) so far (credit carried between steps).
+    const double t = sim.time();
+    const std::size_t expected = static_cast<std::size_t>(std::floor(7.0 * std::clamp(t - 1.0, 0.0, 10.0) + 1e-6));
+    ASSERT_EQ(spawned, expected) << "t = " << t;
+  }
+  EXPECT_EQ(spawned, 70u);
+  // At 1.4 m/s the walk of at most 27.5 m takes under 20 s: the last agent (t = 11 s) is out by 40 s.
+  EXPECT_EQ(sim.agents().size(), 0u);
+  ASSERT_EQ(sim.exits().size(), 70u);
+  for (std::size_t k = 1; k < sim.exits().size(); ++k) EXPECT_GE(sim.exits()[k].time, sim.exits()[k - 1].time);
+  EXPECT_GT(sim.exits().front().time, 1.0 + 26.0 / 1.4 - 2.0);
+}
+
+TEST(CrowdSimulation, ScriptedAgentsWalkTheirScriptAndOthersGiveWay) {
+  // A scripted agent crosses a crowd walking the other way (ch. 4.4.3): it keeps its path and
+  // speed exactly, and nobody overlaps it.
+  const Vec2 hi(30, 30);
+  Goal west;
+  west.point = Vec2(2, 15);
+  auto planner = std::make_shared<DirectPlanner>(std::vector<Goal>{west});
+  Agents agents = randomAgents(300, Vec2(12, 10), Vec2(24, 20), 0, AgentModel::Uic, 11);
+  AgentSpec walker;
+  walker.position = Vec2f(4, 15);
+  walker.radius = 0.4f;
+  walker.maxSpeed = 1.0f;
+  walker.model = AgentModel::Scripted;
+  const std::size_t w = agents.add(walker);
+  const std::uint64_t id = agents.id[w];
+  Script script{id, {Vec2(26, 15), Vec2(26, 25)}, false};
+  CrowdSimulation sim(settings(hi, 30), {}, {west}, planner, std::move(agents), {}, {script});
+  double closest = std::numeric_limits<double>::infinity();
+  for (int step = 1; step <= 250; ++step) {
+    sim.step(0.1);
+    const Agents& a = sim.agents();
+    const std::size_t k = std::find(a.id.begin(), a.id.end(), id) - a.id.begin();
+    const Vec2 x = a.position[k].cast<double>();
+    // Arc length 1 m/s x t along the script: 22 m east, then north.
+    const double s = std::min(0.1 * step, 32.0);
+    const Vec2 expected = s <= 22.0 ? Vec2(4 + s, 15) : Vec2(26, 15 + (s - 22.0));
+    ASSERT_NEAR((x - expected).norm(), 0.0, 1e-4) << "step " << step;
+    for (std::size_t j = 0; j < a.size(); ++j)
+      if (j != k) closest = std::min(closest, (a.position[j] - a.position[k]).norm() / double(a.radius[j] + a.radius[k]));
+  }
+  std::printf("scripted walker: closest approach %.3f d_min\n", closest);
+  EXPECT_GT(closest, 0.95);
+}
+
+TEST(CrowdSimulation, UicAndOrcaAgentsShareAScene) {
+  // Fig. 4.4: a UIC group and an ORCA group cross at right angles; neither kind overlaps the other.
+  const Vec2 hi(40, 40);
+  Goal east, north;
+  east.kind = north.kind = Goal::Kind::Region;
+  east.region = rectangle(Vec2(38, 0), Vec2(40, 40));
+  north.region = rectangle(Vec2(0, 38), Vec2(40, 40));
+  east.exit = north.exit = true;
+  auto planner = std::make_shared<DirectPlanner>(std::vector<Goal>{east, north});
+  Agents agents = randomAgents(200, Vec2(2, 14), Vec2(12, 26), 0, AgentModel::Uic, 3);
+  const Agents orca = randomAgents(100, Vec2(15, 2), Vec2(25, 10), 1, AgentModel::Orca, 4);
+  for (std::size_t i = 0; i < orca.size(); ++i) agents.add(orca.spec(i));
+  CrowdSimulation sim(settings(hi, 40), {}, {east, north}, planner, std::move(agents));
+  double worstMixed = std::numeric_limits<double>::infinity();
+  for (int step = 0; step < 400; ++step) {
+    sim.step(0.1);
+    const Agents& a = sim.agents();
+    const NearestNeighbours nn = nearestNeighbours(a.position, a.radius, 4 * kRadius);
+    for (double r : nn.ratio) worstMixed = std::min(worstMixed, r);
+  }
+  std::printf("UIC + ORCA crossing: closest pair %.3f d_min over 40 s, %zu of 300 agents arrived\n", worstMixed,
+              sim.exits().size());
+  EXPECT_GT(worstMixed, 0.9);
+  EXPECT_GT(sim.exits().size(), 250u);
+}
+
+TEST(CrowdSimulation, RefusesAgentsOutsideTheDomainOrWithUnreachableGoals) {
+  const Vec2 hi(10, 10);
+  Goal g;
+  g.point = Vec2(5, 5);
+  auto planner = std::make_shared<DirectPlanner>(std::vector<Goal>{g});
+  EXPECT_THROW(CrowdSimulation(settings(hi, 10), {}, {g}, planner, randomAgents(3, Vec2(11, 1), Vec2(12, 2), 0, AgentModel::Uic, 1)),
+               InputError);
+  EXPECT_THROW(CrowdSimulation(settings(hi, 10), {}, {g}, planner, randomAgents(3, Vec2(1, 1), Vec2(2, 2), 5, AgentModel::Uic, 1)),
+               InputError);
+  // A goal inside a closed ring of walls.
+  const std::vector<Polygon> ring = {rectangle(Vec2(3, 3), Vec2(7, 3.5)), rectangle(Vec2(3, 6.5), Vec2(7, 7)),
+                                     rectangle(Vec2(3, 3.5), Vec2(3.5, 6.5)), rectangle(Vec2(6.5, 3.5), Vec2(7, 6.5))};
+  NavigationFieldOptions nav;
+  nav.hi = hi;
+  auto field = std::make_shared<NavigationField>(std::vector<Goal>{g}, ring, nav);
+  try {
+    CrowdSimulation(settings(hi, 10), ring, {g}, field, randomAgents(3, Vec2(0.5, 0.5), Vec2(2, 2), 0, AgentModel::Uic, 1));
+    FAIL() << "an enclosed goal must be refused";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot be reached"), std::string::npos) << e.what();
+  }
+}
