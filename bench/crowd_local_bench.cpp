@@ -56,7 +56,7 @@ void BM_CollisionResolution(benchmark::State& state) {
     state.PauseTiming();
     a.position = start.position;
     state.ResumeTiming();
-    resolver.resolve(a, StaticObstacles(), domain);  // defaults: separation 1.2, 12 Jacobi sweeps
+    resolver.resolve(a, StaticObstacles(), domain);  // defaults: separation 1.2, 6 Gauss-Seidel sweeps
   }
   state.counters["bucketings"] = resolver.lastBucketings();
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(n));
@@ -67,6 +67,9 @@ BENCHMARK(BM_CollisionResolution)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Un
 // velocities (1.2 m/s, random headings), which is what resolve() sees after each step.
 void BM_CollisionResolutionStep(benchmark::State& state) {
   const std::size_t n = static_cast<std::size_t>(state.range(0));
+  CollisionResolutionParams params;  // range(1): 0 Gauss-Seidel, 1 Jacobi; range(2): sweeps
+  params.sweeps = state.range(1) ? CollisionResolutionParams::Sweeps::Jacobi : CollisionResolutionParams::Sweeps::GaussSeidel;
+  params.iterations = static_cast<int>(state.range(2));
   Agents start = denseCrowd(n, AgentModel::Uic);
   const float side = std::sqrt(static_cast<float>(n) / 2.0f);
   const DomainBox domain{Vec2f(-1, -1), Vec2f(side + 1, side + 1)};
@@ -76,17 +79,20 @@ void BM_CollisionResolutionStep(benchmark::State& state) {
   resolver.resolve(start, StaticObstacles(), domain, settle);
   for (std::size_t i = 0; i < n; ++i) start.position[i] += 0.1f * start.preferredVelocity[i];
   Agents a = start;
-  resolver.resolve(a, StaticObstacles(), domain);  // warm
+  resolver.resolve(a, StaticObstacles(), domain, params);  // warm
   for (auto _ : state) {
     state.PauseTiming();
     a.position = start.position;
     state.ResumeTiming();
-    resolver.resolve(a, StaticObstacles(), domain);
+    resolver.resolve(a, StaticObstacles(), domain, params);
   }
   state.counters["bucketings"] = resolver.lastBucketings();
+  state.counters["sweeps"] = resolver.lastSweeps();
+  state.counters["redone"] = resolver.lastRedoneSweeps();
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(n));
 }
-BENCHMARK(BM_CollisionResolutionStep)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_CollisionResolutionStep)
+    ->ArgsProduct({{10'000, 100'000, 1'000'000}, {0, 1}, {6, 12}})->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_OrcaStep(benchmark::State& state) {
   const std::size_t n = static_cast<std::size_t>(state.range(0));

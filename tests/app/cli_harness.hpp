@@ -27,8 +27,10 @@ inline fs::path scratch(const std::string& name) {
 }
 
 inline Result runMsim(const std::string& args) {
-  // One log per test: ctest runs the tests of this program in parallel processes.
-  const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  // One log per test (suite and name: two suites may share a test name): ctest runs the tests of
+  // this program in parallel processes.
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  const std::string test = std::string(info->test_suite_name()) + "." + info->name();
   const fs::path log = fs::path(MSIM_TEST_TMP) / "app" / (test + ".log");
   fs::create_directories(log.parent_path());
   const std::string cmd = std::string(MSIM_APP_PATH) + " " + args + " > " + log.string() + " 2>&1";

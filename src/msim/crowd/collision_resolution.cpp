@@ -1,6 +1,7 @@
 #include "msim/crowd/collision_resolution.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 
@@ -151,7 +152,8 @@ void CollisionResolver::bucket(const Agents& agents, float cellSize) {
   const std::span<const std::uint32_t> order = grid_.cellOrder();
   const std::span<const Vec2f> sorted = grid_.sortedPoints();
   // Padding: far away (the squared distance overflows to inf), so never within range.
-  for (auto* v : {&x_, &y_, &nextX_, &nextY_}) v->resize(n + kPad, 1e30f);
+  for (auto* v : {&x_, &y_, &nextX_, &nextY_, &prevX_, &prevY_}) v->resize(n + kPad, 1e30f);
+  path_.assign(n + kPad, 0.0f);
   for (auto* v : {&radius_, &yield_, &tmpRadius_, &tmpYield_}) v->resize(n + kPad, 0.0f);
   bucketed_.resize(n);
   scripted_.resize(n);
@@ -176,6 +178,7 @@ void CollisionResolver::resizeCellFlags() {
   const std::size_t cells = static_cast<std::size_t>(grid_.cellsX()) * grid_.cellsY();
   moved_.resize(cells);
   movedNext_.resize(cells);
+  noop_.resize(cells);
 }
 
 void CollisionResolver::rebucket(float cellSize) {
@@ -275,6 +278,140 @@ inline void pushAvx(const float* xs, const float* ys, const float* rad, const fl
   }
 }
 
+// Gauss-Seidel pair projections of agent i (at xi, yi, radius ri, yield yi_) against the slots
+// [lo, hi), all after i in the processing order: each pair closer than target = s (r_i + r_j) is
+// pushed apart to target, i taking si = yield_j (0 if i is scripted) of the correction and j
+// taking sj = yield_i (2 - 2 yield_j) (0 if j is scripted): equal and opposite for two movable
+// agents. j is updated in place (masked loads and stores: no slot outside the range is touched);
+// i's share is summed into ax, ay, and the lengths moved into path (j) and pathI. Returns the
+// lanes of coincident pairs of the last batch via `close` (handled by the caller, rare).
+inline bool projectAvx(float* xs, float* ys, const float* rad, const float* yield, float* path, std::uint32_t lo,
+                       std::uint32_t hi, float xi, float yi, float ri, float yieldI, bool movableI, float s,
+                       __m256& ax, __m256& ay, __m256& pathI, int& close) {
+  const __m256 xv = _mm256_set1_ps(xi), yv = _mm256_set1_ps(yi), rv = _mm256_set1_ps(ri), sv = _mm256_set1_ps(s);
+  const __m256 eps = _mm256_set1_ps(1e-14f), one = _mm256_set1_ps(1.0f), two = _mm256_set1_ps(2.0f);
+  const __m256 movI = movableI ? _mm256_castsi256_ps(_mm256_set1_epi32(-1)) : _mm256_setzero_ps();
+  const __m256 yI = _mm256_set1_ps(yieldI);
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  bool changed = false;
+  for (std::uint32_t j = lo; j < hi; j += 8) {
+    const __m256i valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(static_cast<int>(hi - j)), lane);
+    const __m256 xj = _mm256_maskload_ps(xs + j, valid), yj = _mm256_maskload_ps(ys + j, valid);
+    const __m256 ex = _mm256_sub_ps(xv, xj), ey = _mm256_sub_ps(yv, yj);
+    const __m256 d2 = _mm256_add_ps(_mm256_mul_ps(ex, ex), _mm256_mul_ps(ey, ey));
+    const __m256 target = _mm256_mul_ps(sv, _mm256_add_ps(rv, _mm256_maskload_ps(rad + j, valid)));
+    const __m256 t2 = _mm256_mul_ps(target, target);
+    const __m256 in = _mm256_and_ps(_mm256_castsi256_ps(valid), _mm256_cmp_ps(d2, t2, _CMP_LT_OQ));
+    if (_mm256_testz_ps(in, in)) continue;
+    const __m256 apart = _mm256_cmp_ps(d2, _mm256_mul_ps(eps, t2), _CMP_GT_OQ);
+    close += __builtin_popcount(static_cast<unsigned>(_mm256_movemask_ps(_mm256_andnot_ps(apart, in))));
+    const __m256 est = _mm256_rsqrt_ps(d2);
+    const __m256 inv = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(0.5f), est),
+                                     _mm256_sub_ps(_mm256_set1_ps(3.0f), _mm256_mul_ps(_mm256_mul_ps(d2, est), est)));
+    const __m256 m = _mm256_and_ps(in, apart);
+    // The whole correction along e: (target / dist - 1) e, of length target - dist.
+    const __m256 f = _mm256_and_ps(m, _mm256_sub_ps(_mm256_mul_ps(target, inv), one));
+    const __m256 yJ = _mm256_maskload_ps(yield + j, valid);
+    const __m256 si = _mm256_and_ps(movI, yJ);
+    const __m256 sj = _mm256_mul_ps(yI, _mm256_sub_ps(two, _mm256_mul_ps(two, yJ)));
+    const __m256 cx = _mm256_mul_ps(f, ex), cy = _mm256_mul_ps(f, ey);
+    const __m256 len = _mm256_sub_ps(target, _mm256_mul_ps(d2, inv));  // target - dist
+    ax = _mm256_add_ps(ax, _mm256_mul_ps(si, cx));
+    ay = _mm256_add_ps(ay, _mm256_mul_ps(si, cy));
+    pathI = _mm256_add_ps(pathI, _mm256_and_ps(m, _mm256_mul_ps(si, len)));
+    const __m256 moveJ = _mm256_and_ps(m, _mm256_cmp_ps(sj, _mm256_setzero_ps(), _CMP_GT_OQ));
+    changed |= (movableI && !_mm256_testz_ps(m, m)) || !_mm256_testz_ps(moveJ, moveJ);
+    _mm256_maskstore_ps(xs + j, valid, _mm256_sub_ps(xj, _mm256_mul_ps(sj, cx)));
+    _mm256_maskstore_ps(ys + j, valid, _mm256_sub_ps(yj, _mm256_mul_ps(sj, cy)));
+    const __m256 pj = _mm256_maskload_ps(path + j, valid);
+    _mm256_maskstore_ps(path + j, valid, _mm256_add_ps(pj, _mm256_and_ps(m, _mm256_mul_ps(sj, len))));
+  }
+  return changed;
+}
+
+// Broadcast of lane `l` of v.
+inline __m256 lane(__m256 v, int l) { return _mm256_permutevar8x32_ps(v, _mm256_set1_epi32(l)); }
+// Sum of the lanes of v in every lane.
+inline __m256 hsumAll(__m256 v) {
+  v = _mm256_add_ps(v, _mm256_permute2f128_ps(v, v, 1));
+  v = _mm256_add_ps(v, _mm256_permute_ps(v, 0b01001110));
+  return _mm256_add_ps(v, _mm256_permute_ps(v, 0b10110001));
+}
+
+// One block of up to 8 candidate slots held in registers (positions, radii, yields, the lengths
+// moved), loaded once per cell and stored back once.
+struct Block {
+  __m256i valid;
+  __m256 x, y, r, w, path;
+  std::uint32_t lo;
+  void load(const float* xs, const float* ys, const float* rad, const float* yield, const float* p, std::uint32_t from,
+            std::uint32_t count) {
+    lo = from;
+    valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(static_cast<int>(count)), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+    x = _mm256_maskload_ps(xs + from, valid);
+    y = _mm256_maskload_ps(ys + from, valid);
+    r = _mm256_maskload_ps(rad + from, valid);
+    w = _mm256_maskload_ps(yield + from, valid);
+    path = _mm256_maskload_ps(p + from, valid);
+  }
+  void store(float* xs, float* ys, float* p) const {
+    _mm256_maskstore_ps(xs + lo, valid, x);
+    _mm256_maskstore_ps(ys + lo, valid, y);
+    _mm256_maskstore_ps(p + lo, valid, path);
+  }
+};
+
+// projectAvx with the candidates in registers: agent i (broadcast in xv, yv, rv, yieldI; movI
+// all ones when it may move) against the lanes `use` of block b. Returns whether anything moved;
+// coincident pairs (rare) are done with their hashed directions through a scalar patch.
+inline bool projectBlock(Block& b, __m256 use, __m256 xv, __m256 yv, __m256 rv, __m256 yI, __m256 movI, __m256 sv,
+                         std::uint32_t i, const std::uint32_t* agent, __m256& ax, __m256& ay, __m256& pathI) {
+  const __m256 one = _mm256_set1_ps(1.0f), two = _mm256_set1_ps(2.0f);
+  const __m256 ex = _mm256_sub_ps(xv, b.x), ey = _mm256_sub_ps(yv, b.y);
+  const __m256 d2 = _mm256_add_ps(_mm256_mul_ps(ex, ex), _mm256_mul_ps(ey, ey));
+  const __m256 target = _mm256_mul_ps(sv, _mm256_add_ps(rv, b.r));
+  const __m256 t2 = _mm256_mul_ps(target, target);
+  const __m256 in = _mm256_and_ps(use, _mm256_cmp_ps(d2, t2, _CMP_LT_OQ));
+  if (_mm256_testz_ps(in, in)) return false;
+  const __m256 apart = _mm256_cmp_ps(d2, _mm256_mul_ps(_mm256_set1_ps(1e-14f), t2), _CMP_GT_OQ);
+  const __m256 est = _mm256_rsqrt_ps(d2);
+  const __m256 inv = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(0.5f), est),
+                                   _mm256_sub_ps(_mm256_set1_ps(3.0f), _mm256_mul_ps(_mm256_mul_ps(d2, est), est)));
+  const __m256 m = _mm256_and_ps(in, apart);
+  const __m256 f = _mm256_and_ps(m, _mm256_sub_ps(_mm256_mul_ps(target, inv), one));
+  __m256 cx = _mm256_mul_ps(f, ex), cy = _mm256_mul_ps(f, ey);
+  __m256 len = _mm256_and_ps(m, _mm256_sub_ps(target, _mm256_mul_ps(d2, inv)));
+  const int coincident = _mm256_movemask_ps(_mm256_andnot_ps(apart, in));
+  if (coincident != 0) {
+    alignas(32) float lx[8], ly[8], ll[8], lt[8], ld[8];
+    _mm256_store_ps(lx, cx);
+    _mm256_store_ps(ly, cy);
+    _mm256_store_ps(ll, len);
+    _mm256_store_ps(lt, target);
+    _mm256_store_ps(ld, d2);
+    for (int l = 0; l < 8; ++l)
+      if (coincident >> l & 1) {
+        const Vec2f dir = coincidentDirection(agent[i], agent[b.lo + l]);
+        ll[l] = lt[l] - std::sqrt(ld[l]);
+        lx[l] = ll[l] * dir.x();
+        ly[l] = ll[l] * dir.y();
+      }
+    cx = _mm256_load_ps(lx);
+    cy = _mm256_load_ps(ly);
+    len = _mm256_load_ps(ll);
+  }
+  const __m256 si = _mm256_and_ps(movI, b.w);
+  const __m256 sj = _mm256_mul_ps(yI, _mm256_sub_ps(two, _mm256_mul_ps(two, b.w)));
+  ax = _mm256_add_ps(ax, _mm256_mul_ps(si, cx));
+  ay = _mm256_add_ps(ay, _mm256_mul_ps(si, cy));
+  pathI = _mm256_add_ps(pathI, _mm256_mul_ps(si, len));
+  b.x = _mm256_sub_ps(b.x, _mm256_mul_ps(sj, cx));
+  b.y = _mm256_sub_ps(b.y, _mm256_mul_ps(sj, cy));
+  b.path = _mm256_add_ps(b.path, _mm256_mul_ps(sj, len));
+  const __m256 movesJ = _mm256_and_ps(in, _mm256_cmp_ps(sj, _mm256_setzero_ps(), _CMP_GT_OQ));
+  return !_mm256_testz_ps(_mm256_and_ps(in, movI), _mm256_and_ps(in, movI)) || !_mm256_testz_ps(movesJ, movesJ);
+}
+
 inline float sum8(__m256 v) {
   alignas(32) float l[8];
   _mm256_store_ps(l, v);
@@ -295,6 +432,7 @@ void CollisionResolver::resolve(Agents& agents, const StaticObstacles& obstacles
                                 const CollisionResolutionParams& params) {
   bucketings_ = 0;
   sweeps_ = 0;
+  redone_ = 0;
   const std::size_t n = agents.size();
   if (n == 0 || params.iterations <= 0) return;
   const float s = params.separation;
@@ -304,10 +442,56 @@ void CollisionResolver::resolve(Agents& agents, const StaticObstacles& obstacles
   // agents may move a little before the buckets have to be redone.
   const float range = s * 2.0f * rmax;
   const float tolerance2 = (params.tolerance * 2.0f * rmax) * (params.tolerance * 2.0f * rmax);
-  constexpr float kSkin = 0.5f;
+  // Gauss-Seidel: the bound on the distance moved counts every correction (agents pushed back and
+  // forth in a jam), so a wider skin; 0.75-1.5 measured the same, 0.5 re-buckets 5 times per
+  // call instead of 3.
+  const float kSkin = params.sweeps == CollisionResolutionParams::Sweeps::Jacobi ? 0.5f : 1.0f;
   bucket(agents, range * (1.0f + kSkin));
   int bucketedAt = 0;           // the first sweep on the current buckets
   float movedSinceBucket2 = 0;  // largest squared displacement since then
+
+  if (params.sweeps == CollisionResolutionParams::Sweeps::GaussSeidel) {
+    auto keepStart = [&] {
+      startEnd2_ = 0.0f;  // called right after bucketing: the positions are the bucketed ones
+      std::copy(x_.begin(), x_.begin() + static_cast<std::ptrdiff_t>(n), prevX_.begin());
+      std::copy(y_.begin(), y_.begin() + static_cast<std::ptrdiff_t>(n), prevY_.begin());
+    };
+    keepStart();
+    bool fresh = true;  // the first sweep on the current buckets
+    for (int it = 0; it < params.iterations; ++it) {
+      SweepMoves moves = gaussSeidelSweep(obstacles, domain, s, fresh);
+      // A pair within range at some moment of the sweep was within range + 2 D when bucketed, D
+      // bounding every agent's distance from its bucketed position during the sweep (distance
+      // at the start plus the lengths of its corrections). If that no longer fits in a cell, a
+      // pair may have been missed: the sweep is undone and redone on new buckets. (Not on fresh
+      // buckets: there a single sweep moved that far, from deep overlaps, and is kept.)
+      auto tooFar = [&](float d) { return range + 2.0f * d * 1.001f + 1e-6f * range >= grid_.cellSize(); };
+      if (!fresh && tooFar(std::sqrt(moves.sinceBucket2))) {
+        ++redone_;
+        std::copy(prevX_.begin(), prevX_.begin() + static_cast<std::ptrdiff_t>(n), x_.begin());
+        std::copy(prevY_.begin(), prevY_.begin() + static_cast<std::ptrdiff_t>(n), y_.begin());
+        rebucket(range * (1.0f + kSkin));
+        keepStart();
+        moves = gaussSeidelSweep(obstacles, domain, s, true);
+      }
+      fresh = false;
+      startEnd2_ = moves.end2;
+      prevX_.swap(nextX_);  // the end positions start the next sweep
+      prevY_.swap(nextY_);
+      moved_.swap(movedNext_);
+      ++sweeps_;
+      if (it + 1 == params.iterations || moves.sweep2 <= tolerance2) break;
+      // Expect the next sweep to move agents about as far as this one: re-bucket before it if the
+      // bound would not fit.
+      if (tooFar(std::sqrt(moves.end2) + moves.path)) {
+        rebucket(range * (1.0f + kSkin));
+        keepStart();
+        fresh = true;
+      }
+    }
+    scatter(agents);
+    return;
+  }
 
   for (int it = 0; it < params.iterations; ++it) {
     const int nx = grid_.cellsX(), ny = grid_.cellsY();
@@ -424,6 +608,238 @@ void CollisionResolver::resolve(Agents& agents, const StaticObstacles& obstacles
     }
   }
   scatter(agents);
+}
+
+namespace {
+// Scalar projectAvx (no AVX2), and the coincident pairs of the AVX2 path (`coincidentOnly`).
+inline bool projectScalar(float* xs, float* ys, const float* rad, const float* yield, float* path,
+                          const std::uint32_t* agent, std::uint32_t lo, std::uint32_t hi, std::uint32_t i, float xi,
+                          float yi, float ri, float yieldI, bool movableI, float s, bool coincidentOnly, float& dx,
+                          float& dy, float& pathI) {
+  bool changed = false;
+  for (std::uint32_t j = lo; j < hi; ++j) {
+    const float ex = xi - xs[j], ey = yi - ys[j];
+    const float target = s * (ri + rad[j]);
+    const float d2 = ex * ex + ey * ey, t2 = target * target;
+    if (d2 >= t2) continue;
+    const bool coincident = !(d2 > 1e-14f * t2);
+    if (coincident != coincidentOnly) continue;
+    const float si = movableI ? yield[j] : 0.0f;
+    const float sj = yieldI * (2.0f - 2.0f * yield[j]);
+    float cx, cy, len;
+    if (coincident) {
+      const Vec2f dir = coincidentDirection(agent[i], agent[j]);
+      len = target - std::sqrt(d2);
+      cx = len * dir.x();
+      cy = len * dir.y();
+    } else {
+      const float dist = std::sqrt(d2);
+      const float f = (target - dist) / dist;
+      len = target - dist;
+      cx = f * ex;
+      cy = f * ey;
+    }
+    dx += si * cx;
+    dy += si * cy;
+    pathI += si * len;
+    xs[j] -= sj * cx;
+    ys[j] -= sj * cy;
+    path[j] += sj * len;
+    changed |= si > 0.0f || sj > 0.0f;
+  }
+  return changed;
+}
+}  // namespace
+
+CollisionResolver::SweepMoves CollisionResolver::gaussSeidelSweep(const StaticObstacles& obstacles,
+                                                                  const DomainBox& domain, float s,
+                                                                  bool everything) {
+  const int nx = grid_.cellsX(), ny = grid_.cellsY();
+  const std::uint32_t* start = grid_.cellStarts().data();
+  const std::size_t n = agent_.size();
+  float* xs = x_.data();
+  float* ys = y_.data();
+  float* path = path_.data();
+  const float* rad = radius_.data();
+  const float* yield = yield_.data();
+  const std::uint8_t* scripted = scripted_.data();
+  const std::uint32_t* agent = agent_.data();
+  const std::uint8_t* moved = moved_.data();
+  std::uint8_t* movedNext = movedNext_.data();
+  std::uint8_t* noop = noop_.data();
+  std::fill(movedNext_.begin(), movedNext_.end(), std::uint8_t(0));
+
+  // Cell (cx, cy) projects the pairs of its agents with the later agents of its own cell, with
+  // those of the cell to its right (the next slots) and with those of the three cells above: every
+  // pair once. It reads and writes only that footprint, which lies in rows cy and cy + 1, so the
+  // even rows can be done in parallel, then the odd ones.
+  auto doCell = [&](int cx, int cy) {
+    const std::size_t c = static_cast<std::size_t>(cy) * nx + cx;
+    const std::uint32_t first = start[c], last = start[c + 1];
+    if (first == last) return;
+    const int fx0 = std::max(cx - 1, 0), fx1 = std::min(cx + 1, nx - 1);
+    const std::uint32_t endSame = start[c + (cx + 1 < nx ? 2 : 1)];
+    std::uint32_t lo2 = 0, hi2 = 0;
+    const bool above = cy + 1 < ny;
+    const std::size_t row = static_cast<std::size_t>(cy + 1) * nx;
+    if (above) {
+      lo2 = start[row + fx0];
+      hi2 = start[row + fx1 + 1];
+    }
+    // Skipped when its last pass moved nobody and nothing in the footprint moved since (in the
+    // last sweep or this one): the same inputs give the same (no) result.
+    if (!everything && noop[c]) {
+      bool dirty = false;
+      for (int x = cx; x <= fx1; ++x) dirty |= (moved[c - cx + x] | movedNext[c - cx + x]) != 0;
+      if (above)
+        for (int x = fx0; x <= fx1; ++x) dirty |= (moved[row + x] | movedNext[row + x]) != 0;
+      if (!dirty) return;
+    }
+    bool changed = false;
+#if defined(__AVX2__)
+    // Usual case: the cell and its right neighbour fit in two blocks of 8 slots, the three cells
+    // above in three. All pairs are done in registers (or spilled to the stack, which forwards),
+    // stored back once: no store-to-load dependency through the slot arrays.
+    if (endSame - first <= 16 && hi2 - lo2 <= 24) {
+      // Blocks 0-1: the cell and its right neighbour; 2-4: the three cells above.
+      Block blk[5];
+      const std::uint32_t n1 = endSame - first, n2 = hi2 - lo2;
+      const int nb1 = static_cast<int>((n1 + 7) / 8), nb2 = static_cast<int>((n2 + 7) / 8);
+      for (int q = 0; q < nb1; ++q)
+        blk[q].load(xs, ys, rad, yield, path, first + 8 * q, std::min<std::uint32_t>(8, n1 - 8 * q));
+      for (int q = 0; q < nb2; ++q)
+        blk[2 + q].load(xs, ys, rad, yield, path, lo2 + 8 * q, std::min<std::uint32_t>(8, n2 - 8 * q));
+      const __m256 sv = _mm256_set1_ps(s);
+      const __m256i lanes = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+      for (std::uint32_t l = 0; l < last - first; ++l) {
+        const int bi = static_cast<int>(l / 8), li = static_cast<int>(l % 8);
+        Block& own = blk[bi];
+        const __m256 xv = lane(own.x, li), yv = lane(own.y, li), rv = lane(own.r, li), yI = lane(own.w, li);
+        const __m256 movI = _mm256_cmp_ps(yI, _mm256_set1_ps(0.75f), _CMP_LT_OQ);
+        __m256 ax = _mm256_setzero_ps(), ay = _mm256_setzero_ps(), pv = _mm256_setzero_ps();
+        const std::uint32_t i = first + l;
+        // The later slots of the cell and those of its right neighbour.
+        for (int q = bi; q < nb1; ++q) {
+          const __m256i later = _mm256_cmpgt_epi32(lanes, _mm256_set1_epi32(li - 8 * (q - bi)));
+          changed |= projectBlock(blk[q], _mm256_castsi256_ps(_mm256_and_si256(blk[q].valid, later)), xv, yv, rv, yI,
+                                  movI, sv, i, agent, ax, ay, pv);
+        }
+        for (int q = 2; q < 2 + nb2; ++q)
+          changed |= projectBlock(blk[q], _mm256_castsi256_ps(blk[q].valid), xv, yv, rv, yI, movI, sv, i, agent, ax,
+                                  ay, pv);
+        const __m256 self = _mm256_castsi256_ps(_mm256_cmpeq_epi32(lanes, _mm256_set1_epi32(li)));
+        own.x = _mm256_add_ps(own.x, _mm256_and_ps(self, hsumAll(ax)));
+        own.y = _mm256_add_ps(own.y, _mm256_and_ps(self, hsumAll(ay)));
+        own.path = _mm256_add_ps(own.path, _mm256_and_ps(self, hsumAll(pv)));
+      }
+      for (int q = 0; q < nb1; ++q) blk[q].store(xs, ys, path);
+      for (int q = 2; q < 2 + nb2; ++q) blk[q].store(xs, ys, path);
+      noop[c] = changed ? 0 : 1;
+      if (changed) {
+        for (int x = cx; x <= fx1; ++x) movedNext[c - cx + x] = 1;
+        if (above)
+          for (int x = fx0; x <= fx1; ++x) movedNext[row + x] = 1;
+      }
+      return;
+    }
+#endif
+    for (std::uint32_t i = first; i < last; ++i) {
+      const float xi = xs[i], yi = ys[i], ri = rad[i], yieldI = yield[i];
+      const bool movableI = scripted[i] == 0;
+      float dx = 0.0f, dy = 0.0f, pathI = 0.0f;
+#if defined(__AVX2__)
+      __m256 ax = _mm256_setzero_ps(), ay = _mm256_setzero_ps(), pv = _mm256_setzero_ps();
+      int close = 0;
+      changed |= projectAvx(xs, ys, rad, yield, path, i + 1, endSame, xi, yi, ri, yieldI, movableI, s, ax, ay, pv, close);
+      changed |= projectAvx(xs, ys, rad, yield, path, lo2, hi2, xi, yi, ri, yieldI, movableI, s, ax, ay, pv, close);
+      dx = sum8(ax);
+      dy = sum8(ay);
+      pathI = sum8(pv);
+      if (close > 0) {
+        changed |= projectScalar(xs, ys, rad, yield, path, agent, i + 1, endSame, i, xi, yi, ri, yieldI, movableI, s,
+                                 true, dx, dy, pathI);
+        changed |= projectScalar(xs, ys, rad, yield, path, agent, lo2, hi2, i, xi, yi, ri, yieldI, movableI, s, true,
+                                 dx, dy, pathI);
+      }
+#else
+      for (const bool coincident : {false, true}) {
+        changed |= projectScalar(xs, ys, rad, yield, path, agent, i + 1, endSame, i, xi, yi, ri, yieldI, movableI, s,
+                                 coincident, dx, dy, pathI);
+        changed |= projectScalar(xs, ys, rad, yield, path, agent, lo2, hi2, i, xi, yi, ri, yieldI, movableI, s,
+                                 coincident, dx, dy, pathI);
+      }
+#endif
+      xs[i] = xi + dx;
+      ys[i] = yi + dy;
+      path[i] += pathI;
+    }
+    noop[c] = changed ? 0 : 1;
+    if (changed) {
+      for (int x = cx; x <= fx1; ++x) movedNext[c - cx + x] = 1;
+      if (above)
+        for (int x = fx0; x <= fx1; ++x) movedNext[row + x] = 1;
+    }
+  };
+  // Rows per task: about 2048 agents. The partition does not change the result.
+  const int grain = static_cast<int>(std::max<std::size_t>(1, static_cast<std::size_t>(ny) * 1024 / std::max<std::size_t>(n, 1)));
+  for (int phase = 0; phase < 2; ++phase) {
+    const int rows = (ny - phase + 1) / 2;
+    tbb::parallel_for(tbb::blocked_range<int>(0, rows, grain), [&](const tbb::blocked_range<int>& r) {
+      for (int k = r.begin(); k != r.end(); ++k) {
+        const int cy = 2 * k + phase;
+        for (int cx = 0; cx < nx; ++cx) doCell(cx, cy);
+      }
+    });
+  }
+
+  // Obstacles and domain, and the displacements (end positions into nextX_, nextY_).
+  const float* px = prevX_.data();
+  const float* py = prevY_.data();
+  float* ex = nextX_.data();
+  float* ey = nextY_.data();
+  const Vec2f* bucketed = bucketed_.data();
+  const std::span<const std::uint32_t> starts = grid_.cellStarts();
+  SweepMoves worst = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, n, 4096), SweepMoves{},
+      [&](const tbb::blocked_range<std::size_t>& r, SweepMoves w) {
+    const std::size_t k0 = r.begin(), k1 = r.end();
+    for (std::size_t k = k0; k < k1; ++k) {
+      float x = xs[k], y = ys[k];
+      if (!scripted[k]) {
+        const float ri = rad[k];
+        Vec2f q(x, y);
+        if (!obstacles.empty()) q = obstacles.pushOut(q, ri);
+        for (int a = 0; a < 2; ++a) {
+          const float lo = domain.lo[a] + ri, hi = domain.hi[a] - ri;
+          q[a] = lo <= hi ? std::clamp(q[a], lo, hi) : 0.5f * (domain.lo[a] + domain.hi[a]);
+        }
+        if (q.x() != x || q.y() != y) {
+          x = xs[k] = q.x();
+          y = ys[k] = q.y();
+          // Its cell moved (the cells are those of the slots: find it, rare).
+          const std::size_t c = static_cast<std::size_t>(
+              std::upper_bound(starts.begin(), starts.end(), static_cast<std::uint32_t>(k)) - starts.begin() - 1);
+          std::atomic_ref<std::uint8_t>(movedNext[c]).store(1, std::memory_order_relaxed);  // may straddle tasks
+        }
+      }
+      const float bx = x - bucketed[k].x(), by = y - bucketed[k].y();
+      const float sx = x - px[k], sy = y - py[k];
+      w.end2 = std::max(w.end2, bx * bx + by * by);
+      w.sweep2 = std::max(w.sweep2, sx * sx + sy * sy);
+      w.path = std::max(w.path, path[k]);
+      ex[k] = x;
+      ey[k] = y;
+      path[k] = 0.0f;
+    }
+    return w;
+  },
+      [](const SweepMoves& a, const SweepMoves& b) {
+        return SweepMoves{0.0f, std::max(a.end2, b.end2), std::max(a.sweep2, b.sweep2), std::max(a.path, b.path)};
+      });
+  // Every position during the sweep was within (distance at the start) + (path) of bucketed_.
+  const float startBound = std::sqrt(startEnd2_) + worst.path;
+  worst.sinceBucket2 = std::max(worst.end2, startBound * startBound);
+  return worst;
 }
 
 void CollisionResolver::scatter(Agents& agents) const {

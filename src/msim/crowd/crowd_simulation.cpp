@@ -38,7 +38,7 @@ float obstacleReach(const Agents& agents, const std::vector<Inflow>& inflows, co
 
 CrowdSimulation::CrowdSimulation(const CrowdSettings& settings, std::vector<Polygon> obstacles, std::vector<Goal> goals,
                                  std::shared_ptr<const GlobalPlanner> planner, Agents agents, std::vector<Inflow> inflows,
-                                 std::vector<Script> scripts)
+                                 std::vector<Script> scripts, std::vector<MovingObstacle> moving)
     : settings_(settings),
       obstacles_(std::move(obstacles)),
       goals_(std::move(goals)),
@@ -50,6 +50,8 @@ CrowdSimulation::CrowdSimulation(const CrowdSettings& settings, std::vector<Poly
       scriptProgress_(scripts_.size(), 0),
       rng_(settings.seed),
       staticObstacles_(obstacles_, obstacleReach(agents_, inflows_, settings.orca)),
+      moving_(std::move(moving)),
+      obstacleReach_(obstacleReach(agents_, inflows_, settings.orca)),
       freeArea_(settings.grid),
       uic_(settings.grid, settings.uicSettings) {
   if (!planner_ || planner_->goalCount() != goals_.size())
@@ -58,12 +60,18 @@ CrowdSimulation::CrowdSimulation(const CrowdSettings& settings, std::vector<Poly
     validateSimple(obstacles_[k], fmt::format("obstacles[{}]", k));
     freeArea_.addStaticObstacle(obstacles_[k]);
   }
+  for (std::size_t k = 0; k < moving_.size(); ++k) {
+    validateSimple(moving_[k].shape, fmt::format("moving obstacle {}", k));
+    if (!moving_[k].velocity.allFinite() || !moving_[k].amplitude.allFinite() || !std::isfinite(moving_[k].frequency))
+      throw InputError(fmt::format("moving obstacle {}: its motion is not finite", k));
+  }
+  placeMovingObstacles(0.0);
   for (std::size_t i = 0; i < agents_.size(); ++i) validateAgent(i, fmt::format("agent {}", agents_.id[i]));
   // Agents placed at random overlap; separate them before the first step so that the overlap
   // statistics measure the simulation, not the placement.
   CollisionResolutionParams relax = settings_.collision;
   relax.iterations = kRelaxSweeps;
-  resolver_.resolve(agents_, staticObstacles_, DomainBox{settings_.lo.cast<float>(), settings_.hi.cast<float>()}, relax);
+  resolver_.resolve(agents_, obstacleIndex(), DomainBox{settings_.lo.cast<float>(), settings_.hi.cast<float>()}, relax);
   for (std::size_t k = 0; k < inflows_.size(); ++k) {
     const Inflow& f = inflows_[k];
     validateSimple(f.region, fmt::format("inflows[{}].region", k));
@@ -98,9 +106,31 @@ Vec2 CrowdSimulation::freePoint(Rng& rng, const Polygon& region, float radius) c
   for (int attempt = 0; attempt < kPlacementAttempts; ++attempt) {
     const Vec2 x(rng.uniform(lo.x(), hi.x()), rng.uniform(lo.y(), hi.y()));
     const Vec2f xf = x.cast<float>();
-    if (contains(region, x) && (staticObstacles_.empty() || staticObstacles_.pushOut(xf, radius) == xf)) return x;
+    if (contains(region, x) && (obstacleIndex().empty() || obstacleIndex().pushOut(xf, radius) == xf)) return x;
   }
   return Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
+}
+
+Polygon MovingObstacle::at(double t) const {
+  const Vec2 offset = velocity * t + amplitude * std::sin(2.0 * M_PI * frequency * t);
+  Polygon p = shape;
+  for (Vec2& v : p.vertices) v += offset;
+  return p;
+}
+
+void CrowdSimulation::placeMovingObstacles(double t) {
+  if (moving_.empty()) return;
+  movingNow_.resize(moving_.size());
+  for (std::size_t k = 0; k < moving_.size(); ++k) movingNow_[k] = moving_[k].at(t);
+  allNow_ = obstacles_;
+  allNow_.insert(allNow_.end(), movingNow_.begin(), movingNow_.end());
+  allObstacles_ = StaticObstacles(allNow_, obstacleReach_);
+}
+
+std::vector<Polygon> CrowdSimulation::movingObstaclesNow() const {
+  std::vector<Polygon> now;
+  for (const MovingObstacle& m : moving_) now.push_back(m.at(time_));
+  return now;
 }
 
 void CrowdSimulation::validateAgent(std::size_t i, const std::string& what) const {
@@ -113,6 +143,9 @@ void CrowdSimulation::validateAgent(std::size_t i, const std::string& what) cons
   for (std::size_t k = 0; k < obstacles_.size(); ++k)
     if (contains(obstacles_[k], x))
       throw InputError(fmt::format("{}: position ({}, {}) is inside obstacles[{}]", what, x.x(), x.y(), k));
+  for (std::size_t k = 0; k < movingNow_.size(); ++k)
+    if (contains(movingNow_[k], x))
+      throw InputError(fmt::format("{}: position ({}, {}) is inside moving obstacle {}", what, x.x(), x.y(), k));
   if (agents_.model[i] == AgentModel::Scripted) return;
   if (agents_.goal[i] >= goals_.size()) throw InputError(fmt::format("{}: there is no goal {}", what, agents_.goal[i]));
   if (!std::isfinite(planner_->distance(agents_.goal[i], x)))
@@ -175,7 +208,7 @@ void CrowdSimulation::moveScripted(double dt) {
 void CrowdSimulation::moveOrca(double dt) {
   if (stats_.orcaAgents == 0) return;
   orcaVelocity_.resize(agents_.size());
-  orca_.computeVelocities(agents_, staticObstacles_, settings_.orca, static_cast<float>(dt), orcaVelocity_);
+  orca_.computeVelocities(agents_, obstacleIndex(), settings_.orca, static_cast<float>(dt), orcaVelocity_);
   const float h = static_cast<float>(dt);
   parallelFor(0, agents_.size(), [&](std::size_t i) {
     if (agents_.model[i] != AgentModel::Orca) return;
@@ -210,7 +243,7 @@ void CrowdSimulation::moveUic(double dt) {
     uicSpeed_[k] = agents_.maxSpeed[i];
   });
   if (n > 0 && settings_.uic) {
-    freeArea_.update(discCentres_, discRadii_);
+    freeArea_.update(discCentres_, discRadii_, movingNow_);
     stats_.uic = uic_.project(uicPosition_, uicPreferred_, uicSpeed_, freeArea_.fraction(), dt, uicVelocity_);
   } else {
     std::copy(uicPreferred_.begin(), uicPreferred_.end(), uicVelocity_.begin());
@@ -281,6 +314,10 @@ void CrowdSimulation::step(double dt, StageTimers* timers) {
     else if (m == AgentModel::Orca) ++stats_.orcaAgents;
     else ++stats_.scriptedAgents;
   }
+  if (!moving_.empty()) {
+    ScopedStage s(t, "crowd: moving obstacles");
+    placeMovingObstacles(time_ + dt);  // where they are at the end of the step
+  }
   {
     ScopedStage s(t, "crowd: planning");
     plan();
@@ -302,7 +339,7 @@ void CrowdSimulation::step(double dt, StageTimers* timers) {
   });
   if (settings_.collisionResolution) {
     ScopedStage s(t, "crowd: collisions");
-    resolver_.resolve(agents_, staticObstacles_,
+    resolver_.resolve(agents_, obstacleIndex(),
                       DomainBox{settings_.lo.cast<float>(), settings_.hi.cast<float>()}, settings_.collision);
   }
   time_ += dt;

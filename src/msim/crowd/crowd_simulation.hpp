@@ -42,6 +42,18 @@ struct Script {
   bool loop = false;
 };
 
+// A polygon in rigid translation, x(t) = x(0) + v t + A sin(2 pi f t) for every vertex (the
+// motion of the smoke phenomenon's obstacles): vehicles, sliding doors, a swinging barrier. The
+// continuum sees it through the free area of the cells it covers, recomputed every step (ch. 4.4.3
+// step 4); collision resolution and ORCA keep agents out of it; global planning ignores it.
+struct MovingObstacle {
+  Polygon shape;  // at t = 0
+  Vec2 velocity = Vec2::Zero();   // [m/s]
+  Vec2 amplitude = Vec2::Zero();  // [m]
+  double frequency = 0.0;         // [1/s]
+  Polygon at(double t) const;
+};
+
 struct CrowdSettings {
   Vec2 lo = Vec2::Zero(), hi = Vec2::Ones();  // walkable box; its sides are walls [m]
   GridSpec<2> grid;                           // the continuum grid of the UIC
@@ -73,7 +85,7 @@ class CrowdSimulation {
   // goal, a script for an unknown or non-scripted agent, or an inflow region outside the domain.
   CrowdSimulation(const CrowdSettings& settings, std::vector<Polygon> obstacles, std::vector<Goal> goals,
                   std::shared_ptr<const GlobalPlanner> planner, Agents agents, std::vector<Inflow> inflows = {},
-                  std::vector<Script> scripts = {});
+                  std::vector<Script> scripts = {}, std::vector<MovingObstacle> moving = {});
 
   void step(double dt, StageTimers* timers = nullptr);
 
@@ -83,6 +95,8 @@ class CrowdSimulation {
   void setTime(double t) { time_ = t; }
   const CrowdSettings& settings() const { return settings_; }
   const std::vector<Polygon>& obstacles() const { return obstacles_; }
+  // The moving obstacles where they are at time() (after the last step).
+  std::vector<Polygon> movingObstaclesNow() const;
   const std::vector<Goal>& goals() const { return goals_; }
   const CrowdStepStats& lastStep() const { return stats_; }
   const UicProjection& uic() const { return uic_; }
@@ -107,6 +121,9 @@ class CrowdSimulation {
   void moveOrca(double dt);
   void moveUic(double dt);
   void arriveAndSpawn(double dt);
+  // Static and moving obstacles at time t, indexed for the local passes (only rebuilt when some move).
+  void placeMovingObstacles(double t);
+  const StaticObstacles& obstacleIndex() const { return moving_.empty() ? staticObstacles_ : allObstacles_; }
 
   CrowdSettings settings_;
   std::vector<Polygon> obstacles_;
@@ -121,6 +138,10 @@ class CrowdSimulation {
   Rng rng_;
 
   StaticObstacles staticObstacles_;
+  std::vector<MovingObstacle> moving_;
+  std::vector<Polygon> movingNow_, allNow_;  // this step's moving polygons; static + moving
+  StaticObstacles allObstacles_;
+  float obstacleReach_ = 0.0f;
   FreeArea freeArea_;
   UicProjection uic_;
   OrcaSolver orca_;

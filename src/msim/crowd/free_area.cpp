@@ -105,6 +105,12 @@ FreeArea::FreeArea(const GridSpec<2>& grid)
     : grid_(grid), static_(grid, 0.0), covered_(grid, 0.0), fraction_(grid, 1.0f) {}
 
 void FreeArea::addStaticObstacle(const Polygon& polygon) {
+  addPolygon(polygon, static_);
+  covered_.data() = static_.data();
+  refreshFraction();
+}
+
+void FreeArea::addPolygon(const Polygon& polygon, Grid<double, 2>& coverage) {
   if (polygon.size() < 3)
     throw InputError(fmt::format("free area: obstacle polygon has {} vertices, need at least 3", polygon.size()));
   for (const Vec2& v : polygon.vertices)
@@ -112,24 +118,19 @@ void FreeArea::addStaticObstacle(const Polygon& polygon) {
   Vec2 lo, hi;
   bounds(polygon, lo, hi);
   IVec2 first, last;
-  if (cellRange(grid_, lo, hi, first, last)) {
-    std::vector<Vec2> a, b;
-    a.reserve(polygon.size() + 8);
-    b.reserve(polygon.size() + 8);
-    for (int j = first.y(); j <= last.y(); ++j)
-      for (int i = first.x(); i <= last.x(); ++i) {
-        const Vec2 cellLo = grid_.origin + Vec2(i, j) * grid_.dx;
-        static_(IVec2(i, j)) += clipArea(polygon, cellLo, cellLo + Vec2::Constant(grid_.dx), a, b);
-      }
-  }
-  covered_.data() = static_.data();
-  refreshFraction();
+  if (!cellRange(grid_, lo, hi, first, last)) return;
+  for (int j = first.y(); j <= last.y(); ++j)
+    for (int i = first.x(); i <= last.x(); ++i) {
+      const Vec2 cellLo = grid_.origin + Vec2(i, j) * grid_.dx;
+      coverage(IVec2(i, j)) += clipArea(polygon, cellLo, cellLo + Vec2::Constant(grid_.dx), clipA_, clipB_);
+    }
 }
 
-void FreeArea::update(std::span<const Vec2f> centres, std::span<const float> radii) {
+void FreeArea::update(std::span<const Vec2f> centres, std::span<const float> radii, std::span<const Polygon> moving) {
   if (centres.size() != radii.size())
     throw InputError(fmt::format("free area: {} disc centres but {} radii", centres.size(), radii.size()));
   std::copy(static_.data().begin(), static_.data().end(), covered_.data().begin());
+  for (const Polygon& polygon : moving) addPolygon(polygon, covered_);
   // Serial: a disc touches a few cells, and neighbouring discs share cells.
   for (std::size_t k = 0; k < centres.size(); ++k) {
     if (!centres[k].allFinite() || !std::isfinite(radii[k]) || radii[k] < 0.0f)

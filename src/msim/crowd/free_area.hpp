@@ -34,10 +34,11 @@ class FreeArea {
   // visited) and refreshes fraction() without discs. Throws InputError for fewer than 3 vertices
   // or a non-finite vertex.
   void addStaticObstacle(const Polygon& polygon);
-  // fraction() = 1 - min(1, (static + disc coverage) / cell area) for this step's discs (moving
-  // obstacles). Allocation-free. Throws InputError for a non-finite centre or radius or a negative
-  // radius, or when the spans differ in size.
-  void update(std::span<const Vec2f> centres, std::span<const float> radii);
+  // fraction() = 1 - min(1, (static + this step's coverage) / cell area) for this step's discs
+  // (scripted and ORCA agents) and moving obstacle polygons at their current place. No allocation
+  // once warm. Throws InputError for a non-finite centre or radius or a negative radius, spans of
+  // different sizes, or a polygon as addStaticObstacle() refuses.
+  void update(std::span<const Vec2f> centres, std::span<const float> radii, std::span<const Polygon> moving = {});
 
   const GridSpec<2>& grid() const { return grid_; }
   // f per cell, cell-centred layout of grid().
@@ -47,11 +48,14 @@ class FreeArea {
 
  private:
   void refreshFraction();
+  // Adds the exact covered area of the polygon to the cells it overlaps.
+  void addPolygon(const Polygon& polygon, Grid<double, 2>& coverage);
 
   GridSpec<2> grid_;
   Grid<double, 2> static_;   // covered area of the static polygons
   Grid<double, 2> covered_;  // static_ plus this step's discs
   Grid<float, 2> fraction_;
+  std::vector<Vec2> clipA_, clipB_;  // clipping scratch
 };
 
 }  // namespace msim::crowd

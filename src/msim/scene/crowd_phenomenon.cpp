@@ -42,7 +42,7 @@ class CrowdPhenomenon final : public Phenomenon {
       : source_(scene.file.string()), timers_(timers), setup_(buildCrowdScene(scene)), preview_(previewWidth(scene)) {
     initialIds_ = setup_.agents.id;
     sim_ = std::make_unique<crowd::CrowdSimulation>(setup_.settings, setup_.obstacles, setup_.goals, setup_.planner,
-                                                    setup_.agents, setup_.inflows, setup_.scripts);
+                                                    setup_.agents, setup_.inflows, setup_.scripts, setup_.moving);
     for (const auto& l : setup_.lines) lines_.push_back(crowd::MeasurementLine{l.from, l.to});
     lineCrossings_.assign(lines_.size(), 0);
     lastIds_ = sim_->agents().id;
@@ -201,6 +201,7 @@ class CrowdPhenomenon final : public Phenomenon {
     }
     std::vector<std::vector<Vec2>> outlines;
     for (const crowd::Polygon& p : setup_.obstacles) outlines.push_back(p.vertices);
+    for (const crowd::Polygon& p : sim_->movingObstaclesNow()) outlines.push_back(p.vertices);
     return render::renderFloorPlan(plan, discs, outlines);
   }
 

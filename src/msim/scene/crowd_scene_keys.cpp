@@ -74,7 +74,7 @@ Schema crowdKeys() {
   Schema col = Schema::object("pairwise collision resolution after each step (ch. 4.3.3)");
   col.boolean("enabled", true, "push overlapping agents apart (off: Fig. 4.3c)");
   col.number("separation", "", 1.2, "pairs closer than this x d_min are pushed to it (ch. 4.5.1: 'somewhat larger')").min(1.0).max(2.0);
-  col.integer("iterations", 12, "most Jacobi sweeps per step").min(1).max(100);
+  col.integer("iterations", 6, "most Gauss-Seidel sweeps per step").min(1).max(100);
   col.number("tolerance", "", 0.01, "stop the sweeps once none moves an agent farther than this x d_min").min(0.0);
   c.field("collision_resolution", col);
   Schema orca = Schema::object("ORCA agents (van den Berg et al. 2011)");
@@ -218,9 +218,19 @@ struct Builder {
       Polygon p = regionPolygon(list[k].at("shape"));
       crowd::validateSimple(p, fmt::format("{}: '{}.shape'", source, key));
       requireInside(p, key + ".shape");
-      out.obstacles.push_back(std::move(p));
+      const Vec2 velocity = sceneVector<2>(list[k].at("velocity"));
+      const Vec2 amplitude = sceneVector<2>(list[k].at("oscillation"));
+      const double frequency = list[k].at("frequency").get<double>();
+      if (velocity.isZero() && (amplitude.isZero() || frequency == 0.0)) {
+        out.obstacles.push_back(std::move(p));
+      } else {
+        out.moving.push_back(crowd::MovingObstacle{std::move(p), velocity, amplitude, frequency});
+      }
     }
-    obstacleIndex = crowd::StaticObstacles(out.obstacles, largestRadius());
+    // Agents are placed clear of the moving obstacles' start positions too.
+    std::vector<Polygon> atStart = out.obstacles;
+    for (const crowd::MovingObstacle& m : out.moving) atStart.push_back(m.shape);
+    obstacleIndex = crowd::StaticObstacles(atStart, largestRadius());
   }
 
   void goals() {
@@ -428,8 +438,11 @@ void declareCrowdKeys(Schema& root) {
   goal.field("shape", regionSchema("the goal: a point or a region", true).required());
   goal.boolean("exit", false, "agents that arrive leave the scene (evacuations)");
   root.array("goals", goal, "destinations");
-  Schema obstacle = Schema::object("static obstacle");
-  obstacle.field("shape", regionSchema("its outline", false).required());
+  Schema obstacle = Schema::object("obstacle, static unless it is given a motion");
+  obstacle.field("shape", regionSchema("its outline at t = 0", false).required());
+  obstacle.vector("velocity", "m/s", {0.0, 0.0}, "v of the motion x(t) = x(0) + v t + A sin(2 pi f t)");
+  obstacle.vector("oscillation", "m", {0.0, 0.0}, "amplitude A of the motion");
+  obstacle.number("frequency", "1/s", 0.0, "f of the motion").min(0.0);
   root.array("obstacles", obstacle, "walls, pillars, stands: polygons agents walk around");
   root.array("groups", groupSchema(), "agents placed at t = 0");
   root.array("inflows", inflowSchema(), "agents entering during the run (Fig. 4.6)");

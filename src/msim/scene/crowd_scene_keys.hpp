@@ -20,7 +20,8 @@ struct CrowdMeasurementLine {
 
 struct CrowdSceneSetup {
   crowd::CrowdSettings settings;
-  std::vector<crowd::Polygon> obstacles;
+  std::vector<crowd::Polygon> obstacles;        // static: planned around
+  std::vector<crowd::MovingObstacle> moving;    // in motion: only avoided locally
   std::vector<crowd::Goal> goals;
   std::shared_ptr<const crowd::GlobalPlanner> planner;
   std::string plannerName;
