@@ -59,7 +59,7 @@ TEST(CrowdNavigationField, DirectionPointsAtAVisibleGoal) {
   const Vec2 goal(12, 7);
   const NavigationField field({pointGoal(goal)}, {}, box({0, 0}, {20, 20}, 0.25, 0.0));
   double worst = 0;
-  for (const Vec2 x : {Vec2(1, 1), Vec2(18, 18), Vec2(12, 1), Vec2(3, 15), Vec2(11.2, 7.4)}) {
+  for (const Vec2& x : {Vec2(1, 1), Vec2(18, 18), Vec2(12, 1), Vec2(3, 15), Vec2(11.2, 7.4)}) {
     const Vec2 d = field.direction(0, x);
     EXPECT_NEAR(d.norm(), 1.0, 1e-9);
     worst = std::max(worst, std::acos(std::clamp(d.dot((goal - x).normalized()), -1.0, 1.0)));

@@ -70,7 +70,9 @@ TEST(NeighbourGrid, CellOrderIsStableCountingSort) {
     return std::pair(std::floor(rel.y()), std::floor(rel.x()));
   };
   for (std::size_t k = 1; k < order.size(); ++k)
-    if (cellOf(order[k]) == cellOf(order[k - 1])) ASSERT_LT(order[k - 1], order[k]);
+    if (cellOf(order[k]) == cellOf(order[k - 1])) {
+      ASSERT_LT(order[k - 1], order[k]);
+    }
 }
 
 TEST(NeighbourGrid, SparseFarPointsAndEmpty) {

@@ -28,8 +28,8 @@ Plot fixedPlot() {
   plot.xMin = 0.0, plot.xMax = 10.0, plot.yMin = 0.0, plot.yMax = 5.0;
   plot.legend = false;
   plot.title = "Test (1/m^2)";
-  plot.xLabel = "x";
-  plot.yLabel = "y";
+  plot.xLabel = std::string("x");  // move-assigned: GCC 12 -O3 warns falsely (-Wrestrict) on char* assignment
+  plot.yLabel = std::string("y");
   return plot;
 }
 
