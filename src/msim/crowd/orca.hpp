@@ -11,7 +11,7 @@
 #include <tbb/enumerable_thread_specific.h>
 
 #include "msim/crowd/agents.hpp"
-#include "msim/crowd/collision_resolution.hpp"
+#include "msim/crowd/obstacle_index.hpp"
 #include "msim/crowd/neighbour_grid.hpp"
 
 namespace msim::crowd {

@@ -7,7 +7,7 @@
 #include "msim/core/error.hpp"
 #include "msim/core/log.hpp"
 #include "msim/core/rng.hpp"
-#include "msim/crowd/collision_resolution.hpp"
+#include "msim/crowd/obstacle_index.hpp"
 #include "msim/crowd/direct_planner.hpp"
 #include "msim/crowd/navigation_field.hpp"
 #include "msim/crowd/roadmap.hpp"
