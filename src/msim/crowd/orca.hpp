@@ -11,8 +11,8 @@
 #include <tbb/enumerable_thread_specific.h>
 
 #include "msim/crowd/agents.hpp"
-#include "msim/crowd/obstacle_index.hpp"
 #include "msim/crowd/neighbour_grid.hpp"
+#include "msim/crowd/obstacle_index.hpp"
 
 namespace msim::crowd {
 
