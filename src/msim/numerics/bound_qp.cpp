@@ -68,9 +68,19 @@ constexpr auto kAdd = [](int, double a, double b) { return a + b; };
 
 }  // namespace
 
+// The chopped gradient of an entry off the face: min(g, 0) at its lower bound (a negative g pushes
+// it up into the box), max(g, 0) at its upper bound, 0 if both bounds coincide (it cannot move).
+double BoundQpSolver::chopped(Eigen::Index i, double pi, double gi) const {
+  const double l = lo(i), u = hi(i);
+  if (l == u) return 0.0;
+  if (pi <= l) return std::min(gi, 0.0);
+  if (pi >= u) return std::max(gi, 0.0);
+  return 0.0;
+}
+
 void BoundQpSolver::setFace(const Eigen::VectorXd& p, QpFacePreconditioner* preconditioner) {
   forBlocks(p.size(), [&](Eigen::Index begin, Eigen::Index end) {
-    for (Eigen::Index i = begin; i < end; ++i) free_[i] = p[i] > 0.0 ? 1 : 0;
+    for (Eigen::Index i = begin; i < end; ++i) free_[i] = p[i] > lo(i) && p[i] < hi(i) ? 1 : 0;
   });
   if (preconditioner) preconditioner->setFace(free_);
 }
@@ -96,10 +106,30 @@ double BoundQpSolver::dot(const Eigen::VectorXd& x, const Eigen::VectorXd& y) {
 
 BoundQpResult BoundQpSolver::solve(const QpOperator& A, const Eigen::VectorXd& b, Eigen::VectorXd& p,
                                    const BoundQpSettings& settings, QpFacePreconditioner* preconditioner) {
+  return solveBox(A, b, nullptr, nullptr, p, settings, preconditioner);
+}
+
+BoundQpResult BoundQpSolver::solve(const QpOperator& A, const Eigen::VectorXd& b, const Eigen::VectorXd& lower,
+                                   const Eigen::VectorXd& upper, Eigen::VectorXd& p, const BoundQpSettings& settings,
+                                   QpFacePreconditioner* preconditioner) {
+  if (lower.size() != A.size() || upper.size() != A.size())
+    throw std::invalid_argument("BoundQpSolver: operator has size " + std::to_string(A.size()) + ", bounds " +
+                                std::to_string(lower.size()) + " and " + std::to_string(upper.size()));
+  for (Eigen::Index i = 0; i < lower.size(); ++i)
+    if (!(lower[i] <= upper[i]))
+      throw std::invalid_argument("BoundQpSolver: bounds of entry " + std::to_string(i) + " are NaN or lower > upper");
+  return solveBox(A, b, &lower, &upper, p, settings, preconditioner);
+}
+
+BoundQpResult BoundQpSolver::solveBox(const QpOperator& A, const Eigen::VectorXd& b, const Eigen::VectorXd* lower,
+                                      const Eigen::VectorXd* upper, Eigen::VectorXd& p,
+                                      const BoundQpSettings& settings, QpFacePreconditioner* preconditioner) {
   const Eigen::Index n = A.size();
   if (b.size() != n || p.size() != n)
     throw std::invalid_argument("BoundQpSolver: operator has size " + std::to_string(n) + ", b " +
                                 std::to_string(b.size()) + ", p " + std::to_string(p.size()));
+  lower_ = lower ? lower->data() : nullptr;
+  upper_ = upper ? upper->data() : nullptr;
   if (!(settings.tolerance >= 0.0) || !(settings.gamma > 0.0) || settings.maxIterations < 0 ||
       !(settings.alphaBar >= 0.0) || !(settings.alphaBarFactor > 0.0 && settings.alphaBarFactor <= 2.0))
     throw std::invalid_argument("BoundQpSolver: invalid settings (need tolerance >= 0, gamma > 0, "
@@ -107,7 +137,7 @@ BoundQpResult BoundQpSolver::solve(const QpOperator& A, const Eigen::VectorXd& b
 
   BoundQpResult result;
   const double bNorm = std::sqrt(dot(b, b));
-  if (bNorm == 0.0) {
+  if (bNorm == 0.0 && !lower_ && !upper_) {
     // A is positive definite, so f(p) >= 0 = f(0) on p >= 0: the solution is p = 0 exactly.
     p.setZero();
     result.converged = true;
@@ -117,7 +147,7 @@ BoundQpResult BoundQpSolver::solve(const QpOperator& A, const Eigen::VectorXd& b
   const double alphaBar = settings.alphaBar > 0.0 ? settings.alphaBar : settings.alphaBarFactor / A.normUpperBound();
   if (!(alphaBar > 0.0) || !std::isfinite(alphaBar))
     throw std::invalid_argument("BoundQpSolver: expansion step length is not a positive number");
-  const double threshold = settings.tolerance * bNorm;
+  double threshold = settings.tolerance * bNorm;  // b = 0 (box bounds): set from the first gradient
   const double gamma2 = settings.gamma * settings.gamma;
 
   // Size the work vectors once per problem size; the iteration below does not allocate.
@@ -136,7 +166,7 @@ BoundQpResult BoundQpSolver::solve(const QpOperator& A, const Eigen::VectorXd& b
 
   // Warm start projected onto the feasible set.
   forBlocks(n, [&](Eigen::Index begin, Eigen::Index end) {
-    for (Eigen::Index i = begin; i < end; ++i) p[i] = std::max(p[i], 0.0);
+    for (Eigen::Index i = begin; i < end; ++i) p[i] = std::clamp(p[i], lo(i), hi(i));
   });
   auto updateGradient = [&] {
     A.apply(p, g_);
@@ -158,25 +188,28 @@ BoundQpResult BoundQpSolver::solve(const QpOperator& A, const Eigen::VectorXd& b
   restart();
 
   while (true) {
-    // Free gradient phi (g on F), chopped gradient beta (min(g, 0) off F), and the reduced free
-    // gradient phi~_i = min(p_i / alphaBar, phi_i), whose product with phi measures how far a
-    // fixed-length projected step along phi can go before it is cut by the bound.
+    // Free gradient phi (g on F), chopped gradient beta (min(g, 0) at a lower bound, max(g, 0) at
+    // an upper one), and the reduced free gradient phi~_i = min((p_i - l_i) / alphaBar, phi_i)
+    // (max((p_i - u_i) / alphaBar, phi_i) when phi_i < 0), whose product with phi measures how far
+    // a fixed-length projected step along phi can go before it is cut by the bounds.
     const auto sums = reduceBlocks<3>(n, partial_, {0.0, 0.0, 0.0},
                                       [&](Eigen::Index begin, Eigen::Index end, auto& acc) {
       double phi2 = 0.0, beta2 = 0.0, reduced = 0.0;
       for (Eigen::Index i = begin; i < end; ++i) {
         const double gi = g_[i];
+        const double beta = chopped(i, p[i], gi);
         if (free_[i]) {
           phi2 += gi * gi;
-          reduced += std::min(p[i] / alphaBar, gi) * gi;
-        } else if (gi < 0.0) {
-          beta2 += gi * gi;
+          reduced += (gi > 0.0 ? std::min((p[i] - lo(i)) / alphaBar, gi) : std::max((p[i] - hi(i)) / alphaBar, gi)) * gi;
+        } else {
+          beta2 += beta * beta;
         }
       }
       acc = {phi2, beta2, reduced};
     }, kAdd);
     const double phi2 = sums[0], beta2 = sums[1], reducedPhi = sums[2];
     result.projectedGradientNorm = std::sqrt(phi2 + beta2);
+    if (result.iterations == 0 && bNorm == 0.0) threshold = settings.tolerance * result.projectedGradientNorm;
     if (result.projectedGradientNorm <= threshold) {
       result.converged = true;
       break;
@@ -185,7 +218,7 @@ BoundQpResult BoundQpSolver::solve(const QpOperator& A, const Eigen::VectorXd& b
     ++result.iterations;
 
     if (beta2 <= gamma2 * reducedPhi) {
-      // Proportional iterate: a CG step on the face, unless it would leave p >= 0.
+      // Proportional iterate: a CG step on the face, unless it would leave the box.
       A.apply(d_, Ad_);
       ++result.operatorApplications;
       constexpr double inf = std::numeric_limits<double>::infinity();
@@ -196,7 +229,8 @@ BoundQpResult BoundQpSolver::solve(const QpOperator& A, const Eigen::VectorXd& b
           const double di = d_[i];
           dAd += di * Ad_[i];
           gd += g_[i] * di;
-          if (di > 0.0) feasible = std::min(feasible, p[i] / di);
+          if (di > 0.0) feasible = std::min(feasible, (p[i] - lo(i)) / di);
+          else if (di < 0.0) feasible = std::min(feasible, (p[i] - hi(i)) / di);
         }
         acc = {dAd, gd, feasible};
       }, [](int k, double a, double v) { return k == 2 ? std::min(a, v) : a + v; });
@@ -208,7 +242,7 @@ BoundQpResult BoundQpSolver::solve(const QpOperator& A, const Eigen::VectorXd& b
         // The clamp only removes round-off when alphaCg is within an ulp of alphaFeasible.
         forBlocks(n, [&](Eigen::Index begin, Eigen::Index end) {
           for (Eigen::Index i = begin; i < end; ++i) {
-            p[i] = std::max(p[i] - alphaCg * d_[i], 0.0);
+            p[i] = std::clamp(p[i] - alphaCg * d_[i], lo(i), hi(i));
             g_[i] -= alphaCg * Ad_[i];
           }
         });
@@ -221,13 +255,14 @@ BoundQpResult BoundQpSolver::solve(const QpOperator& A, const Eigen::VectorXd& b
         ++result.cgSteps;
       } else {
         // Expansion: the largest feasible step along d, then a fixed-length step alphaBar along
-        // the free gradient at that point, projected onto p >= 0. With alphaBar <= 2/||A|| this
-        // decreases f and may add several constraints at once (unlike active-set CG).
+        // the free gradient at that point, projected onto the box. With alphaBar <= 2/||A|| this
+        // decreases f and may add several constraints at once (unlike active-set CG). Entries
+        // that reached a bound stay there (d and the free gradient are zero off the face).
         forBlocks(n, [&](Eigen::Index begin, Eigen::Index end) {
           for (Eigen::Index i = begin; i < end; ++i) {
-            const double pi = p[i] - alphaFeasible * d_[i];
+            const double pi = std::clamp(p[i] - alphaFeasible * d_[i], lo(i), hi(i));
             const double gi = g_[i] - alphaFeasible * Ad_[i];
-            p[i] = pi > 0.0 ? std::max(pi - alphaBar * gi, 0.0) : 0.0;
+            p[i] = pi > lo(i) && pi < hi(i) ? std::clamp(pi - alphaBar * gi, lo(i), hi(i)) : pi;
           }
         });
         updateGradient();
@@ -236,16 +271,25 @@ BoundQpResult BoundQpSolver::solve(const QpOperator& A, const Eigen::VectorXd& b
       }
     } else {
       // Proportioning: the chopped gradient dominates, so the active set is wrong; an exact line
-      // search along -beta releases the constraints whose multipliers are negative.
+      // search along -beta releases the constraints whose multipliers have the wrong sign, cut
+      // where an entry would cross its other bound (box constraints only).
       forBlocks(n, [&](Eigen::Index begin, Eigen::Index end) {
-        for (Eigen::Index i = begin; i < end; ++i) d_[i] = !free_[i] && g_[i] < 0.0 ? g_[i] : 0.0;
+        for (Eigen::Index i = begin; i < end; ++i) d_[i] = free_[i] ? 0.0 : chopped(i, p[i], g_[i]);
       });
       A.apply(d_, Ad_);
       ++result.operatorApplications;
-      const double alpha = beta2 / dot(d_, Ad_);  // g^T beta = beta^T beta
+      double alpha = beta2 / dot(d_, Ad_);  // g^T beta = beta^T beta
+      if (upper_)
+        alpha = std::min(alpha, reduceBlocks<1>(n, partial_, {std::numeric_limits<double>::infinity()},
+                                                [&](Eigen::Index begin, Eigen::Index end, auto& acc) {
+          for (Eigen::Index i = begin; i < end; ++i) {
+            if (d_[i] < 0.0) acc[0] = std::min(acc[0], (p[i] - hi(i)) / d_[i]);
+            else if (d_[i] > 0.0) acc[0] = std::min(acc[0], (p[i] - lo(i)) / d_[i]);
+          }
+        }, [](int, double a, double v) { return std::min(a, v); })[0]);
       forBlocks(n, [&](Eigen::Index begin, Eigen::Index end) {
         for (Eigen::Index i = begin; i < end; ++i) {
-          p[i] -= alpha * d_[i];
+          p[i] = std::clamp(p[i] - alpha * d_[i], lo(i), hi(i));
           g_[i] -= alpha * Ad_[i];
         }
       });
@@ -254,10 +298,10 @@ BoundQpResult BoundQpSolver::solve(const QpOperator& A, const Eigen::VectorXd& b
     }
   }
 
-  result.relativeProjectedGradient = result.projectedGradientNorm / bNorm;
+  result.relativeProjectedGradient = bNorm > 0.0 ? result.projectedGradientNorm / bNorm : 0.0;
   result.activeCount = static_cast<int>(reduceBlocks<1>(n, partial_, {0.0},
                                                         [&](Eigen::Index begin, Eigen::Index end, auto& acc) {
-    for (Eigen::Index i = begin; i < end; ++i) acc[0] += p[i] == 0.0 ? 1.0 : 0.0;
+    for (Eigen::Index i = begin; i < end; ++i) acc[0] += p[i] == lo(i) || p[i] == hi(i) ? 1.0 : 0.0;
   }, kAdd)[0]);
   return result;
 }

@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace msim::numerics {
@@ -85,7 +86,7 @@ struct BoundQpResult {
   int operatorApplications = 0;         // products with A, including the initial gradient
   double projectedGradientNorm = 0.0;   // ||g^P(p)||_2 at exit
   double relativeProjectedGradient = 0.0;  // projectedGradientNorm / ||b||_2 (0 when b = 0)
-  int activeCount = 0;                  // entries with p_i = 0 at exit
+  int activeCount = 0;                  // entries at a bound at exit (p_i = 0 for p >= 0)
   bool converged = false;
 };
 
@@ -99,12 +100,33 @@ class BoundQpSolver {
   BoundQpResult solve(const QpOperator& A, const Eigen::VectorXd& b, Eigen::VectorXd& p,
                       const BoundQpSettings& settings = {}, QpFacePreconditioner* preconditioner = nullptr);
 
+  // The same over the box lower <= p <= upper (entries may be -inf / +inf; lower <= upper), the
+  // form of the linearised friction bounds -s_max <= s_ij <= s_max of Narain (2011) eq. 5.15:
+  // MPRGP for box constraints (Dostál 2009, ch. 8; Kružík et al. 2020). The free set is
+  // lower < p < upper; the chopped gradient is min(g, 0) at a lower and max(g, 0) at an upper
+  // bound; steps are cut at either bound and expansions project onto the box. The face
+  // preconditioner sees free[i] != 0 exactly where p_i is strictly inside its bounds. When b = 0
+  // the tolerance is taken relative to the projected gradient at the projected warm start.
+  // std::invalid_argument also for bound vectors of another size, NaN bounds or lower > upper.
+  BoundQpResult solve(const QpOperator& A, const Eigen::VectorXd& b, const Eigen::VectorXd& lower,
+                      const Eigen::VectorXd& upper, Eigen::VectorXd& p, const BoundQpSettings& settings = {},
+                      QpFacePreconditioner* preconditioner = nullptr);
+
  private:
+  // lower/upper null: p >= 0.
+  BoundQpResult solveBox(const QpOperator& A, const Eigen::VectorXd& b, const Eigen::VectorXd* lower,
+                         const Eigen::VectorXd* upper, Eigen::VectorXd& p, const BoundQpSettings& settings,
+                         QpFacePreconditioner* preconditioner);
   void setFace(const Eigen::VectorXd& p, QpFacePreconditioner* preconditioner);
+  double chopped(Eigen::Index i, double pi, double gi) const;
   void precondition(QpFacePreconditioner* preconditioner);  // z_ from g_ on the current face
   double dot(const Eigen::VectorXd& x, const Eigen::VectorXd& y);  // blocked, deterministic
 
   bool jacobi_ = false;  // built-in Jacobi (no preconditioner passed, Jacobi requested)
+  const double* lower_ = nullptr;  // bounds of the current solve; null: 0 and +inf
+  const double* upper_ = nullptr;
+  double lo(Eigen::Index i) const { return lower_ ? lower_[i] : 0.0; }
+  double hi(Eigen::Index i) const { return upper_ ? upper_[i] : std::numeric_limits<double>::infinity(); }
   std::vector<std::uint8_t> free_;
   Eigen::VectorXd g_, z_, d_, Ad_, invDiagonal_;
   std::vector<double> partial_;  // per-block partial sums of the vector loops
