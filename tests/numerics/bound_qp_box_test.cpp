@@ -14,6 +14,7 @@
 
 #include "msim/core/rng.hpp"
 #include "msim/numerics/bound_qp.hpp"
+#include "random_spd.hpp"
 #include "msim/numerics/bound_qp_mic0.hpp"
 
 using namespace msim;
@@ -101,10 +102,7 @@ TEST(BoundQpBox, MatchesExhaustiveSearchOnSmallDenseProblems) {
   int bothBoundsHit = 0, total = 0;
   for (int n = 1; n <= 7; ++n)
     for (int trial = 0; trial < 20; ++trial) {
-      Eigen::MatrixXd R(n, n);
-      for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j) R(i, j) = rng.normal();
-      const Eigen::MatrixXd dense = R * R.transpose() / n + 0.1 * Eigen::MatrixXd::Identity(n, n);
+      const Eigen::MatrixXd dense = randomSpd(n, rng, 0.1);
       const SpMat A = dense.sparseView();
       Eigen::VectorXd b(n), lo(n), hi(n);
       for (int i = 0; i < n; ++i) {
@@ -218,10 +216,7 @@ TEST(BoundQpBox, BoundsThatExcludeZeroWithZeroRightHandSide) {
 TEST(BoundQpBox, EqualBoundsFixTheEntryAndNonNegativeBoundsMatchTheDefault) {
   Rng rng(5);
   const int n = 8;
-  Eigen::MatrixXd R(n, n);
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j) R(i, j) = rng.normal();
-  const Eigen::MatrixXd dense = R * R.transpose() / n + 0.2 * Eigen::MatrixXd::Identity(n, n);
+  const Eigen::MatrixXd dense = randomSpd(n, rng, 0.2);
   const SpMat A = dense.sparseView();
   Eigen::VectorXd b(n);
   for (int i = 0; i < n; ++i) b[i] = rng.uniform(-1.0, 1.0);

@@ -13,6 +13,7 @@
 
 #include "msim/core/rng.hpp"
 #include "msim/numerics/bound_qp.hpp"
+#include "random_spd.hpp"
 
 using namespace msim;
 using namespace msim::numerics;
@@ -114,10 +115,7 @@ TEST(BoundQp, MatchesExhaustiveActiveSetSearchOnSmallDenseProblems) {
   settings.tolerance = 1e-13;
   for (int n = 1; n <= 10; ++n)
     for (int trial = 0; trial < 20; ++trial) {
-      Eigen::MatrixXd R(n, n);
-      for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j) R(i, j) = rng.normal();
-      const Eigen::MatrixXd dense = R * R.transpose() / n + 0.1 * Eigen::MatrixXd::Identity(n, n);
+      const Eigen::MatrixXd dense = randomSpd(n, rng, 0.1);
       const SpMat A = dense.sparseView();
       const Eigen::VectorXd b = randomVector(n, rng, -1.0, 1.0);
       const Eigen::VectorXd expected = bruteForce(dense, b);
