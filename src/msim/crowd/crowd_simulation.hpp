@@ -105,8 +105,10 @@ class CrowdSimulation {
   const std::vector<ExitEvent>& exits() const { return exits_; }
   // Inflow bookkeeping, for restoring a saved state: agents owed to each inflow (fractional).
   std::vector<double>& inflowCredit() { return inflowCredit_; }
+  const std::vector<double>& inflowCredit() const { return inflowCredit_; }
   // Next waypoint of each script, for saving and restoring a run.
   std::vector<std::size_t>& scriptProgress() { return scriptProgress_; }
+  const std::vector<std::size_t>& scriptProgress() const { return scriptProgress_; }
   const std::vector<Script>& scripts() const { return scripts_; }
   // The fastest an agent may walk [m/s] (for CFL-like time step limits).
   double maxSpeed() const;

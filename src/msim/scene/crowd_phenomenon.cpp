@@ -117,7 +117,7 @@ class CrowdPhenomenon final : public Phenomenon {
     io::PointCloud state;
     state.positions.push_back(Vecf<3>::Zero());
     state.attributes.push_back({"next_id", {static_cast<float>(a.nextId)}});
-    auto& self = const_cast<crowd::CrowdSimulation&>(*sim_);
+    const crowd::CrowdSimulation& self = *sim_;
     for (std::size_t k = 0; k < self.inflowCredit().size(); ++k)
       state.attributes.push_back({fmt::format("inflow_credit_{}", k), {static_cast<float>(self.inflowCredit()[k])}});
     for (std::size_t s = 0; s < self.scriptProgress().size(); ++s)
