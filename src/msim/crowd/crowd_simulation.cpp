@@ -12,7 +12,6 @@ namespace msim::crowd {
 namespace {
 
 constexpr int kRelaxSweeps = 50;
-constexpr int kPlacementAttempts = 100000;
 
 // Largest radius and speed over the initial agents and every agent an inflow will create.
 void extremes(const Agents& agents, const std::vector<Inflow>& inflows, float& radius, float& speed) {
@@ -85,7 +84,7 @@ CrowdSimulation::CrowdSimulation(const CrowdSettings& settings, std::vector<Poly
     if (f.agent.goal >= goals_.size())
       throw InputError(fmt::format("inflows[{}].goal: there is no goal {}", k, f.agent.goal));
     Rng probe = rng_.split(~std::uint64_t(k));
-    const Vec2 x = freePoint(probe, f.region, f.agent.radius);
+    const Vec2 x = randomFreePoint(probe, f.region, f.agent.radius, obstacleIndex());
     if (!x.allFinite())
       throw InputError(fmt::format("inflows[{}].region: no room for an agent of radius {} m outside the obstacles", k,
                                    f.agent.radius));
@@ -93,22 +92,17 @@ CrowdSimulation::CrowdSimulation(const CrowdSettings& settings, std::vector<Poly
       throw InputError(fmt::format("inflows[{}].goal: goal {} cannot be reached from the inflow region", k, f.agent.goal));
   }
   for (std::size_t s = 0; s < scripts_.size(); ++s) {
-    const auto it = std::find(agents_.id.begin(), agents_.id.end(), scripts_[s].agentId);
-    if (it == agents_.id.end() || agents_.model[it - agents_.id.begin()] != AgentModel::Scripted)
+    const std::size_t i = indexOfId(scripts_[s].agentId);
+    if (i == agents_.size() || agents_.model[i] != AgentModel::Scripted)
       throw InputError(fmt::format("scripts[{}]: agent {} is not a scripted agent of the scene", s, scripts_[s].agentId));
     if (scripts_[s].waypoints.empty()) throw InputError(fmt::format("scripts[{}]: no waypoints", s));
   }
 }
 
-Vec2 CrowdSimulation::freePoint(Rng& rng, const Polygon& region, float radius) const {
-  Vec2 lo, hi;
-  bounds(region, lo, hi);
-  for (int attempt = 0; attempt < kPlacementAttempts; ++attempt) {
-    const Vec2 x(rng.uniform(lo.x(), hi.x()), rng.uniform(lo.y(), hi.y()));
-    const Vec2f xf = x.cast<float>();
-    if (contains(region, x) && (obstacleIndex().empty() || obstacleIndex().pushOut(xf, radius) == xf)) return x;
-  }
-  return Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
+std::size_t CrowdSimulation::indexOfId(std::uint64_t id) const {
+  // Agents stay in id order: add() appends the next id, removeFlagged() keeps the order.
+  const auto it = std::lower_bound(agents_.id.begin(), agents_.id.end(), id);
+  return it != agents_.id.end() && *it == id ? static_cast<std::size_t>(it - agents_.id.begin()) : agents_.size();
 }
 
 Polygon MovingObstacle::at(double t) const {
@@ -179,9 +173,8 @@ void CrowdSimulation::plan() {
 void CrowdSimulation::moveScripted(double dt) {
   for (std::size_t s = 0; s < scripts_.size(); ++s) {
     Script& script = scripts_[s];
-    const auto it = std::find(agents_.id.begin(), agents_.id.end(), script.agentId);
-    if (it == agents_.id.end()) continue;
-    const std::size_t i = it - agents_.id.begin();
+    const std::size_t i = indexOfId(script.agentId);
+    if (i == agents_.size()) continue;
     double budget = agents_.maxSpeed[i] * dt;
     Vec2 x = agents_.position[i].cast<double>();
     const Vec2 start = x;
@@ -283,8 +276,6 @@ void CrowdSimulation::arriveAndSpawn(double dt) {
     const Inflow& f = inflows_[k];
     const double open = std::max(0.0, std::min(time_, f.stop) - std::max(time_ - dt, f.start));
     inflowCredit_[k] += f.rate * open;
-    Vec2 lo, hi;
-    bounds(f.region, lo, hi);
     // The tolerance keeps round-off (rate x dt summed over many steps, or a credit saved as float
     // for --resume) from delaying an agent by a step.
     while (inflowCredit_[k] >= 1.0 - 1e-6) {
@@ -292,7 +283,7 @@ void CrowdSimulation::arriveAndSpawn(double dt) {
       // Uniform in the region by rejection from its bounds (regions are checked to have area). The
       // stream depends only on the seed and the new agent's id, so a resumed run spawns the same.
       Rng rng = rng_.split(agents_.nextId);
-      const Vec2 x = freePoint(rng, f.region, f.agent.radius);
+      const Vec2 x = randomFreePoint(rng, f.region, f.agent.radius, obstacleIndex());
       if (!x.allFinite())
         throw SimulationError(fmt::format("inflows[{}]: no free room for a new agent in the region", k));
       AgentSpec spec = f.agent;

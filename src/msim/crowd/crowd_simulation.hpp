@@ -115,9 +115,8 @@ class CrowdSimulation {
 
  private:
   void validateAgent(std::size_t i, const std::string& what) const;
-  // A uniformly random point of the region where a disc of the radius clears every obstacle; NaN if
-  // many tries find none.
-  Vec2 freePoint(Rng& rng, const Polygon& region, float radius) const;
+  // Index of the agent with this id, size() if it has left.
+  std::size_t indexOfId(std::uint64_t id) const;
   void plan();
   void moveScripted(double dt);
   void moveOrca(double dt);

@@ -120,4 +120,15 @@ Vec2f StaticObstacles::pushOut(Vec2f p, float radius) const {
   return p;
 }
 
+Vec2 randomFreePoint(Rng& rng, const Polygon& region, float radius, const StaticObstacles& obstacles, int attempts) {
+  Vec2 lo, hi;
+  bounds(region, lo, hi);
+  for (int attempt = 0; attempt < attempts; ++attempt) {
+    const Vec2 x(rng.uniform(lo.x(), hi.x()), rng.uniform(lo.y(), hi.y()));
+    const Vec2f xf = x.cast<float>();
+    if (contains(region, x) && (obstacles.empty() || obstacles.pushOut(xf, radius) == xf)) return x;
+  }
+  return Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
+}
+
 }  // namespace msim::crowd

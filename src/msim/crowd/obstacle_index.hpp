@@ -6,6 +6,7 @@
 #include <span>
 #include <vector>
 
+#include "msim/core/rng.hpp"
 #include "msim/crowd/agents.hpp"
 #include "msim/crowd/polygon.hpp"
 
@@ -59,5 +60,11 @@ void StaticObstacles::forEachEdgeNear(const Vec2f& p, F&& f) const {
     for (std::uint32_t v = begin; v < end; ++v) f(vertices_[v], vertices_[v + 1 < end ? v + 1 : begin]);
   }
 }
+
+// A uniformly random point of `region` where a disc of the radius clears every obstacle of the
+// index (radius <= its reach), by rejection from the region's bounds; NaN if `attempts` tries find
+// none (the region lies inside obstacles). Places groups at the start and inflow agents later.
+Vec2 randomFreePoint(Rng& rng, const Polygon& region, float radius, const StaticObstacles& obstacles,
+                     int attempts = 100000);
 
 }  // namespace msim::crowd

@@ -285,14 +285,10 @@ struct Builder {
 
   // Uniform random points in the region where an agent of the radius clears every obstacle.
   Vec2 randomPoint(Rng& rng, const Polygon& region, float radius, const std::string& key) const {
-    Vec2 lo, hi;
-    crowd::bounds(region, lo, hi);
-    for (int attempt = 0; attempt < 100000; ++attempt) {
-      const Vec2 x(rng.uniform(lo.x(), hi.x()), rng.uniform(lo.y(), hi.y()));
-      const crowd::Vec2f xf = x.cast<float>();
-      if (crowd::contains(region, x) && (obstacleIndex.empty() || obstacleIndex.pushOut(xf, radius) == xf)) return x;
-    }
-    fail(key, fmt::format("has no free room for agents of radius {} m: it lies inside obstacles", radius));
+    const Vec2 x = crowd::randomFreePoint(rng, region, radius, obstacleIndex);
+    if (!x.allFinite())
+      fail(key, fmt::format("has no free room for agents of radius {} m: it lies inside obstacles", radius));
+    return x;
   }
 
   // Largest agent radius any group or inflow asks for (the obstacle index answers up to it).
