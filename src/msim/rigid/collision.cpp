@@ -1,50 +1,83 @@
 #include "msim/rigid/collision.hpp"
 
-#include <algorithm>
-#include <cmath>
+#include <variant>
+
+#include "msim/rigid/polyhedron.hpp"
+#include "msim/rigid/polyhedron_contact.hpp"
 
 namespace msim::rigid {
 namespace {
 
-void sphereSphere(const RigidBody& A, int ia, double ra, const RigidBody& B, int ib, double rb,
-                  double margin, std::vector<Contact>& out) {
-  const Vec3 d = A.position - B.position;
-  const double dist = d.norm();
-  const double depth = ra + rb - dist;
-  if (depth < -margin) return;
-  // Coincident centres: any normal is right; pick +z so the result is deterministic.
-  const Vec3 n = dist > 0.0 ? Vec3(d / dist) : Vec3(Vec3::UnitZ());
-  out.push_back({ia, ib, B.position + n * rb, n, depth, 0.0, 0.0});
+// A convex part of a body, placed in the world.
+struct PosedPart {
+  std::variant<const Sphere*, const Box*, const ConvexMesh*> shape;
+  Pose pose;
+  double radius;  // bounding radius about pose.position
+};
+
+template <class S>
+void addParts(const S& shape, const Pose& pose, double radius, std::vector<PosedPart>& parts) {
+  parts.push_back({&shape, pose, radius});
 }
 
-// Sphere (a) against box (b): closest point of the box to the centre; if the centre is inside,
-// push out through the nearest face.
-void sphereBox(const RigidBody& S, int is, double r, const RigidBody& B, int ib, const Vec3& h,
-               double margin, std::vector<Contact>& out) {
-  const Eigen::Matrix3d R = B.rotation();
-  const Vec3 c = R.transpose() * (S.position - B.position);  // sphere centre in box frame
-  const Vec3 q = c.cwiseMax(-h).cwiseMin(h);
-  Vec3 nLocal;
-  double depth;
-  Vec3 surface;
-  if ((c - q).squaredNorm() > 0.0) {
-    const double dist = (c - q).norm();
-    nLocal = (c - q) / dist;
-    depth = r - dist;
-    surface = q;
-  } else {
-    int axis = 0;
-    double best = h[0] - std::abs(c[0]);
-    for (int k = 1; k < 3; ++k)
-      if (h[k] - std::abs(c[k]) < best) best = h[k] - std::abs(c[k]), axis = k;
-    nLocal = Vec3::Zero();
-    nLocal[axis] = c[axis] >= 0.0 ? 1.0 : -1.0;
-    depth = r + best;
-    surface = c;
-    surface[axis] = nLocal[axis] * h[axis];
-  }
+void addParts(const Compound& compound, const Pose& pose, double, std::vector<PosedPart>& parts) {
+  for (const CompoundPart& part : compound.parts)
+    std::visit(
+        [&](const auto& s) {
+          parts.push_back({&s,
+                           Pose{pose.toWorld(part.offset),
+                                pose.rotation * part.rotation.toRotationMatrix()},
+                           partBoundingRadius(part.shape)});
+        },
+        part.shape);
+}
+
+std::vector<PosedPart> posedParts(const RigidBody& body) {
+  std::vector<PosedPart> parts;
+  const Pose pose{body.position, body.rotation()};
+  const double radius = boundingRadius(body.shape());
+  std::visit([&](const auto& s) { addParts(s, pose, radius, parts); }, body.shape());
+  return parts;
+}
+
+void planeContacts(const Sphere& s, const Pose& pose, auto&& add) { add(pose.position, s.radius); }
+void planeContacts(const Box& b, const Pose& pose, auto&& add) {
+  for (const Vec3& v : boxPolyhedron(b.halfExtents).vertices) add(pose.toWorld(v), 0.0);
+}
+void planeContacts(const ConvexMesh& m, const Pose& pose, auto&& add) {
+  for (const Vec3& v : m.vertices) add(pose.toWorld(v), 0.0);
+}
+
+// Sphere (centre, radius r, body is) against a part of body io.
+void spherePart(const Vec3& centre, double r, int is, const PosedPart& other, int io,
+                double margin, std::vector<Contact>& out) {
+  const Vec3 local = other.pose.rotation.transpose() * (centre - other.pose.position);
+  const SurfacePoint s =
+      std::visit([&](const auto* shape) { return closestSurfacePoint(*shape, local); }, other.shape);
+  const double depth = r - s.distance;
   if (depth < -margin) return;
-  out.push_back({is, ib, B.position + R * surface, R * nLocal, depth, 0.0, 0.0});
+  out.push_back({is, io, other.pose.toWorld(s.point), other.pose.rotation * s.normal, depth, 0.0,
+                 0.0});
+}
+
+// Boxes become polyhedra in `storage`; meshes are used as they are.
+const ConvexMesh& polyhedronOf(const PosedPart& part, ConvexMesh& storage) {
+  if (const auto* box = std::get_if<const Box*>(&part.shape)) {
+    storage = boxPolyhedron((*box)->halfExtents);
+    return storage;
+  }
+  return *std::get<const ConvexMesh*>(part.shape);
+}
+
+void collideParts(const PosedPart& pa, int ia, const PosedPart& pb, int ib, double margin,
+                  std::vector<Contact>& out) {
+  if (const auto* s = std::get_if<const Sphere*>(&pa.shape))
+    return spherePart(pa.pose.position, (*s)->radius, ia, pb, ib, margin, out);
+  if (const auto* s = std::get_if<const Sphere*>(&pb.shape))
+    return spherePart(pb.pose.position, (*s)->radius, ib, pa, ia, margin, out);
+  ConvexMesh boxA, boxB;
+  collidePolyhedra(polyhedronOf(pa, boxA), pa.pose, ia, polyhedronOf(pb, boxB), pb.pose, ib,
+                   margin, out);
 }
 
 }  // namespace
@@ -57,41 +90,19 @@ void collidePlane(const RigidBody& body, int a, const Plane& plane, double margi
       out.push_back({a, kWorld, p - plane.normal * (plane.normal.dot(p) - plane.offset),
                      plane.normal, depth, 0.0, 0.0});
   };
-  if (const auto* s = std::get_if<Sphere>(&body.shape())) {
-    add(body.position, s->radius);
-  } else if (const auto* b = std::get_if<Box>(&body.shape())) {
-    for (int k = 0; k < 8; ++k) {
-      const Vec3 corner((k & 1) ? b->halfExtents.x() : -b->halfExtents.x(),
-                        (k & 2) ? b->halfExtents.y() : -b->halfExtents.y(),
-                        (k & 4) ? b->halfExtents.z() : -b->halfExtents.z());
-      add(body.toWorld(corner), 0.0);
-    }
-  } else {
-    for (const Vec3& v : std::get<ConvexMesh>(body.shape()).vertices) add(body.toWorld(v), 0.0);
-  }
+  for (const PosedPart& part : posedParts(body))
+    std::visit([&](const auto* shape) { planeContacts(*shape, part.pose, add); }, part.shape);
 }
 
-bool collidePair(const RigidBody& A, int ia, const RigidBody& B, int ib, double margin,
+void collidePair(const RigidBody& A, int ia, const RigidBody& B, int ib, double margin,
                  std::vector<Contact>& out) {
-  const auto* sa = std::get_if<Sphere>(&A.shape());
-  const auto* sb = std::get_if<Sphere>(&B.shape());
-  if (sa && sb) {
-    sphereSphere(A, ia, sa->radius, B, ib, sb->radius, margin, out);
-    return true;
-  }
-  if (sa) {
-    if (const auto* bb = std::get_if<Box>(&B.shape())) {
-      sphereBox(A, ia, sa->radius, B, ib, bb->halfExtents, margin, out);
-      return true;
+  const std::vector<PosedPart> partsA = posedParts(A), partsB = posedParts(B);
+  for (const PosedPart& pa : partsA)
+    for (const PosedPart& pb : partsB) {
+      const double reach = pa.radius + pb.radius + 2.0 * margin;
+      if ((pa.pose.position - pb.pose.position).squaredNorm() > reach * reach) continue;
+      collideParts(pa, ia, pb, ib, margin, out);
     }
-  }
-  if (sb) {
-    if (const auto* ba = std::get_if<Box>(&A.shape())) {
-      sphereBox(B, ib, sb->radius, A, ia, ba->halfExtents, margin, out);
-      return true;
-    }
-  }
-  return false;
 }
 
 std::vector<Plane> domainWalls(const Vec3& lo, const Vec3& hi, const Material& material) {

@@ -133,7 +133,7 @@ void solveConstraints(std::vector<RigidBody>& bodies, const std::vector<Contact>
     const bool bounce = c.restitution > 0.0 && -vn0 > s.restitutionThreshold;
     if (c.depth < 0.0) {
       // Speculative: may close the gap this step, no more; bounce if it would cross it.
-      row.bias = (bounce && -vn0 * dt > -c.depth) ? -c.restitution * vn0 : -c.depth / dt;
+      row.bias = (bounce && -vn0 * dt > -c.depth) ? -c.restitution * vn0 : c.depth / dt;
     } else {
       row.bias = s.baumgarte / dt * std::max(c.depth - s.slop, 0.0);
       if (bounce) row.bias = std::max(row.bias, -c.restitution * vn0);

@@ -6,10 +6,12 @@
 #include <numbers>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include <Eigen/Geometry>
 
 #include "msim/core/error.hpp"
+#include "msim/rigid/polyhedron.hpp"
 
 namespace msim::rigid {
 namespace {
@@ -140,26 +142,71 @@ MassProperties meshMassProperties(const TriangleMesh& mesh, double density) {
   return p;
 }
 
-MassProperties shapeMassProperties(const Shape& shape, double density) {
-  if (const auto* s = std::get_if<Sphere>(&shape)) return sphereMassProperties(*s, density);
-  if (const auto* b = std::get_if<Box>(&shape)) return boxMassProperties(*b, density);
-  const auto& m = std::get<ConvexMesh>(shape);
+Eigen::Matrix3d parallelAxisInertia(double mass, const Vec3& offset) {
+  return mass * (offset.squaredNorm() * Eigen::Matrix3d::Identity() - offset * offset.transpose());
+}
+
+namespace {
+
+MassProperties massOf(const Sphere& s, double density) { return sphereMassProperties(s, density); }
+MassProperties massOf(const Box& b, double density) { return boxMassProperties(b, density); }
+MassProperties massOf(const ConvexMesh& m, double density) {
+  if (m.faces.empty())
+    throw InputError("rigid body mesh: ConvexMesh has no faces; build it with makeConvexMesh");
   return meshMassProperties(TriangleMesh{m.vertices, m.triangles}, density);
+}
+MassProperties massOf(const Compound& c, double density) {
+  if (c.parts.empty()) throw InputError("rigid compound: needs at least one part");
+  MassProperties total;
+  std::vector<MassProperties> parts;
+  for (const CompoundPart& part : c.parts) {
+    MassProperties p =
+        std::visit([&](const auto& s) { return massOf(s, density); }, part.shape);
+    const Eigen::Matrix3d R = part.rotation.normalized().toRotationMatrix();
+    p.centreOfMass = R * p.centreOfMass + part.offset;
+    p.inertia = R * p.inertia * R.transpose();
+    total.mass += p.mass;
+    total.centreOfMass += p.mass * p.centreOfMass;
+    parts.push_back(p);
+  }
+  total.centreOfMass /= total.mass;
+  for (const MassProperties& p : parts)
+    total.inertia += p.inertia + parallelAxisInertia(p.mass, p.centreOfMass - total.centreOfMass);
+  return total;
+}
+
+}  // namespace
+
+MassProperties shapeMassProperties(const Shape& shape, double density) {
+  return std::visit([&](const auto& s) { return massOf(s, density); }, shape);
 }
 
 ConvexMesh makeConvexMesh(const TriangleMesh& mesh) {
   const MassProperties p = meshMassProperties(mesh, 1.0);
-  ConvexMesh out{mesh.vertices, mesh.triangles};
+  ConvexMesh out{mesh.vertices, mesh.triangles, {}, {}, {}};
   for (Vec3& v : out.vertices) v -= p.centreOfMass;
+  buildConvexFeatures(out);
   return out;
 }
 
-double boundingRadius(const Shape& shape) {
-  if (const auto* s = std::get_if<Sphere>(&shape)) return s->radius;
-  if (const auto* b = std::get_if<Box>(&shape)) return b->halfExtents.norm();
-  double r = 0.0;
-  for (const Vec3& v : std::get<ConvexMesh>(shape).vertices) r = std::max(r, v.norm());
-  return r;
+Compound makeCompound(std::vector<CompoundPart> parts) {
+  for (std::size_t k = 0; k < parts.size(); ++k) {
+    CompoundPart& part = parts[k];
+    const std::string name = "rigid compound part " + std::to_string(k) + ": ";
+    if (!part.offset.allFinite()) throw InputError(name + "offset is not finite");
+    if (!part.rotation.coeffs().allFinite() || !(part.rotation.norm() > 0.0))
+      throw InputError(name + "rotation must be a finite non-zero quaternion");
+    part.rotation.normalize();
+    try {
+      std::visit([](const auto& s) { massOf(s, 1.0); }, part.shape);
+    } catch (const InputError& e) {
+      throw InputError(name + e.what());
+    }
+  }
+  Compound out{std::move(parts)};
+  const Vec3 c = massOf(out, 1.0).centreOfMass;
+  for (CompoundPart& part : out.parts) part.offset -= c;
+  return out;
 }
 
 }  // namespace msim::rigid
