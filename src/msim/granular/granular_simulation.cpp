@@ -1,0 +1,305 @@
+#include "msim/granular/granular_simulation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "msim/core/parallel.hpp"
+#include "msim/core/timer.hpp"
+#include "msim/granular/particle_advection.hpp"
+
+namespace msim::granular {
+
+namespace {
+
+int dominantAxis(const Vec3& g) {
+  int axis = 1;
+  for (int a = 0; a < 3; ++a)
+    if (std::abs(g[a]) > std::abs(g[axis])) axis = a;
+  return axis;
+}
+
+// Face-major copies between the solver's double faces and the particles' float MAC grid.
+void toMac(const FaceField& f, MacGrid<3>& m) {
+  for (int a = 0; a < 3; ++a) {
+    std::vector<float>& out = m.component(a).data();
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = static_cast<float>(f.values[a][i]);
+  }
+}
+
+// Centre of face-a q in world space.
+Vec3 faceCentre(const GridSpec<3>& spec, int a, const IVec3& q) {
+  Vec3 x = spec.origin + (q.cast<double>().array() + 0.5).matrix() * spec.dx;
+  x[a] -= 0.5 * spec.dx;
+  return x;
+}
+
+}  // namespace
+
+GranularSimulation::GranularSimulation(GranularSettings settings, std::vector<GranularMaterial> materials)
+    : settings_(std::move(settings)),
+      materials_(std::move(materials)),
+      world_([&] {
+        rigid::WorldSettings w;
+        w.gravity = settings_.gravity;
+        return w;
+      }()),
+      splitMerge_(defaultParticleRadius(settings_.grid.dx)) {
+  if (materials_.empty()) throw std::invalid_argument("granular: at least one material is needed");
+  validate(materials_);
+  if (!(settings_.grid.dx > 0.0) || (settings_.grid.res.array() < 1).any())
+    throw std::invalid_argument("granular: the grid needs a positive cell size and at least one cell per axis");
+  if (!(settings_.cfl > 0.0)) throw std::invalid_argument("granular: cfl must be > 0");
+  if (!(settings_.flipRatio >= 0.0 && settings_.flipRatio <= 1.0))
+    throw std::invalid_argument("granular: flip_ratio must lie in [0, 1]");
+  settings_.stress.upAxis = dominantAxis(settings_.gravity);
+  stress_.settings() = settings_.stress;
+  world_.addDomainBox(settings_.grid.origin, settings_.grid.upper());
+  fields_ = ParticleGridFields(settings_.grid);
+  velocityNew_ = MacGrid<3>(settings_.grid);
+  displacement_ = MacGrid<3>(settings_.grid);
+  wallFaces_ = FaceField(settings_.grid.res, 1.0);
+  for (int a = 0; a < 3; ++a) {
+    const IVec3 n = wallFaces_.size(a);
+    parallelForCells<3>(n, [&](const IVec3& q, std::size_t i) {
+      if (q[a] == 0 || q[a] == settings_.grid.res[a]) wallFaces_.values[a][i] = 0.0;
+    });
+  }
+  if (settings_.renderPointsPerParticle > 0) renderPoints_.emplace(settings_.renderPointsPerParticle);
+}
+
+void GranularSimulation::addStaticSolid(std::shared_ptr<const geometry::Shape<3>> solid) {
+  if (!solid) throw std::invalid_argument("granular: null static solid");
+  for (int a = 0; a < 3; ++a)
+    parallelForCells<3>(wallFaces_.size(a), [&](const IVec3& q, std::size_t i) {
+      if (solid->distance(faceCentre(settings_.grid, a, q)) < 0.0) wallFaces_.values[a][i] = 0.0;
+    });
+  staticSolids_.push_back(std::move(solid));
+}
+
+double GranularSimulation::solidDistance(const Vec3& x) const {
+  double d = std::numeric_limits<double>::infinity();
+  for (const auto& s : staticSolids_) d = std::min(d, s->distance(x));
+  for (const rigid::RigidBody& b : world_.bodies())
+    d = std::min(d, rigid::signedDistance(b.shape(), b.orientation.conjugate() * (x - b.position)));
+  return d;
+}
+
+std::size_t GranularSimulation::seed(const Vec3& lo, const Vec3& hi, const std::function<bool(const Vec3&)>& inside,
+                                     const SeedOptions& options) {
+  const GridSpec<3>& g = settings_.grid;
+  for (int a = 0; a < 3; ++a)
+    if (!(lo[a] < hi[a]) || hi[a] <= g.origin[a] || lo[a] >= g.upper()[a])
+      throw std::invalid_argument("granular: a seeded region must have lo < hi and overlap the domain");
+  // Particles are kept half a particle radius clear of every solid.
+  const double clearance = 0.5 * defaultParticleRadius(g.dx);
+  const std::size_t added = seedRegion(
+      particles_, g, lo.cwiseMax(g.origin), hi.cwiseMin(g.upper()),
+      [&](const Vec3& x) { return inside(x) && solidDistance(x) > clearance; }, materials_, options);
+  if (added == 0) throw std::invalid_argument("granular: the seeded region lies inside solids or holds no cell");
+  if (renderPoints_) renderPoints_->sample(particles_);
+  return added;
+}
+
+double GranularSimulation::stableTimestep(double maxDt) const {
+  const std::size_t n = particles_.size();
+  double vmax = parallelMax(n, [&](std::size_t i) { return static_cast<double>(particles_.velocity[i].norm()); });
+  for (const rigid::RigidBody& b : world_.bodies())
+    if (!b.isStatic()) vmax = std::max(vmax, b.velocity.norm() + b.angularVelocity.norm() * rigid::boundingRadius(b.shape()));
+  const double speed = vmax + settings_.gravity.norm() * maxDt;
+  return speed > 0.0 ? std::min(maxDt, settings_.cfl * settings_.grid.dx / speed) : maxDt;
+}
+
+void GranularSimulation::buildGridState() {
+  transfer_.toGrid(particles_, materials_, fields_);
+  const GridSpec<3>& g = settings_.grid;
+  const double invV = 1.0 / g.cellVolume();
+  state_.spec = g;
+  const std::size_t cells = g.cellCount();
+  state_.phi.resize(cells);
+  state_.alpha.resize(cells);
+  parallelFor(0, cells, [&](std::size_t i) {
+    state_.phi[i] = fields_.volume[i] * invV;
+    state_.alpha[i] = fields_.friction[i];
+  });
+  state_.phiFace = FaceField(g.res);
+  state_.rhoFace = FaceField(g.res);
+  for (int a = 0; a < 3; ++a) {
+    const std::vector<float>& volume = fields_.faceVolume.component(a).data();
+    const std::vector<float>& mass = fields_.faceMass.component(a).data();
+    for (std::size_t i = 0; i < volume.size(); ++i) {
+      state_.phiFace.values[a][i] = volume[i] * invV;
+      state_.rhoFace.values[a][i] = mass[i] * invV;
+    }
+  }
+  state_.open = wallFaces_;
+}
+
+void GranularSimulation::rasterizeBodies(double dt) {
+  bodies_.clear();
+  bodyIndex_.clear();
+  if (!settings_.coupleBodies) return;
+  const GridSpec<3>& g = settings_.grid;
+  const std::vector<rigid::RigidBody>& bodies = world_.bodies();
+  for (std::size_t k = 0; k < bodies.size(); ++k) {
+    const rigid::RigidBody& b = bodies[k];
+    if (b.isStatic()) continue;
+    CoupledBody c;
+    c.inverseMass = b.inverseMassMatrix();
+    rigid::Vec6 gravity = rigid::Vec6::Zero();
+    gravity.head<3>() = b.mass() * settings_.gravity;
+    c.velocity = b.generalizedVelocity() + dt * c.inverseMass * gravity;
+    c.centre = b.position;
+    // Covered fraction: the ramp 0.5 - d / dx across the surface cell (geometry/occupancy.hpp),
+    // over the cells of the body's bounding sphere.
+    c.cellFraction.assign(g.cellCount(), 0.0);
+    const double reach = rigid::boundingRadius(b.shape()) + g.dx;
+    IVec3 lo, hi;
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::max(0, static_cast<int>(std::floor((b.position[a] - reach - g.origin[a]) / g.dx)));
+      hi[a] = std::min(g.res[a] - 1, static_cast<int>(std::floor((b.position[a] + reach - g.origin[a]) / g.dx)));
+    }
+    const Eigen::Quaterniond toBody = b.orientation.conjugate();
+    bool any = false;
+    for (int z = lo[2]; z <= hi[2]; ++z)
+      for (int y = lo[1]; y <= hi[1]; ++y)
+        for (int x = lo[0]; x <= hi[0]; ++x) {
+          const Vec3 p = g.cellCenter(IVec3(x, y, z));
+          const double d = rigid::signedDistance(b.shape(), toBody * (p - b.position));
+          const double f = std::clamp(0.5 - d / g.dx, 0.0, 1.0);
+          c.cellFraction[(static_cast<std::size_t>(z) * g.res[1] + y) * g.res[0] + x] = f;
+          any |= f > 0.0;
+        }
+    if (!any) continue;
+    c.faceFraction = FaceField(g.res);
+    for (int a = 0; a < 3; ++a)
+      parallelForCells<3>(c.faceFraction.size(a), [&](const IVec3& q, std::size_t i) {
+        IVec3 below = q;
+        below[a] -= 1;
+        auto cell = [&](const IVec3& k) {
+          if (k[a] < 0 || k[a] >= g.res[a]) return 0.0;
+          return c.cellFraction[(static_cast<std::size_t>(k[2]) * g.res[1] + k[1]) * g.res[0] + k[0]];
+        };
+        c.faceFraction.values[a][i] = 0.5 * (cell(q) + cell(below));
+      });
+    bodies_.push_back(std::move(c));
+    bodyIndex_.push_back(static_cast<int>(k));
+  }
+}
+
+void GranularSimulation::pushOutOfSolids() {
+  if (staticSolids_.empty() && world_.bodies().empty()) return;
+  const double h = 0.25 * settings_.grid.dx;
+  parallelFor(0, particles_.size(), [&](std::size_t i) {
+    const Vec3 x = particles_.position[i].cast<double>();
+    const double d = solidDistance(x);
+    if (d >= 0.0) return;
+    // Out along the distance gradient (central differences), to the surface.
+    Vec3 n;
+    for (int a = 0; a < 3; ++a) {
+      Vec3 e = Vec3::Zero();
+      e[a] = h;
+      n[a] = solidDistance(x + e) - solidDistance(x - e);
+    }
+    if (!(n.squaredNorm() > 0.0)) return;
+    n.normalize();
+    particles_.position[i] = clampIntoDomain(settings_.grid, x - d * n).cast<float>();
+    // The velocity into the solid is removed (relative to the body it touches, if moving).
+    Vec3 solidVelocity = Vec3::Zero();
+    for (const rigid::RigidBody& b : world_.bodies())
+      if (rigid::signedDistance(b.shape(), b.orientation.conjugate() * (x - b.position)) <= d + 1e-12)
+        solidVelocity = b.velocityAt(x);
+    Vec3 v = particles_.velocity[i].cast<double>();
+    const double vn = (v - solidVelocity).dot(n);
+    if (vn < 0.0) v -= vn * n;
+    particles_.velocity[i] = v.cast<float>();
+  });
+}
+
+void GranularSimulation::removeVelocityAgainstCorrection() {
+  // The density correction resolves overlaps the way a contact does, so like a contact (and like
+  // the inelastic pressure of eq. 5.9) it also removes the velocity into the overlap: a particle
+  // pushed back by dx keeps no velocity component against dx. Without this, grains resting on a
+  // packed surface (whose cells never read as full under the trilinear splat, so the pressure
+  // never holds them) keep falling in velocity while the correction puts them back every step.
+  correctionAt_.resize(particles_.size());
+  gather(displacement_, particles_.position, TransferKernel::Linear, correctionAt_);
+  parallelFor(0, particles_.size(), [&](std::size_t i) {
+    const Vecf<3> d = correctionAt_[i];
+    const float d2 = d.squaredNorm();
+    if (!(d2 > 0.0f)) return;
+    const float vd = particles_.velocity[i].dot(d);
+    if (vd < 0.0f) particles_.velocity[i] -= (vd / d2) * d;
+  });
+}
+
+void GranularSimulation::step(double dt) {
+  if (!(dt > 0.0) || !std::isfinite(dt)) throw std::invalid_argument("granular: the time step must be positive");
+  times_ = {};
+  {
+    ScopedTimer t(times_.transfer);
+    buildGridState();
+    rasterizeBodies(dt);
+  }
+  std::vector<const CoupledBody*> coupled;
+  for (const CoupledBody& b : bodies_) coupled.push_back(&b);
+  {
+    ScopedTimer t(times_.correction);
+    const FaceField& dx = stress_.correctDensity(state_, coupled);
+    toMac(dx, displacement_);
+  }
+  const bool corrected = stress_.stats().correctionIterations > 0;
+  // v* = v^n + dt g on the open faces that hold material (eq. 5.5 without stress); walls at rest.
+  FaceField velocity(settings_.grid.res);
+  for (int a = 0; a < 3; ++a) {
+    const std::vector<float>& v = fields_.velocity.component(a).data();
+    for (std::size_t i = 0; i < v.size(); ++i)
+      if (state_.open.values[a][i] != 0.0 && state_.rhoFace.values[a][i] > 0.0)
+        velocity.values[a][i] = v[i] + dt * settings_.gravity[a];
+  }
+  stress_.solve(state_, dt, velocity, coupled);
+  times_.pressure = stress_.stats().pressureSeconds;
+  times_.friction = stress_.stats().frictionSeconds;
+  for (int a = 0; a < 3; ++a)
+    for (double v : velocity.values[a])
+      if (!std::isfinite(v))
+        throw std::runtime_error(fmt::format("granular: non-finite grid velocity at t = {:.6g} s (step {:.3g} s)", time_, dt));
+  toMac(velocity, velocityNew_);
+  {
+    ScopedTimer t(times_.bodies);
+    for (std::size_t k = 0; k < bodies_.size(); ++k) world_.body(bodyIndex_[k]).applyImpulse(stress_.bodyImpulses()[k]);
+    world_.step(dt);
+  }
+  {
+    ScopedTimer t(times_.particles);
+    transfer_.toParticles(fields_.velocity, velocityNew_, particles_, settings_.flipRatio);
+    if (corrected) removeVelocityAgainstCorrection();
+    advectParticles(particles_, velocityNew_, dt, corrected ? &displacement_ : nullptr);
+    if (renderPoints_) renderPoints_->advect(velocityNew_, dt, corrected ? &displacement_ : nullptr);
+    pushOutOfSolids();
+    if (settings_.splitMerge) {
+      splitMergeStats_ = splitMerge_.apply(particles_);
+      if (renderPoints_) renderPoints_->reassign(particles_, splitMerge_.successors());
+    }
+    if (renderPoints_) renderPoints_->resampleEscaped(particles_);
+  }
+  time_ += dt;
+}
+
+double GranularSimulation::totalMass() const {
+  return parallelSum(particles_.size(), [&](std::size_t i) { return static_cast<double>(particles_.mass[i]); });
+}
+
+Vec3 GranularSimulation::totalMomentum() const {
+  Vec3 p;
+  for (int a = 0; a < 3; ++a)
+    p[a] = parallelSum(particles_.size(), [&](std::size_t i) {
+      return static_cast<double>(particles_.mass[i]) * particles_.velocity[i][a];
+    });
+  return p;
+}
+
+}  // namespace msim::granular

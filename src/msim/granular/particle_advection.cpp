@@ -1,0 +1,88 @@
+#include "msim/granular/particle_advection.hpp"
+
+#include <algorithm>
+
+#include "msim/core/interpolation.hpp"
+#include "msim/core/parallel.hpp"
+
+namespace msim::granular {
+
+VelocitySample sampleVelocityAndJacobian(const MacGrid<3>& velocity, const Vec3& x) {
+  using interpolation_detail::LinearAxis;
+  VelocitySample out;
+  const double inverseDx = 1.0 / velocity.spec().dx;
+  for (int a = 0; a < 3; ++a) {
+    const Grid<float, 3>& g = velocity.component(a);
+    const Vec3 s = g.toSampleSpace(x);
+    LinearAxis axis[3];
+    bool varies[3];  // whether the interpolant depends on this coordinate at x
+    for (int b = 0; b < 3; ++b) {
+      const int n = g.size()[b];
+      axis[b] = interpolation_detail::linearAxis(s[b], n, g.stride(b));
+      varies[b] = n >= 2 && s[b] >= 0.0 && s[b] <= n - 1;
+    }
+    const float* data = g.data().data();
+    double value = 0.0;
+    Vec3 gradient = Vec3::Zero();  // per sample-space coordinate
+    for (int corner = 0; corner < 8; ++corner) {
+      std::ptrdiff_t offset = 0;
+      double w[3], sign[3];
+      for (int b = 0; b < 3; ++b) {
+        const bool high = (corner >> b) & 1;
+        offset += high ? axis[b].hi : axis[b].lo;
+        w[b] = high ? axis[b].t : 1.0 - axis[b].t;
+        sign[b] = high ? 1.0 : -1.0;
+      }
+      const double f = data[offset];
+      value += f * w[0] * w[1] * w[2];
+      gradient[0] += f * sign[0] * w[1] * w[2];
+      gradient[1] += f * w[0] * sign[1] * w[2];
+      gradient[2] += f * w[0] * w[1] * sign[2];
+    }
+    out.value[a] = value;
+    for (int b = 0; b < 3; ++b) out.jacobian(a, b) = varies[b] ? gradient[b] * inverseDx : 0.0;
+  }
+  return out;
+}
+
+Eigen::Matrix3d deformShape(const Eigen::Matrix3d& a, const Eigen::Matrix3d& jacobian, double dt) {
+  const Eigen::Matrix3d f = Eigen::Matrix3d::Identity() + dt * jacobian;
+  return f * a * f.transpose();
+}
+
+Vec3 clampIntoDomain(const GridSpec<3>& domain, const Vec3& x) {
+  const double eps = kBoundaryEpsilonCells * domain.dx;
+  const Vec3 lo = domain.origin.array() + eps, hi = domain.upper().array() - eps;
+  return x.cwiseMax(lo).cwiseMin(hi);
+}
+
+namespace {
+
+// The position after the density correction, before the velocity step.
+Vec3 corrected(const Vecf<3>& x, const GridSpec<3>& domain, const MacGrid<3>* displacement) {
+  const Vec3 p = x.cast<double>();
+  return displacement ? clampIntoDomain(domain, p + sampleLinear<3>(*displacement, p)) : p;
+}
+
+}  // namespace
+
+void advectParticles(GranularParticles& particles, const MacGrid<3>& velocity, double dt,
+                     const MacGrid<3>* displacement) {
+  const GridSpec<3>& domain = velocity.spec();
+  parallelFor(0, particles.size(), [&](std::size_t i) {
+    const Vec3 x = corrected(particles.position[i], domain, displacement);
+    const VelocitySample v = sampleVelocityAndJacobian(velocity, x);
+    particles.shape[i] = toShape(deformShape(shapeMatrix(particles.shape[i]), v.jacobian, dt));
+    particles.position[i] = clampIntoDomain(domain, x + dt * v.value).cast<float>();
+  });
+}
+
+void advectPoints(std::span<Vecf<3>> points, const MacGrid<3>& velocity, double dt, const MacGrid<3>* displacement) {
+  const GridSpec<3>& domain = velocity.spec();
+  parallelFor(0, points.size(), [&](std::size_t i) {
+    const Vec3 x = corrected(points[i], domain, displacement);
+    points[i] = clampIntoDomain(domain, x + dt * sampleLinear<3>(velocity, x)).cast<float>();
+  });
+}
+
+}  // namespace msim::granular

@@ -1,0 +1,469 @@
+#include "msim/granular/stress_solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include <Eigen/Geometry>
+
+#include "msim/core/parallel.hpp"
+#include "msim/core/timer.hpp"
+#include "msim/numerics/bound_qp_mic0.hpp"
+
+namespace msim::granular {
+
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+
+namespace {
+
+// A stress variable acting through one or two components with a sign: the pressure is
+// -(D_x + D_y + D_z) p, the pair of ch. 5.5.1 is s_xx = -s_yy / 2 + d, s_zz = -s_yy / 2 - d, so d
+// acts as +D_xx - D_zz; the others act as themselves.
+struct Term {
+  StressComponent c;
+  double sign;
+};
+
+// The rank-6 part of a body: J x = sum_q column[q] x_q over the samples its faces touch
+// (J = G Phi_s D of eqs. 5.21/5.22, G_f = [e_a; r_f x e_a] the generalized direction of face f).
+struct BodyColumns {
+  std::vector<std::size_t> sample;
+  std::vector<Vec6> column;
+  Mat6 inverseMass;
+  Vec6 apply(const Eigen::VectorXd& x) const {
+    Vec6 y = Vec6::Zero();
+    for (std::size_t k = 0; k < sample.size(); ++k) y += column[k] * x[static_cast<Eigen::Index>(sample[k])];
+    return y;
+  }
+};
+
+// dt^2 (D^T W D + V_c sum_b J_b^T M_b^-1 J_b): the grid Poisson part plus the bodies.
+class CoupledOperator final : public numerics::QpOperator {
+ public:
+  CoupledOperator() : grid_(IVec3::Ones(), {std::vector<double>(1, 0.0), {0.0}, {0.0}}, {1.0}) {}
+  numerics::GridPoissonQpOperator<3>& grid() { return grid_; }
+  std::vector<BodyColumns>& bodies() { return bodies_; }
+  void setBodyWeight(double w) { bodyWeight_ = w; }
+
+  Eigen::Index size() const override { return grid_.size(); }
+  void apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const override {
+    grid_.apply(x, y);
+    for (const BodyColumns& b : bodies_) {
+      const Vec6 f = bodyWeight_ * (b.inverseMass * b.apply(x));
+      for (std::size_t k = 0; k < b.sample.size(); ++k) y[static_cast<Eigen::Index>(b.sample[k])] += b.column[k].dot(f);
+    }
+  }
+  void diagonal(Eigen::VectorXd& d) const override {
+    grid_.diagonal(d);
+    for (const BodyColumns& b : bodies_)
+      for (std::size_t k = 0; k < b.sample.size(); ++k)
+        d[static_cast<Eigen::Index>(b.sample[k])] += bodyWeight_ * b.column[k].dot(b.inverseMass * b.column[k]);
+  }
+  double normUpperBound() const override {
+    // Gershgorin for a rank-6 term: row q sums |c_q^T M^-1 c_q'| <= |c_q| |M^-1| sum |c_q'|.
+    double bound = grid_.normUpperBound();
+    for (const BodyColumns& b : bodies_) {
+      double sum = 0.0, largest = 0.0;
+      for (const Vec6& c : b.column) {
+        sum += c.norm();
+        largest = std::max(largest, c.norm());
+      }
+      bound += bodyWeight_ * b.inverseMass.norm() * largest * sum;
+    }
+    return bound;
+  }
+
+ private:
+  numerics::GridPoissonQpOperator<3> grid_;
+  std::vector<BodyColumns> bodies_;
+  double bodyWeight_ = 0.0;
+};
+
+// One quadratic program of the staggered sequence, with its storage kept between steps.
+struct Problem {
+  std::vector<Term> terms;
+  IVec3 lattice = IVec3::Zero();
+  CoupledOperator op;
+  numerics::GridMic0FacePreconditioner<3> mic{IVec3::Ones(), {std::vector<double>(1, 0.0), {0.0}, {0.0}}, {1.0}};
+  numerics::BoundQpSolver solver;
+  std::array<std::vector<double>, 3> lower, part;
+  std::vector<double> diagonal, partDiagonal, scratch;
+  Eigen::VectorXd b, lo, hi, x;
+
+  // Builds dt^2 (sum_terms D^T W D + V_c J^T M^-1 J) for face weights W.
+  void build(const GranularGridState& st, const FaceField& weight, double dt,
+             const std::vector<const CoupledBody*>& bodies) {
+    lattice = latticeSize(terms.front().c, st.spec.res);
+    const std::size_t n = static_cast<std::size_t>(lattice.prod());
+    for (auto& l : lower) l.assign(n, 0.0);
+    diagonal.assign(n, 0.0);
+    for (const Term& t : terms) {
+      poissonStencil(t.c, weight, st.spec.dx, st.open, 0.0, part, partDiagonal);
+      for (int a = 0; a < 3; ++a)
+        for (std::size_t i = 0; i < n; ++i) lower[a][i] += part[a][i];
+      for (std::size_t i = 0; i < n; ++i) diagonal[i] += partDiagonal[i];
+    }
+    const double dt2 = dt * dt;
+    for (auto& l : lower)
+      for (double& w : l) w *= dt2;
+    // Samples no material reaches decouple; any positive diagonal keeps the operator definite
+    // and their bounds (or right-hand sides) hold them at 0.
+    for (double& d : diagonal) d = d > 0.0 ? d * dt2 : 1.0;
+    op.grid().assign(lattice, lower, diagonal);
+    mic.assign(lattice, lower, diagonal);
+    op.setBodyWeight(dt2 * st.spec.cellVolume());
+    op.bodies().resize(bodies.size());
+    for (std::size_t k = 0; k < bodies.size(); ++k) bodyColumns(st, *bodies[k], op.bodies()[k]);
+  }
+
+  void bodyColumns(const GranularGridState& st, const CoupledBody& body, BodyColumns& out) const {
+    out.inverseMass = body.inverseMass;
+    out.sample.clear();
+    out.column.clear();
+    const double invDx = 1.0 / st.spec.dx;
+    for (int a = 0; a < 3; ++a) {
+      const IVec3 n = st.open.size(a);
+      const std::vector<double>& frac = body.faceFraction.values[a];
+      for (std::size_t i = 0; i < frac.size(); ++i) {
+        if (frac[i] <= 0.0 || st.open.values[a][i] == 0.0) continue;
+        const IVec3 f(static_cast<int>(i % n[0]), static_cast<int>(i / n[0] % n[1]), static_cast<int>(i / n[0] / n[1]));
+        Vec3 x = st.spec.origin + (f.cast<double>().array() + 0.5).matrix() * st.spec.dx;
+        x[a] -= 0.5 * st.spec.dx;
+        Vec6 g;
+        g.head<3>() = Vec3::Unit(a);
+        g.tail<3>() = Vec3(x - body.centre).cross(Vec3(Vec3::Unit(a)));
+        g *= frac[i] * invDx;
+        for (const Term& t : terms)
+          forEachFaceSample(t.c, lattice, a, f, [&](std::size_t q, double sign) {
+            out.sample.push_back(q);
+            out.column.push_back(t.sign * sign * g);
+          });
+      }
+    }
+  }
+
+  int solve(const numerics::BoundQpSettings& settings) {
+    const auto r = solver.solve(op, b, lo, hi, x, settings, &mic);
+    return r.iterations;
+  }
+};
+
+}  // namespace
+
+struct StressSolver::Impl {
+  Problem pressure;
+  std::array<Problem, 5> friction;  // up diagonal, the other pair, and the three off-diagonals
+  FaceField kappa, weightP, weightS, weightB, force, flux, velocity0;
+  std::vector<double> tmp, tmp2, smax, var, cellScratch;
+  struct BodyFace {
+    int axis;
+    std::size_t index;
+    Vec6 g;  // phi_s G_f
+  };
+  std::vector<std::vector<BodyFace>> bodyFaces;
+  std::vector<Vec6> bodyVelocity;  // current V~ of each body with the current stresses
+};
+
+StressSolver::StressSolver(StressSolverSettings settings) : impl_(std::make_shared<Impl>()), settings_(settings) {
+  if (settings_.upAxis < 0 || settings_.upAxis > 2) throw std::invalid_argument("StressSolver: upAxis must be 0, 1 or 2");
+  Impl& m = *impl_;
+  m.pressure.terms = {{StressComponent::Diagonal(0), -1.0}, {StressComponent::Diagonal(1), -1.0},
+                      {StressComponent::Diagonal(2), -1.0}};
+  const int u = settings_.upAxis, a = (u + 1) % 3, c = (u + 2) % 3;
+  m.friction[0].terms = {{StressComponent::Diagonal(u), 1.0}};
+  m.friction[1].terms = {{StressComponent::Diagonal(std::min(a, c)), 1.0}, {StressComponent::Diagonal(std::max(a, c)), -1.0}};
+  m.friction[2].terms = {{StressComponent::OffDiagonal(0, 1), 1.0}};
+  m.friction[3].terms = {{StressComponent::OffDiagonal(1, 2), 1.0}};
+  m.friction[4].terms = {{StressComponent::OffDiagonal(0, 2), 1.0}};
+}
+
+const std::vector<double>& StressSolver::stress(const StressComponent& c) const {
+  static constexpr int kOffIndex[3][3] = {{0, 3, 4}, {3, 1, 5}, {4, 5, 2}};
+  return s_[static_cast<std::size_t>(kOffIndex[c.a][c.b])];
+}
+
+namespace {
+
+// Sum over terms of sign * D_term x, added into force (per unit volume).
+void addTerms(const std::vector<Term>& terms, const std::vector<double>& x, double scale, double dx,
+              const FaceField& mask, FaceField& force) {
+  for (const Term& t : terms) addDivergence(t.c, x, scale * t.sign, dx, mask, force);
+}
+
+// out = sum over terms of sign * D_term^T u.
+void transposeTerms(const std::vector<Term>& terms, const FaceField& u, double dx, const FaceField& mask,
+                    std::vector<double>& out, std::vector<double>& tmp) {
+  out.clear();
+  for (const Term& t : terms) {
+    divergenceTranspose(t.c, u, dx, mask, tmp);
+    if (out.empty()) out.assign(tmp.size(), 0.0);
+    for (std::size_t i = 0; i < tmp.size(); ++i) out[i] += t.sign * tmp[i];
+  }
+}
+
+// Cell value averaged onto the samples of a component's lattice (the cells around an edge).
+void toLattice(const StressComponent& c, const IVec3& cells, const std::vector<double>& cell, std::vector<double>& out) {
+  const IVec3 n = latticeSize(c, cells);
+  out.resize(static_cast<std::size_t>(n.prod()));
+  if (c.diagonal()) {
+    std::copy(cell.begin(), cell.end(), out.begin());
+    return;
+  }
+  parallelForCells<3>(n, [&](const IVec3& q, std::size_t i) {
+    double sum = 0.0;
+    int count = 0;
+    for (int da = -1; da <= 0; ++da)
+      for (int db = -1; db <= 0; ++db) {
+        IVec3 k = q;
+        k[c.a] += da;
+        k[c.b] += db;
+        if (k[c.a] < 0 || k[c.b] < 0 || k[c.a] >= cells[c.a] || k[c.b] >= cells[c.b]) continue;
+        sum += cell[(static_cast<std::size_t>(k[2]) * cells[1] + k[1]) * cells[0] + k[0]];
+        ++count;
+      }
+    out[i] = count ? sum / count : 0.0;
+  });
+}
+
+}  // namespace
+
+void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velocity,
+                         const std::vector<const CoupledBody*>& bodies) {
+  Impl& m = *impl_;
+  const double correctionSeconds = stats_.correctionSeconds;
+  const int correctionIterations = stats_.correctionIterations;
+  stats_ = {};
+  stats_.correctionSeconds = correctionSeconds;
+  stats_.correctionIterations = correctionIterations;
+  const std::size_t cells = st.spec.cellCount();
+  const double dx = st.spec.dx, vc = st.spec.cellVolume();
+  const int up = settings_.upAxis;
+  const int pa = std::min((up + 1) % 3, (up + 2) % 3), pc = std::max((up + 1) % 3, (up + 2) % 3);
+  // Warm start from the last step's stress when the grid is the same, else from zero.
+  if (p_.size() != cells) p_.assign(cells, 0.0);
+  const std::array<StressComponent, 6> comps = {StressComponent::Diagonal(0),       StressComponent::Diagonal(1),
+                                                StressComponent::Diagonal(2),       StressComponent::OffDiagonal(0, 1),
+                                                StressComponent::OffDiagonal(0, 2), StressComponent::OffDiagonal(1, 2)};
+  for (std::size_t k = 0; k < 6; ++k) {
+    const std::size_t n = static_cast<std::size_t>(latticeSize(comps[k], st.spec.res).prod());
+    if (s_[k].size() != n || !settings_.friction) s_[k].assign(n, 0.0);
+  }
+  // The storage of each friction problem's variable: up, the pair (a, c), xy, yz, xz.
+  const std::array<std::size_t, 5> slot = {static_cast<std::size_t>(up), static_cast<std::size_t>(pa), 3, 5, 4};
+
+  // Face coefficients: kappa = (1 - phi_s) / rho (velocity per impulse density, eq. 5.27), the
+  // pressure weight phi kappa (eqs. 5.8, 5.47), the friction energy weight phi rho kappa^2 and its
+  // linear weight phi rho kappa (eqs. 5.16-5.19, 5.49-5.50). Faces without material have kappa = 0.
+  for (FaceField* f : {&m.kappa, &m.weightP, &m.weightS, &m.weightB, &m.force, &m.flux}) *f = FaceField(st.spec.res);
+  for (int a = 0; a < 3; ++a)
+    for (std::size_t i = 0; i < m.kappa.values[a].size(); ++i) {
+      double solid = 0.0;
+      for (const CoupledBody* b : bodies) solid += b->faceFraction.values[a][i];
+      const double rho = st.rhoFace.values[a][i], phi = st.phiFace.values[a][i];
+      const bool material = st.open.values[a][i] != 0.0 && rho > 0.0 && phi > 0.0;
+      const double k = material ? std::max(0.0, 1.0 - solid) * phi / (rho * std::max(phi, settings_.minimumFaceFraction)) : 0.0;
+      m.kappa.values[a][i] = k;
+      m.weightP.values[a][i] = phi * k;
+      m.weightS.values[a][i] = phi * rho * k * k;
+      m.weightB.values[a][i] = phi * rho * k;
+    }
+  m.velocity0 = velocity;  // v^n + dt f_ext / rho: the state without stress
+  m.cellScratch.assign(cells, 0.0);
+
+  // Bookkeeping by the total stress force density F on the faces (-grad p + div s): the grain
+  // velocity is v0 + dt kappa F and each body's V0 + dt V_c M^-1 sum_f phi_s G_f F_f (eq. 5.23).
+  // A problem removes its own variable's share of F, solves, and adds the new share back.
+  addTerms(m.pressure.terms, p_, 1.0, dx, st.open, m.force);
+  for (std::size_t k = 0; k < 3; ++k) addDivergence(comps[k], s_[k], 1.0, dx, st.open, m.force);
+  for (std::size_t k = 3; k < 6; ++k) addDivergence(comps[k], s_[k], 1.0, dx, st.open, m.force);
+  auto grainVelocity = [&] {
+    for (int a = 0; a < 3; ++a)
+      for (std::size_t i = 0; i < velocity.values[a].size(); ++i)
+        velocity.values[a][i] = m.velocity0.values[a][i] + dt * m.kappa.values[a][i] * m.force.values[a][i];
+  };
+  // Each body's faces: phi_s G_f (G_f = [e_a; r_f x e_a]).
+  m.bodyFaces.resize(bodies.size());
+  for (std::size_t k = 0; k < bodies.size(); ++k) {
+    auto& list = m.bodyFaces[k];
+    list.clear();
+    for (int a = 0; a < 3; ++a) {
+      const IVec3 n = st.open.size(a);
+      const std::vector<double>& frac = bodies[k]->faceFraction.values[a];
+      for (std::size_t i = 0; i < frac.size(); ++i) {
+        if (frac[i] <= 0.0 || st.open.values[a][i] == 0.0) continue;
+        const IVec3 f(static_cast<int>(i % n[0]), static_cast<int>(i / n[0] % n[1]), static_cast<int>(i / n[0] / n[1]));
+        Vec3 x = st.spec.origin + (f.cast<double>().array() + 0.5).matrix() * dx;
+        x[a] -= 0.5 * dx;
+        Vec6 g;
+        g.head<3>() = Vec3::Unit(a);
+        g.tail<3>() = Vec3(x - bodies[k]->centre).cross(Vec3(Vec3::Unit(a)));
+        list.push_back({a, i, frac[i] * g});
+      }
+    }
+  }
+  auto bodyImpulse = [&](std::size_t k) {
+    Vec6 j = Vec6::Zero();
+    for (const auto& bf : m.bodyFaces[k]) j += bf.g * m.force.values[bf.axis][bf.index];
+    return (dt * vc * j).eval();
+  };
+  auto bodyVelocities = [&] {
+    m.bodyVelocity.resize(bodies.size());
+    for (std::size_t k = 0; k < bodies.size(); ++k)
+      m.bodyVelocity[k] = bodies[k]->velocity + bodies[k]->inverseMass * bodyImpulse(k);
+  };
+
+  numerics::BoundQpSettings qp;
+  qp.tolerance = settings_.tolerance;
+  qp.maxIterations = settings_.maxIterations;
+  m.pressure.build(st, m.weightP, dt, bodies);
+  // Friction operators do not depend on p: built once per step.
+  if (settings_.friction)
+    for (Problem& pr : m.friction) pr.build(st, m.weightS, dt, bodies);
+
+  std::vector<double>& var = m.var;
+  for (int iteration = 0; iteration < settings_.staggeredIterations; ++iteration) {
+    if (settings_.friction) {
+      ScopedTimer t(stats_.frictionSeconds);
+      for (std::size_t k = 0; k < m.friction.size(); ++k) {
+        Problem& pr = m.friction[k];
+        const std::vector<double>& sUp = s_[static_cast<std::size_t>(up)];
+        // Remove this variable's share of F (v~|_{s_c = 0} of eq. 5.46). The pair removes both
+        // its components and puts back their trace-free part -s_up / 2 for the current s_up.
+        if (k == 1) {
+          for (int axis : {pa, pc}) {
+            std::vector<double>& s = s_[static_cast<std::size_t>(axis)];
+            for (std::size_t i = 0; i < cells; ++i) m.cellScratch[i] = -0.5 * sUp[i] - s[i];
+            addDivergence(StressComponent::Diagonal(axis), m.cellScratch, 1.0, dx, st.open, m.force);
+          }
+          var.resize(cells);
+          for (std::size_t i = 0; i < cells; ++i) var[i] = 0.5 * (s_[static_cast<std::size_t>(pa)][i] - s_[static_cast<std::size_t>(pc)][i]);
+        } else {
+          var = s_[slot[k]];
+          addTerms(pr.terms, var, -1.0, dx, st.open, m.force);
+        }
+        grainVelocity();
+        bodyVelocities();
+        // Linear term dt (D^T phi (1 - phi_s) v~ + J^T V~) (eqs. 5.19, 5.26, 5.50), negated for
+        // the solver's 1/2 x^T A x - b^T x.
+        for (int a = 0; a < 3; ++a)
+          for (std::size_t i = 0; i < velocity.values[a].size(); ++i)
+            m.flux.values[a][i] = m.weightB.values[a][i] * velocity.values[a][i];
+        transposeTerms(pr.terms, m.flux, dx, st.open, m.tmp, m.tmp2);
+        pr.b = -dt * Eigen::Map<const Eigen::VectorXd>(m.tmp.data(), static_cast<Eigen::Index>(m.tmp.size()));
+        for (std::size_t b = 0; b < bodies.size(); ++b) {
+          const BodyColumns& bc = pr.op.bodies()[b];
+          for (std::size_t j = 0; j < bc.sample.size(); ++j)
+            pr.b[static_cast<Eigen::Index>(bc.sample[j])] -= dt * bc.column[j].dot(m.bodyVelocity[b]);
+        }
+        // Bounds |s_ij| <= alpha p (eq. 5.15); the pair keeps s_a and s_c within them given s_up.
+        for (std::size_t i = 0; i < cells; ++i) m.cellScratch[i] = st.alpha[i] * p_[i];
+        toLattice(pr.terms.front().c, st.spec.res, m.cellScratch, m.smax);
+        const Eigen::Index n = static_cast<Eigen::Index>(m.smax.size());
+        pr.lo.resize(n);
+        pr.hi.resize(n);
+        pr.x.resize(n);
+        for (Eigen::Index i = 0; i < n; ++i) {
+          const double half = k == 1 ? 0.5 * std::abs(sUp[static_cast<std::size_t>(i)]) : 0.0;
+          const double bound = std::max(0.0, m.smax[static_cast<std::size_t>(i)] - half);
+          pr.lo[i] = -bound;
+          pr.hi[i] = bound;
+          pr.x[i] = var[static_cast<std::size_t>(i)];
+        }
+        stats_.frictionIterations += pr.solve(qp);
+        var.assign(pr.x.data(), pr.x.data() + pr.x.size());
+        addTerms(pr.terms, var, 1.0, dx, st.open, m.force);
+        if (k == 1) {
+          for (std::size_t i = 0; i < cells; ++i) {
+            s_[static_cast<std::size_t>(pa)][i] = -0.5 * sUp[i] + var[i];
+            s_[static_cast<std::size_t>(pc)][i] = -0.5 * sUp[i] - var[i];
+          }
+        } else {
+          s_[slot[k]] = var;
+        }
+      }
+    }
+    ScopedTimer t(stats_.pressureSeconds);
+    Problem& pr = m.pressure;
+    // Remove the pressure's share, then predict phi + phi_s without it (eqs. 5.7-5.8, 5.25):
+    // phi* = phi^n - dt div(phi v~) = phi^n + dt sum_a D_a^T (phi v~).
+    addTerms(pr.terms, p_, -1.0, dx, st.open, m.force);
+    grainVelocity();
+    bodyVelocities();
+    for (int a = 0; a < 3; ++a)
+      for (std::size_t i = 0; i < velocity.values[a].size(); ++i)
+        m.flux.values[a][i] = st.phiFace.values[a][i] * velocity.values[a][i];
+    transposeTerms(pr.terms, m.flux, dx, st.open, m.tmp, m.tmp2);  // = div(phi v~)
+    pr.b.resize(static_cast<Eigen::Index>(cells));
+    for (std::size_t i = 0; i < cells; ++i) pr.b[static_cast<Eigen::Index>(i)] = st.phi[i] - dt * m.tmp[i] - 1.0;
+    // Bodies: + phi_s^{n+1}|p=0 = phi_s^n + dt J1^T V~ (the columns carry the pressure's -1).
+    for (std::size_t b = 0; b < bodies.size(); ++b) {
+      const BodyColumns& bc = pr.op.bodies()[b];
+      for (std::size_t i = 0; i < cells; ++i) pr.b[static_cast<Eigen::Index>(i)] += bodies[b]->cellFraction[i];
+      for (std::size_t j = 0; j < bc.sample.size(); ++j)
+        pr.b[static_cast<Eigen::Index>(bc.sample[j])] -= dt * bc.column[j].dot(m.bodyVelocity[b]);
+    }
+    pr.lo = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(cells));
+    pr.hi = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(cells), std::numeric_limits<double>::infinity());
+    pr.x = Eigen::Map<const Eigen::VectorXd>(p_.data(), static_cast<Eigen::Index>(cells));
+    stats_.pressureIterations += pr.solve(qp);
+    std::copy(pr.x.data(), pr.x.data() + pr.x.size(), p_.begin());
+    addTerms(pr.terms, p_, 1.0, dx, st.open, m.force);
+  }
+  grainVelocity();
+  impulses_.resize(bodies.size());
+  for (std::size_t k = 0; k < bodies.size(); ++k) impulses_[k] = bodyImpulse(k);
+  stats_.activePressureCells = static_cast<int>(std::count_if(p_.begin(), p_.end(), [](double p) { return p > 0.0; }));
+}
+
+const FaceField& StressSolver::correctDensity(GranularGridState& st, const std::vector<const CoupledBody*>& bodies) {
+  Impl& m = *impl_;
+  ScopedTimer t(stats_.correctionSeconds);
+  const std::size_t cells = st.spec.cellCount();
+  // The pressure problem with dt = 1 and no velocity (eq. 5.14, Delta x = -grad y / rho).
+  for (FaceField* f : {&m.kappa, &m.weightP, &m.force, &m.flux}) *f = FaceField(st.spec.res);
+  for (int a = 0; a < 3; ++a)
+    for (std::size_t i = 0; i < m.kappa.values[a].size(); ++i) {
+      const double rho = st.rhoFace.values[a][i], phi = st.phiFace.values[a][i];
+      double solid = 0.0;
+      for (const CoupledBody* b : bodies) solid += b->faceFraction.values[a][i];
+      const double k = st.open.values[a][i] != 0.0 && rho > 0.0 && phi > 0.0
+                           ? std::max(0.0, 1.0 - solid) * phi / (rho * std::max(phi, settings_.minimumFaceFraction))
+                           : 0.0;
+      m.kappa.values[a][i] = k;
+      m.weightP.values[a][i] = phi * k;
+    }
+  Problem& pr = m.pressure;
+  // Bodies do not move in the correction: only the grid part, with their volume in the constraint.
+  pr.build(st, m.weightP, 1.0, {});
+  pr.b.resize(static_cast<Eigen::Index>(cells));
+  for (std::size_t i = 0; i < cells; ++i) {
+    double solid = 0.0;
+    for (const CoupledBody* b : bodies) solid += b->cellFraction[i];
+    pr.b[static_cast<Eigen::Index>(i)] = st.phi[i] + solid - 1.0;
+  }
+  displacement_ = FaceField(st.spec.res);
+  stats_.correctionIterations = 0;
+  if (!(pr.b.maxCoeff() > 0.0)) return displacement_;
+  pr.lo = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(cells));
+  pr.hi = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(cells), std::numeric_limits<double>::infinity());
+  pr.x = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(cells));
+  numerics::BoundQpSettings qp;
+  qp.tolerance = settings_.tolerance;
+  qp.maxIterations = settings_.maxIterations;
+  stats_.correctionIterations = pr.solve(qp);
+  m.var.assign(pr.x.data(), pr.x.data() + pr.x.size());
+  addTerms(pr.terms, m.var, 1.0, st.spec.dx, st.open, m.force);
+  for (int a = 0; a < 3; ++a)
+    for (std::size_t i = 0; i < m.force.values[a].size(); ++i) {
+      displacement_.values[a][i] = m.kappa.values[a][i] * m.force.values[a][i];
+      m.flux.values[a][i] = st.phiFace.values[a][i] * displacement_.values[a][i];
+    }
+  // phi <- phi - div(phi Delta x) (eq. 5.14).
+  transposeTerms(pr.terms, m.flux, st.spec.dx, st.open, m.tmp, m.tmp2);
+  for (std::size_t i = 0; i < cells; ++i) st.phi[i] -= m.tmp[i];
+  return displacement_;
+}
+
+}  // namespace msim::granular

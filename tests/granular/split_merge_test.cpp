@@ -1,0 +1,195 @@
+// Split and merge (ch. 5.4.1): validity, exact conservation and the eq. 5.43 round trip.
+#include "msim/granular/split_merge.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include <Eigen/Eigenvalues>
+
+#include "granular_test_support.hpp"
+#include "msim/granular/particle_advection.hpp"
+
+namespace msim::granular {
+namespace {
+
+constexpr double kDx = 0.1;
+const double kR = defaultParticleRadius(kDx);
+
+// Semi-axes relative to r, ascending.
+Vec3 semiAxesOverR(const Shape& s) {
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(shapeMatrix(s)).eigenvalues().cwiseSqrt() / kR;
+}
+
+void expectAllValid(const GranularParticles& p, double tolerance = 1e-4) {
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const Vec3 axes = semiAxesOverR(p.shape[i]);
+    EXPECT_GE(axes[0], (1 - tolerance) / std::sqrt(2.0)) << "particle " << i;
+    EXPECT_LE(axes[2], (1 + tolerance) * std::sqrt(2.0)) << "particle " << i;
+  }
+}
+
+void expectConserved(const test::Totals& before, const test::Totals& after, double scale) {
+  EXPECT_LE(std::abs(after.mass - before.mass) / before.mass, 1e-6);
+  EXPECT_LE((after.momentum - before.momentum).norm() / before.mass, 1e-6);  // |v| <= ~1 m/s
+  EXPECT_LE((after.centreOfMass() - before.centreOfMass()).norm() / scale, 1e-6);
+}
+
+TEST(GranularSplitMerge, ValidityIsTheSemiAxisRange) {
+  const auto diag = [](double a, double b, double c) { return Vec3(a * a, b * b, c * c).asDiagonal().toDenseMatrix(); };
+  EXPECT_TRUE(isValidShape(diag(kR, kR, kR), kR));
+  EXPECT_TRUE(isValidShape(diag(0.71 * kR, 1.41 * kR, kR), kR));
+  EXPECT_FALSE(isValidShape(diag(0.70 * kR, kR, kR), kR));
+  EXPECT_FALSE(isValidShape(diag(kR, 1.42 * kR, kR), kR));
+  EXPECT_THROW(SplitMerge(0.0), std::invalid_argument);
+  EXPECT_THROW(SplitMerge(kR, 4), std::invalid_argument);
+}
+
+TEST(GranularSplitMerge, SplitThenMergeOfTheChildrenGivesBackTheParticle) {
+  // A particle stretched to 1.6 r along a tilted axis.
+  const Eigen::Matrix3d rotation = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  const Eigen::Matrix3d a = rotation * Vec3(1.6 * 1.6, 1.1 * 1.1, 0.9 * 0.9).asDiagonal() * rotation.transpose() * kR * kR;
+  GranularParticles p;
+  p.append(Vecf<3>(0.3f, -0.2f, 0.5f), Vecf<3>(1.0f, -2.0f, 0.5f), 0.25f, toShape(a), 3);
+  const GranularParticles original = p;
+  SplitMerge splitMerge(kR);
+  const SplitMergeStats stats = splitMerge.apply(p);
+  ASSERT_EQ(stats.splits, 1u);
+  ASSERT_EQ(p.size(), 2u);
+  EXPECT_EQ(splitMerge.successors()[0].begin, 0u);
+  EXPECT_EQ(splitMerge.successors()[0].count, 2u);
+  expectAllValid(p);
+  // Children: half the mass, the same velocity and material, the long semi-axis halved.
+  for (int c = 0; c < 2; ++c) {
+    EXPECT_EQ(p.mass[c], 0.125f);
+    EXPECT_EQ(p.velocity[c], original.velocity[0]);
+    EXPECT_EQ(p.material[c], 3);
+    EXPECT_NEAR(semiAxesOverR(p.shape[c])[0], 0.8, 1e-5);
+  }
+  const MergedParticle k = mergeParticles(p.position[0].cast<double>(), p.velocity[0].cast<double>(), p.mass[0],
+                                          shapeMatrix(p.shape[0]), p.position[1].cast<double>(),
+                                          p.velocity[1].cast<double>(), p.mass[1], shapeMatrix(p.shape[1]));
+  const double shapeError = (k.shape - a).norm() / a.norm();
+  const double positionError = (k.position - original.position[0].cast<double>()).norm() / kR;
+  std::printf("split + merge round trip: shape %.2g, position %.2g (relative)\n", shapeError, positionError);
+  EXPECT_LE(shapeError, 1e-6);  // float storage of the children
+  EXPECT_LE(positionError, 1e-5);
+  EXPECT_EQ(k.mass, 0.25);
+  EXPECT_LE((k.velocity - original.velocity[0].cast<double>()).norm(), 1e-7);
+}
+
+TEST(GranularSplitMerge, IsotropicGrowthSplitsIntoEightValidChildren) {
+  GranularParticles p;
+  p.append(Vecf<3>::Zero(), Vecf<3>::Zero(), 1.0f, toShape(1.5 * 1.5 * kR * kR * Eigen::Matrix3d::Identity()), 0);
+  SplitMerge splitMerge(kR);
+  const SplitMergeStats stats = splitMerge.apply(p);
+  EXPECT_EQ(stats.children, 8u);
+  ASSERT_EQ(p.size(), 8u);
+  expectAllValid(p);
+  EXPECT_LE(test::totals(p).centreOfMass().norm(), 1e-8);
+  // With at most one level allowed the split is refused (its children would be invalid).
+  GranularParticles q;
+  q.append(Vecf<3>::Zero(), Vecf<3>::Zero(), 1.0f, toShape(1.5 * 1.5 * kR * kR * Eigen::Matrix3d::Identity()), 0);
+  EXPECT_EQ(SplitMerge(kR, 1).apply(q).splits, 0u);
+  EXPECT_EQ(q.size(), 1u);
+}
+
+TEST(GranularSplitMerge, DivergingCloudIsSplitStaysValidAndConserves) {
+  // A seeded block in v = G (x - c) with G symmetric positive definite: every ellipsoid grows.
+  const GridSpec<3> grid(Vec3::Zero(), kDx, IVec3::Constant(24));
+  const Vec3 centre = Vec3::Constant(1.2);
+  Eigen::Matrix3d g;
+  g << 0.9, 0.2, 0.0, 0.2, 0.6, 0.1, 0.0, 0.1, 0.4;
+  MacGrid<3> velocity(grid);
+  test::fillLinear(velocity, g, -g * centre);
+  GranularParticles p;
+  const std::vector<GranularMaterial> materials{{1600.0, 0.5}};
+  seedBox(p, grid, centre.array() - 0.3, centre.array() + 0.3, materials);
+  test::randomVelocities(p, 11);
+  const std::size_t initial = p.size();
+  SplitMerge splitMerge(kR);
+  SplitMergeStats total;
+  for (int step = 0; step < 40; ++step) {
+    advectParticles(p, velocity, 0.025);
+    const test::Totals before = test::totals(p);
+    const SplitMergeStats s = splitMerge.apply(p);
+    total.splits += s.splits;
+    total.children += s.children;
+    total.merges += s.merges;
+    expectConserved(before, test::totals(p), 1.0);
+    expectAllValid(p);
+    if (HasFailure()) break;
+  }
+  std::printf("diverging cloud: %zu -> %zu particles, %zu splits (%zu children), %zu merges\n", initial, p.size(),
+              total.splits, total.children, total.merges);
+  EXPECT_GT(total.splits, initial / 2);
+}
+
+TEST(GranularSplitMerge, CompressedCloudMergesValidlyAndConserves) {
+  // Uniaxial compression v = (-k (x - c), 0, 0): ellipsoids flatten along x and merge with their
+  // (now close) neighbours along x.
+  const GridSpec<3> grid(Vec3::Zero(), kDx, IVec3::Constant(24));
+  const Vec3 centre = Vec3::Constant(1.2);
+  Eigen::Matrix3d g = Eigen::Matrix3d::Zero();
+  g(0, 0) = -1.0;
+  MacGrid<3> velocity(grid);
+  test::fillLinear(velocity, g, -g * centre);
+  GranularParticles p;
+  const std::vector<GranularMaterial> materials{{1600.0, 0.5}};
+  seedBox(p, grid, centre.array() - 0.3, centre.array() + 0.3, materials);
+  test::randomVelocities(p, 12);
+  const std::size_t initial = p.size();
+  SplitMerge splitMerge(kR);
+  std::size_t merges = 0;
+  for (int step = 0; step < 30; ++step) {
+    advectParticles(p, velocity, 0.025);
+    const test::Totals before = test::totals(p);
+    const std::size_t n = p.size();
+    const SplitMergeStats s = splitMerge.apply(p);
+    merges += s.merges;
+    EXPECT_EQ(p.size(), n - s.merges + s.children - s.splits);
+    expectConserved(before, test::totals(p), 1.0);
+    // Every merged particle is valid; the successors map both members to it.
+    for (std::size_t i = 0; i < n; ++i) EXPECT_LT(splitMerge.successors()[i].begin, p.size());
+    if (HasFailure()) break;
+  }
+  std::printf("compressed cloud: %zu -> %zu particles, %zu merges\n", initial, p.size(), merges);
+  EXPECT_GT(merges, initial / 4);
+}
+
+TEST(GranularSplitMerge, OnlyParticlesOfTheSameMaterialMerge) {
+  const Eigen::Matrix3d flat = Vec3(0.5 * kR * kR, kR * kR, kR * kR).asDiagonal();
+  GranularParticles p;
+  p.append(Vecf<3>(0, 0, 0), Vecf<3>::Zero(), 1.0f, toShape(flat), 0);
+  p.append(Vecf<3>(float(kR), 0, 0), Vecf<3>::Zero(), 1.0f, toShape(flat), 1);
+  p.shape[0][0] = p.shape[1][0] = float(0.3 * kR * kR);  // too thin
+  GranularParticles q = p;
+  EXPECT_EQ(SplitMerge(kR).apply(p).merges, 0u);
+  q.material[1] = 0;
+  SplitMerge splitMerge(kR);
+  EXPECT_EQ(splitMerge.apply(q).merges, 1u);
+  ASSERT_EQ(q.size(), 1u);
+  EXPECT_EQ(splitMerge.successors()[1].begin, 0u);
+  EXPECT_NEAR(q.position[0][0], 0.5 * kR, 1e-8);
+  EXPECT_EQ(q.mass[0], 2.0f);
+  expectAllValid(q);
+}
+
+TEST(GranularSplitMerge, DeterministicAcrossRuns) {
+  const GridSpec<3> grid(Vec3::Zero(), kDx, IVec3::Constant(12));
+  const std::vector<GranularMaterial> materials{{1600.0, 0.5}};
+  GranularParticles a;
+  seedBox(a, grid, Vec3::Constant(0.3), Vec3::Constant(0.9), materials);
+  Rng rng(4);
+  for (Shape& s : a.shape) s[0] *= float(rng.uniform(0.2, 3.0));  // some too thin, some too long
+  GranularParticles b = a;
+  SplitMerge first(kR), second(kR);
+  first.apply(a);
+  second.apply(b);
+  EXPECT_EQ(a.position, b.position);
+  EXPECT_EQ(a.shape, b.shape);
+}
+
+}  // namespace
+}  // namespace msim::granular
