@@ -227,6 +227,17 @@ void toLattice(const StressComponent& c, const IVec3& cells, const std::vector<d
   });
 }
 
+// Slip walls: the edges on a domain wall normal to a slip axis carry the wall's tangential friction
+// (the off-diagonal components there act only on the faces beside the wall); their bound is 0.
+void removeWallFriction(const StressComponent& c, const IVec3& cells, unsigned slipWalls, std::vector<double>& smax) {
+  if (c.diagonal()) return;
+  const IVec3 n = latticeSize(c, cells);
+  parallelForCells<3>(n, [&](const IVec3& q, std::size_t i) {
+    for (int w : {c.a, c.b})
+      if ((slipWalls >> w & 1u) != 0 && (q[w] == 0 || q[w] == cells[w])) smax[i] = 0.0;
+  });
+}
+
 }  // namespace
 
 void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velocity,
@@ -360,6 +371,7 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
         // Bounds |s_ij| <= alpha p (eq. 5.15); the pair keeps s_a and s_c within them given s_up.
         for (std::size_t i = 0; i < cells; ++i) m.cellScratch[i] = st.alpha[i] * p_[i];
         toLattice(pr.terms.front().c, st.spec.res, m.cellScratch, m.smax);
+        if (settings_.slipWalls != 0) removeWallFriction(pr.terms.front().c, st.spec.res, settings_.slipWalls, m.smax);
         const Eigen::Index n = static_cast<Eigen::Index>(m.smax.size());
         pr.lo.resize(n);
         pr.hi.resize(n);

@@ -48,6 +48,9 @@ struct StressSolverSettings {
   // and the few grains that reach a free surface's faces would be shot off it by the pressure
   // holding the cells below. 0 gives eq. 5.5 unchanged.
   double minimumFaceFraction = 0.25;
+  // Bit w set: the domain walls normal to axis w have no friction (the material slides along
+  // them freely), e.g. the side walls of a quasi-2D slab. Walls are frictional by default.
+  unsigned slipWalls = 0;
 };
 
 // Time spent and work done in the last step (for the performance split of Table 5.1).

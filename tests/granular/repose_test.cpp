@@ -1,0 +1,85 @@
+// Slope stability of the linearised friction model against the angle it predicts (docs/granular.md,
+// "Angle of repose"): with the bounds |s_ij| <= alpha p of eq. 5.15 on grid axes, an infinite
+// slope dipping along a grid axis can stand up to tan(theta) = alpha / (1 - alpha). A quasi-2D
+// wedge of sand (slip side walls) is built at the predicted angle minus 5 degrees, where it must
+// stand, and plus 5 degrees, where it must flow and end flatter.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+#include "msim/granular/granular_simulation.hpp"
+
+using namespace msim;
+using namespace msim::granular;
+
+namespace {
+
+constexpr double kDx = 0.025, kWidth = 0.1;
+
+double predictedRepose(double alpha) { return std::atan(alpha / (1.0 - alpha)) * 180.0 / std::numbers::pi; }
+
+// A block kWidth wide against the left wall, then a slope at `degrees` down to the floor; runs one
+// second and returns the final slope angle (a line fitted to the surface heights between 20% and
+// 80% of the top, z-averaged).
+double slopeAfterOneSecond(double alpha, double degrees, double height) {
+  GranularSettings s;
+  s.grid = GridSpec<3>(Vec3::Zero(), kDx, IVec3(48, 20, 4));
+  s.stress.tolerance = 1e-3;
+  s.stress.slipWalls = 1u << 2;  // quasi-2D: the z walls hold nothing
+  GranularSimulation sim(s, {GranularMaterial{1600.0, alpha}});
+  const double t = std::tan(degrees * std::numbers::pi / 180.0);
+  sim.seed(Vec3::Zero(), Vec3(1.2, height, 0.1),
+           [&](const Vec3& x) { return x.x() < kWidth || x.y() < height - (x.x() - kWidth) * t; }, {});
+  while (sim.time() < 1.0) sim.step(sim.stableTimestep(1.0 / 60.0));
+  sim.step(1e-5);  // the grid fields of the final state
+  const GranularGridState& st = sim.gridState();
+  const IVec3 r = s.grid.res;
+  auto phi = [&](int i, int j) {
+    double sum = 0.0;
+    for (int k = 0; k < r[2]; ++k) sum += st.phi[(static_cast<std::size_t>(k) * r[1] + j) * r[0] + i];
+    return sum / r[2];
+  };
+  std::vector<double> h(static_cast<std::size_t>(r[0]), 0.0);
+  double top = 0.0;
+  for (int i = 0; i < r[0]; ++i) {
+    for (int j = r[1] - 1; j >= 0; --j)
+      if (phi(i, j) >= 0.5) {  // the half-full level, interpolated towards the cell above
+        const double above = j + 1 < r[1] ? phi(i, j + 1) : 0.0;
+        h[static_cast<std::size_t>(i)] = (j + 0.5 + (phi(i, j) - 0.5) / std::max(phi(i, j) - above, 1e-9)) * kDx;
+        break;
+      }
+    top = std::max(top, h[static_cast<std::size_t>(i)]);
+  }
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  int n = 0;
+  for (int i = 0; i < r[0]; ++i) {
+    const double x = (i + 0.5) * kDx, y = h[static_cast<std::size_t>(i)];
+    if (y <= 0.2 * top || y >= 0.8 * top) continue;
+    sx += x;
+    sy += y;
+    sxx += x * x;
+    sxy += x * y;
+    ++n;
+  }
+  const double slope = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+  return std::atan(-slope) * 180.0 / std::numbers::pi;
+}
+
+}  // namespace
+
+TEST(GranularRepose, SlopesStandBelowThePredictedAngleAndFlowAbove) {
+  for (const double alpha : {0.3, 0.5}) {
+    const double predicted = predictedRepose(alpha);
+    const double below = predicted - 5.0, above = predicted + 5.0;
+    const double height = alpha < 0.4 ? 0.3 : 0.4;  // the toe of the gentler slope stays off the far wall
+    const double stands = slopeAfterOneSecond(alpha, below, height);
+    const double flows = slopeAfterOneSecond(alpha, above, height);
+    std::printf("alpha %.1f: predicted %.1f deg; built at %.1f -> %.1f, at %.1f -> %.1f\n", alpha, predicted, below, stands,
+                above, flows);
+    EXPECT_NEAR(stands, below, 1.5) << "alpha " << alpha << ": a slope at " << below << " deg did not stand";
+    EXPECT_LT(flows, above - 3.0) << "alpha " << alpha << ": a slope at " << above << " deg did not flow";
+    EXPECT_GT(flows, predicted - 15.0) << "alpha " << alpha << ": collapsed far below the predicted angle";
+  }
+}
