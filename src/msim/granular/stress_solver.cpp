@@ -85,16 +85,22 @@ class CoupledOperator final : public numerics::QpOperator {
 struct Problem {
   std::vector<Term> terms;
   IVec3 lattice = IVec3::Zero();
+  std::array<std::vector<double>, 3> lower, part;  // the whole lattice's stencil
+  std::vector<double> diagonal, partDiagonal;
+  std::vector<BodyColumns> bodies;  // J of each body, in whole-lattice sample indices
+  Eigen::VectorXd b, lo, hi, x;     // whole lattice
+  // The solve runs on a box of the lattice (see solve()).
   CoupledOperator op;
   numerics::GridMic0FacePreconditioner<3> mic{IVec3::Ones(), {std::vector<double>(1, 0.0), {0.0}, {0.0}}, {1.0}};
   numerics::BoundQpSolver solver;
-  std::array<std::vector<double>, 3> lower, part;
-  std::vector<double> diagonal, partDiagonal, scratch;
-  Eigen::VectorXd b, lo, hi, x;
+  std::array<std::vector<double>, 3> boxLower;
+  std::vector<double> boxDiagonal;
+  std::vector<std::size_t> boxToLattice;
+  Eigen::VectorXd boxB, boxLo, boxHi, boxX;
 
-  // Builds dt^2 (sum_terms D^T W D + V_c J^T M^-1 J) for face weights W.
+  // Builds dt^2 (sum_terms D^T W D) for face weights W, and the bodies' columns.
   void build(const GranularGridState& st, const FaceField& weight, double dt,
-             const std::vector<const CoupledBody*>& bodies) {
+             const std::vector<const CoupledBody*>& coupled) {
     lattice = latticeSize(terms.front().c, st.spec.res);
     const std::size_t n = static_cast<std::size_t>(lattice.prod());
     for (auto& l : lower) l.assign(n, 0.0);
@@ -111,11 +117,9 @@ struct Problem {
     // Samples no material reaches decouple; any positive diagonal keeps the operator definite
     // and their bounds (or right-hand sides) hold them at 0.
     for (double& d : diagonal) d = d > 0.0 ? d * dt2 : 1.0;
-    op.grid().assign(lattice, lower, diagonal);
-    mic.assign(lattice, lower, diagonal);
     op.setBodyWeight(dt2 * st.spec.cellVolume());
-    op.bodies().resize(bodies.size());
-    for (std::size_t k = 0; k < bodies.size(); ++k) bodyColumns(st, *bodies[k], op.bodies()[k]);
+    bodies.resize(coupled.size());
+    for (std::size_t k = 0; k < coupled.size(); ++k) bodyColumns(st, *coupled[k], bodies[k]);
   }
 
   void bodyColumns(const GranularGridState& st, const CoupledBody& body, BodyColumns& out) const {
@@ -144,8 +148,68 @@ struct Problem {
     }
   }
 
+  // Solves on the bounding box of the samples whose bounds leave room (lo < hi): the others are
+  // fixed at their bound, which is 0 for the friction (no pressure, no friction) - the friction
+  // lives only where the material is packed, often a small part of the grid. Samples outside the
+  // box count as Dirichlet neighbours at 0 (the stencil keeps their links in the diagonal).
   int solve(const numerics::BoundQpSettings& settings) {
-    const auto r = solver.solve(op, b, lo, hi, x, settings, &mic);
+    IVec3 first = lattice, last = IVec3::Constant(-1);
+    for (int k = 0; k < lattice[2]; ++k)
+      for (int j = 0; j < lattice[1]; ++j)
+        for (int i = 0; i < lattice[0]; ++i) {
+          const Eigen::Index q = (static_cast<Eigen::Index>(k) * lattice[1] + j) * lattice[0] + i;
+          if (!(lo[q] < hi[q])) continue;
+          first = first.cwiseMin(IVec3(i, j, k));
+          last = last.cwiseMax(IVec3(i, j, k));
+        }
+    if ((last.array() < 0).any()) {
+      x = x.cwiseMax(lo).cwiseMin(hi);
+      return 0;
+    }
+    const IVec3 box = last - first + IVec3::Ones();
+    const std::size_t m = static_cast<std::size_t>(box.prod());
+    for (auto& l : boxLower) l.resize(m);
+    boxDiagonal.resize(m);
+    boxToLattice.resize(m);
+    boxB.resize(static_cast<Eigen::Index>(m));
+    boxLo.resize(static_cast<Eigen::Index>(m));
+    boxHi.resize(static_cast<Eigen::Index>(m));
+    boxX.resize(static_cast<Eigen::Index>(m));
+    std::size_t k = 0;
+    for (int z = first[2]; z <= last[2]; ++z)
+      for (int y = first[1]; y <= last[1]; ++y)
+        for (int xx = first[0]; xx <= last[0]; ++xx, ++k) {
+          const std::size_t q = (static_cast<std::size_t>(z) * lattice[1] + y) * lattice[0] + xx;
+          boxToLattice[k] = q;
+          for (int a = 0; a < 3; ++a) boxLower[a][k] = lower[a][q];
+          boxDiagonal[k] = diagonal[q];
+          const Eigen::Index e = static_cast<Eigen::Index>(k), f = static_cast<Eigen::Index>(q);
+          boxB[e] = b[f];
+          boxLo[e] = lo[f];
+          boxHi[e] = hi[f];
+          boxX[e] = x[f];
+        }
+    op.grid().assign(box, boxLower, boxDiagonal);
+    mic.assign(box, boxLower, boxDiagonal);
+    op.bodies().resize(bodies.size());
+    for (std::size_t body = 0; body < bodies.size(); ++body) {
+      BodyColumns& boxed = op.bodies()[body];
+      boxed.inverseMass = bodies[body].inverseMass;
+      boxed.sample.clear();
+      boxed.column.clear();
+      for (std::size_t j = 0; j < bodies[body].sample.size(); ++j) {
+        const std::size_t q = bodies[body].sample[j];
+        const int qx = static_cast<int>(q % lattice[0]), qy = static_cast<int>(q / lattice[0] % lattice[1]),
+                  qz = static_cast<int>(q / lattice[0] / lattice[1]);
+        const IVec3 c = IVec3(qx, qy, qz) - first;
+        if ((c.array() < 0).any() || (c.array() >= box.array()).any()) continue;
+        boxed.sample.push_back((static_cast<std::size_t>(c[2]) * box[1] + c[1]) * box[0] + c[0]);
+        boxed.column.push_back(bodies[body].column[j]);
+      }
+    }
+    const auto r = solver.solve(op, boxB, boxLo, boxHi, boxX, settings, &mic);
+    x = x.cwiseMax(lo).cwiseMin(hi);
+    for (std::size_t j = 0; j < m; ++j) x[static_cast<Eigen::Index>(boxToLattice[j])] = boxX[static_cast<Eigen::Index>(j)];
     return r.iterations;
   }
 };
@@ -364,7 +428,7 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
         transposeTerms(pr.terms, m.flux, dx, st.open, m.tmp, m.tmp2);
         pr.b = -dt * Eigen::Map<const Eigen::VectorXd>(m.tmp.data(), static_cast<Eigen::Index>(m.tmp.size()));
         for (std::size_t b = 0; b < bodies.size(); ++b) {
-          const BodyColumns& bc = pr.op.bodies()[b];
+          const BodyColumns& bc = pr.bodies[b];
           for (std::size_t j = 0; j < bc.sample.size(); ++j)
             pr.b[static_cast<Eigen::Index>(bc.sample[j])] -= dt * bc.column[j].dot(m.bodyVelocity[b]);
         }
@@ -411,7 +475,7 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
     for (std::size_t i = 0; i < cells; ++i) pr.b[static_cast<Eigen::Index>(i)] = st.phi[i] - dt * m.tmp[i] - 1.0;
     // Bodies: + phi_s^{n+1}|p=0 = phi_s^n + dt J1^T V~ (the columns carry the pressure's -1).
     for (std::size_t b = 0; b < bodies.size(); ++b) {
-      const BodyColumns& bc = pr.op.bodies()[b];
+      const BodyColumns& bc = pr.bodies[b];
       for (std::size_t i = 0; i < cells; ++i) pr.b[static_cast<Eigen::Index>(i)] += bodies[b]->cellFraction[i];
       for (std::size_t j = 0; j < bc.sample.size(); ++j)
         pr.b[static_cast<Eigen::Index>(bc.sample[j])] -= dt * bc.column[j].dot(m.bodyVelocity[b]);
