@@ -76,5 +76,18 @@ TEST(Shape, DistanceFieldSamplesCellCentres) {
   EXPECT_FLOAT_EQ(field(IVec2(3, 1)), static_cast<float>(std::hypot(1.75, 0.75) - 1.0));
 }
 
+TEST(Cylinder, SideCapAndRimDistances) {
+  // Axis along y from (0,0,0) to (0,2,0), radius 1: side, cap and rim (edge) regions, inside.
+  const Cylinder<3> c(Vec<3>(0, 0, 0), Vec<3>(0, 2, 0), 1.0);
+  EXPECT_NEAR(c.distance(Vec<3>(3, 1, 0)), 2.0, 1e-12);                  // beside the side
+  EXPECT_NEAR(c.distance(Vec<3>(0.5, 3.5, 0)), 1.5, 1e-12);              // above the cap
+  EXPECT_NEAR(c.distance(Vec<3>(4, -4, 0)), std::hypot(3.0, 4.0), 1e-12);  // past the rim
+  EXPECT_NEAR(c.distance(Vec<3>(0, 1, 0.5)), -0.5, 1e-12);               // nearer the side than the caps
+  EXPECT_NEAR(c.distance(Vec<3>(0, 0.2, 0)), -0.2, 1e-12);               // nearer the bottom cap
+  const auto b = c.bounds();
+  EXPECT_NEAR(b.min.x(), -1.0, 1e-12);
+  EXPECT_NEAR(b.max.y(), 2.0, 1e-12);
+}
+
 }  // namespace
 }  // namespace msim::geometry

@@ -1,6 +1,6 @@
 #pragma once
 // Shapes with closed-form exact signed distances, in 2D (circle, rectangle, stadium, half-plane)
-// and 3D (sphere, box, capsule, half-space).
+// and 3D (sphere, box, capsule, capped cylinder, half-space).
 #include <algorithm>
 #include <cmath>
 
@@ -61,6 +61,35 @@ class Capsule final : public Shape<D> {
   Vec<D> a_;
   Vec<D> b_;
   double radius_;
+};
+
+// Capped cylinder of `radius` around the segment a-b (flat ends at a and b; a rectangle in 2D).
+// Exact: the distance to the flat caps and to the side combine like a 2D box in (axial, radial).
+template <int D>
+class Cylinder final : public Shape<D> {
+ public:
+  // a != b (callers validate).
+  Cylinder(const Vec<D>& a, const Vec<D>& b, double radius)
+      : a_(a), axis_((b - a).normalized()), halfLength_(0.5 * (b - a).norm()), radius_(radius) {}
+  double distance(const Vec<D>& x) const override {
+    const Vec<D> d = x - a_;
+    const double t = d.dot(axis_);
+    const double radial = (d - t * axis_).norm() - radius_;
+    const double axial = std::abs(t - halfLength_) - halfLength_;
+    const double outside = std::hypot(std::max(radial, 0.0), std::max(axial, 0.0));
+    return outside + std::min(std::max(radial, axial), 0.0);
+  }
+  Bounds<D> bounds() const override {
+    // Per axis the disc of an end cap reaches radius * sqrt(1 - axis_k^2) from its centre.
+    const Vec<D> b = a_ + 2.0 * halfLength_ * axis_;
+    Vec<D> r;
+    for (int k = 0; k < D; ++k) r[k] = radius_ * std::sqrt(std::max(0.0, 1.0 - axis_[k] * axis_[k]));
+    return {a_.cwiseMin(b) - r, a_.cwiseMax(b) + r};
+  }
+
+ private:
+  Vec<D> a_, axis_;
+  double halfLength_, radius_;
 };
 
 // Half-space behind the plane through `point`: the solid is on the side opposite `normal`.

@@ -63,6 +63,11 @@ std::unique_ptr<Shape<D>> buildShape(const nlohmann::json& shape, const std::fil
   if (type == "capsule")
     return std::make_unique<Capsule<D>>(readVector<D>(shape, "a", context), readVector<D>(shape, "b", context),
                                         shape.at("radius").get<double>());
+  if (type == "cylinder") {
+    const Vec<D> a = readVector<D>(shape, "a", context), b = readVector<D>(shape, "b", context);
+    if (!((b - a).norm() > 0.0)) fail(context, "cylinder ends 'a' and 'b' must differ");
+    return std::make_unique<Cylinder<D>>(a, b, shape.at("radius").get<double>());
+  }
   if (type == "plane") {
     const Vec<D> normal = readVector<D>(shape, "normal", context);
     if (normal.norm() == 0.0) fail(context, "plane 'normal' must not be zero");

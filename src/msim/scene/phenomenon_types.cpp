@@ -1,12 +1,14 @@
 #include "msim/scene/crowd_phenomenon.hpp"
 #include "msim/scene/gas_phenomenon.hpp"
+#include "msim/scene/granular_phenomenon.hpp"
 #include "msim/scene/phenomenon.hpp"
 #include "msim/scene/smoke_phenomenon.hpp"
 
 namespace msim::scene {
 
 const std::vector<PhenomenonType>& phenomenonTypes() {
-  static const std::vector<PhenomenonType> types = {gasPhenomenonType(), smokePhenomenonType(), crowdPhenomenonType()};
+  static const std::vector<PhenomenonType> types = {gasPhenomenonType(), smokePhenomenonType(), crowdPhenomenonType(),
+                                                    granularPhenomenonType()};
   return types;
 }
 
