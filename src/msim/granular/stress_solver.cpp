@@ -152,7 +152,9 @@ struct Problem {
   // fixed at their bound, which is 0 for the friction (no pressure, no friction) - the friction
   // lives only where the material is packed, often a small part of the grid. Samples outside the
   // box count as Dirichlet neighbours at 0 (the stencil keeps their links in the diagonal).
-  int solve(const numerics::BoundQpSettings& settings) {
+  // absoluteFloor: a projected-gradient norm per sqrt(sample) below which the solve stops even
+  // if the relative tolerance is not met (0: relative only).
+  int solve(numerics::BoundQpSettings settings, double absoluteFloor = 0.0) {
     IVec3 first = lattice, last = IVec3::Constant(-1);
     for (int k = 0; k < lattice[2]; ++k)
       for (int j = 0; j < lattice[1]; ++j)
@@ -207,6 +209,9 @@ struct Problem {
         boxed.column.push_back(bodies[body].column[j]);
       }
     }
+    const double bNorm = boxB.norm();
+    if (absoluteFloor > 0.0 && bNorm > 0.0)
+      settings.tolerance = std::max(settings.tolerance, absoluteFloor * std::sqrt(static_cast<double>(m)) / bNorm);
     const auto r = solver.solve(op, boxB, boxLo, boxHi, boxX, settings, &mic);
     x = x.cwiseMax(lo).cwiseMin(hi);
     for (std::size_t j = 0; j < m; ++j) x[static_cast<Eigen::Index>(boxToLattice[j])] = boxX[static_cast<Eigen::Index>(j)];
@@ -447,7 +452,10 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
           pr.hi[i] = bound;
           pr.x[i] = var[static_cast<std::size_t>(i)];
         }
-        stats_.frictionIterations += pr.solve(qp);
+        // A friction gradient of dt / dx * delta_v per sample is a velocity error of about
+        // delta_v: below velocityTolerance the solve has nothing left worth removing (at rest the
+        // relative tolerance would chase particle noise to ever smaller absolute levels).
+        stats_.frictionIterations += pr.solve(qp, dt / dx * settings_.velocityTolerance);
         var.assign(pr.x.data(), pr.x.data() + pr.x.size());
         addTerms(pr.terms, var, 1.0, dx, st.open, m.force);
         if (k == 1) {

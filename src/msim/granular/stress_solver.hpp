@@ -42,6 +42,7 @@ struct StressSolverSettings {
   bool friction = true;
   int upAxis = 1;               // its diagonal component is solved first (ch. 5.5.1 order)
   double tolerance = 1e-5;      // MPRGP relative projected-gradient tolerance
+  double velocityTolerance = 3e-4;  // [m/s] friction solves stop once their velocity error is below
   int maxIterations = 400;      // per QP solve
   // Faces filled below this fraction respond to stress like a face filled this much: the
   // velocity change dt F / rho of eq. 5.5 grows without bound as a face's density goes to zero,
