@@ -1,13 +1,14 @@
 #pragma once
 // The inner loops of pairwise collision resolution (collision_resolution.cpp), on the cell-ordered
-// structure-of-arrays copy of the agents: Jacobi pushes and Gauss-Seidel pair projections, scalar
-// and AVX2 (eight neighbours at a time), and the hashed direction that separates coincident
-// agents. Internal to the resolver; kept apart so that file holds the algorithm, this one the
+// structure-of-arrays copy of the agents: Jacobi pushes (scalar and AVX2, eight neighbours at a
+// time), the candidate search that lists Gauss-Seidel pairs, the Gauss-Seidel pair projections,
+// and the hashed direction that separates coincident agents. Internal to the resolver; kept apart so that file holds the algorithm, this one the
 // arithmetic.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #if defined(__AVX2__)
 #include <immintrin.h>
@@ -97,140 +98,6 @@ inline void pushAvx(const float* xs, const float* ys, const float* rad, const fl
   }
 }
 
-// Gauss-Seidel pair projections of agent i (at xi, yi, radius ri, yield yi_) against the slots
-// [lo, hi), all after i in the processing order: each pair closer than target = s (r_i + r_j) is
-// pushed apart to target, i taking si = yield_j (0 if i is scripted) of the correction and j
-// taking sj = yield_i (2 - 2 yield_j) (0 if j is scripted): equal and opposite for two movable
-// agents. j is updated in place (masked loads and stores: no slot outside the range is touched);
-// i's share is summed into ax, ay, and the lengths moved into path (j) and pathI. Returns the
-// lanes of coincident pairs of the last batch via `close` (handled by the caller, rare).
-inline bool projectAvx(float* xs, float* ys, const float* rad, const float* yield, float* path, std::uint32_t lo,
-                       std::uint32_t hi, float xi, float yi, float ri, float yieldI, bool movableI, float s,
-                       __m256& ax, __m256& ay, __m256& pathI, int& close) {
-  const __m256 xv = _mm256_set1_ps(xi), yv = _mm256_set1_ps(yi), rv = _mm256_set1_ps(ri), sv = _mm256_set1_ps(s);
-  const __m256 eps = _mm256_set1_ps(1e-14f), one = _mm256_set1_ps(1.0f), two = _mm256_set1_ps(2.0f);
-  const __m256 movI = movableI ? _mm256_castsi256_ps(_mm256_set1_epi32(-1)) : _mm256_setzero_ps();
-  const __m256 yI = _mm256_set1_ps(yieldI);
-  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-  bool changed = false;
-  for (std::uint32_t j = lo; j < hi; j += 8) {
-    const __m256i valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(static_cast<int>(hi - j)), lane);
-    const __m256 xj = _mm256_maskload_ps(xs + j, valid), yj = _mm256_maskload_ps(ys + j, valid);
-    const __m256 ex = _mm256_sub_ps(xv, xj), ey = _mm256_sub_ps(yv, yj);
-    const __m256 d2 = _mm256_add_ps(_mm256_mul_ps(ex, ex), _mm256_mul_ps(ey, ey));
-    const __m256 target = _mm256_mul_ps(sv, _mm256_add_ps(rv, _mm256_maskload_ps(rad + j, valid)));
-    const __m256 t2 = _mm256_mul_ps(target, target);
-    const __m256 in = _mm256_and_ps(_mm256_castsi256_ps(valid), _mm256_cmp_ps(d2, t2, _CMP_LT_OQ));
-    if (_mm256_testz_ps(in, in)) continue;
-    const __m256 apart = _mm256_cmp_ps(d2, _mm256_mul_ps(eps, t2), _CMP_GT_OQ);
-    close += __builtin_popcount(static_cast<unsigned>(_mm256_movemask_ps(_mm256_andnot_ps(apart, in))));
-    const __m256 est = _mm256_rsqrt_ps(d2);
-    const __m256 inv = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(0.5f), est),
-                                     _mm256_sub_ps(_mm256_set1_ps(3.0f), _mm256_mul_ps(_mm256_mul_ps(d2, est), est)));
-    const __m256 m = _mm256_and_ps(in, apart);
-    // The whole correction along e: (target / dist - 1) e, of length target - dist.
-    const __m256 f = _mm256_and_ps(m, _mm256_sub_ps(_mm256_mul_ps(target, inv), one));
-    const __m256 yJ = _mm256_maskload_ps(yield + j, valid);
-    const __m256 si = _mm256_and_ps(movI, yJ);
-    const __m256 sj = _mm256_mul_ps(yI, _mm256_sub_ps(two, _mm256_mul_ps(two, yJ)));
-    const __m256 cx = _mm256_mul_ps(f, ex), cy = _mm256_mul_ps(f, ey);
-    const __m256 len = _mm256_sub_ps(target, _mm256_mul_ps(d2, inv));  // target - dist
-    ax = _mm256_add_ps(ax, _mm256_mul_ps(si, cx));
-    ay = _mm256_add_ps(ay, _mm256_mul_ps(si, cy));
-    pathI = _mm256_add_ps(pathI, _mm256_and_ps(m, _mm256_mul_ps(si, len)));
-    const __m256 moveJ = _mm256_and_ps(m, _mm256_cmp_ps(sj, _mm256_setzero_ps(), _CMP_GT_OQ));
-    changed |= (movableI && !_mm256_testz_ps(m, m)) || !_mm256_testz_ps(moveJ, moveJ);
-    _mm256_maskstore_ps(xs + j, valid, _mm256_sub_ps(xj, _mm256_mul_ps(sj, cx)));
-    _mm256_maskstore_ps(ys + j, valid, _mm256_sub_ps(yj, _mm256_mul_ps(sj, cy)));
-    const __m256 pj = _mm256_maskload_ps(path + j, valid);
-    _mm256_maskstore_ps(path + j, valid, _mm256_add_ps(pj, _mm256_and_ps(m, _mm256_mul_ps(sj, len))));
-  }
-  return changed;
-}
-
-// Broadcast of lane `l` of v.
-inline __m256 lane(__m256 v, int l) { return _mm256_permutevar8x32_ps(v, _mm256_set1_epi32(l)); }
-// Sum of the lanes of v in every lane.
-inline __m256 hsumAll(__m256 v) {
-  v = _mm256_add_ps(v, _mm256_permute2f128_ps(v, v, 1));
-  v = _mm256_add_ps(v, _mm256_permute_ps(v, 0b01001110));
-  return _mm256_add_ps(v, _mm256_permute_ps(v, 0b10110001));
-}
-
-// One block of up to 8 candidate slots held in registers (positions, radii, yields, the lengths
-// moved), loaded once per cell and stored back once.
-struct Block {
-  __m256i valid;
-  __m256 x, y, r, w, path;
-  std::uint32_t lo;
-  void load(const float* xs, const float* ys, const float* rad, const float* yield, const float* p, std::uint32_t from,
-            std::uint32_t count) {
-    lo = from;
-    valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(static_cast<int>(count)), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
-    x = _mm256_maskload_ps(xs + from, valid);
-    y = _mm256_maskload_ps(ys + from, valid);
-    r = _mm256_maskload_ps(rad + from, valid);
-    w = _mm256_maskload_ps(yield + from, valid);
-    path = _mm256_maskload_ps(p + from, valid);
-  }
-  void store(float* xs, float* ys, float* p) const {
-    _mm256_maskstore_ps(xs + lo, valid, x);
-    _mm256_maskstore_ps(ys + lo, valid, y);
-    _mm256_maskstore_ps(p + lo, valid, path);
-  }
-};
-
-// projectAvx with the candidates in registers: agent i (broadcast in xv, yv, rv, yieldI; movI
-// all ones when it may move) against the lanes `use` of block b. Returns whether anything moved;
-// coincident pairs (rare) are done with their hashed directions through a scalar patch.
-inline bool projectBlock(Block& b, __m256 use, __m256 xv, __m256 yv, __m256 rv, __m256 yI, __m256 movI, __m256 sv,
-                         std::uint32_t i, const std::uint32_t* agent, __m256& ax, __m256& ay, __m256& pathI) {
-  const __m256 one = _mm256_set1_ps(1.0f), two = _mm256_set1_ps(2.0f);
-  const __m256 ex = _mm256_sub_ps(xv, b.x), ey = _mm256_sub_ps(yv, b.y);
-  const __m256 d2 = _mm256_add_ps(_mm256_mul_ps(ex, ex), _mm256_mul_ps(ey, ey));
-  const __m256 target = _mm256_mul_ps(sv, _mm256_add_ps(rv, b.r));
-  const __m256 t2 = _mm256_mul_ps(target, target);
-  const __m256 in = _mm256_and_ps(use, _mm256_cmp_ps(d2, t2, _CMP_LT_OQ));
-  if (_mm256_testz_ps(in, in)) return false;
-  const __m256 apart = _mm256_cmp_ps(d2, _mm256_mul_ps(_mm256_set1_ps(1e-14f), t2), _CMP_GT_OQ);
-  const __m256 est = _mm256_rsqrt_ps(d2);
-  const __m256 inv = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(0.5f), est),
-                                   _mm256_sub_ps(_mm256_set1_ps(3.0f), _mm256_mul_ps(_mm256_mul_ps(d2, est), est)));
-  const __m256 m = _mm256_and_ps(in, apart);
-  const __m256 f = _mm256_and_ps(m, _mm256_sub_ps(_mm256_mul_ps(target, inv), one));
-  __m256 cx = _mm256_mul_ps(f, ex), cy = _mm256_mul_ps(f, ey);
-  __m256 len = _mm256_and_ps(m, _mm256_sub_ps(target, _mm256_mul_ps(d2, inv)));
-  const int coincident = _mm256_movemask_ps(_mm256_andnot_ps(apart, in));
-  if (coincident != 0) {
-    alignas(32) float lx[8], ly[8], ll[8], lt[8], ld[8];
-    _mm256_store_ps(lx, cx);
-    _mm256_store_ps(ly, cy);
-    _mm256_store_ps(ll, len);
-    _mm256_store_ps(lt, target);
-    _mm256_store_ps(ld, d2);
-    for (int l = 0; l < 8; ++l)
-      if (coincident >> l & 1) {
-        const Vec2f dir = coincidentDirection(agent[i], agent[b.lo + l]);
-        ll[l] = lt[l] - std::sqrt(ld[l]);
-        lx[l] = ll[l] * dir.x();
-        ly[l] = ll[l] * dir.y();
-      }
-    cx = _mm256_load_ps(lx);
-    cy = _mm256_load_ps(ly);
-    len = _mm256_load_ps(ll);
-  }
-  const __m256 si = _mm256_and_ps(movI, b.w);
-  const __m256 sj = _mm256_mul_ps(yI, _mm256_sub_ps(two, _mm256_mul_ps(two, b.w)));
-  ax = _mm256_add_ps(ax, _mm256_mul_ps(si, cx));
-  ay = _mm256_add_ps(ay, _mm256_mul_ps(si, cy));
-  pathI = _mm256_add_ps(pathI, _mm256_mul_ps(si, len));
-  b.x = _mm256_sub_ps(b.x, _mm256_mul_ps(sj, cx));
-  b.y = _mm256_sub_ps(b.y, _mm256_mul_ps(sj, cy));
-  b.path = _mm256_add_ps(b.path, _mm256_mul_ps(sj, len));
-  const __m256 movesJ = _mm256_and_ps(in, _mm256_cmp_ps(sj, _mm256_setzero_ps(), _CMP_GT_OQ));
-  return !_mm256_testz_ps(_mm256_and_ps(in, movI), _mm256_and_ps(in, movI)) || !_mm256_testz_ps(movesJ, movesJ);
-}
-
 inline float sum8(__m256 v) {
   alignas(32) float l[8];
   _mm256_store_ps(l, v);
@@ -238,42 +105,125 @@ inline float sum8(__m256 v) {
 }
 #endif
 
-// Scalar projectAvx (no AVX2), and the coincident pairs of the AVX2 path (`coincidentOnly`).
-inline bool projectScalar(float* xs, float* ys, const float* rad, const float* yield, float* path,
-                          const std::uint32_t* agent, std::uint32_t lo, std::uint32_t hi, std::uint32_t i, float xi,
-                          float yi, float ri, float yieldI, bool movableI, float s, bool coincidentOnly, float& dx,
-                          float& dy, float& pathI) {
-  bool changed = false;
+// Appends to `out` the slots j in [lo, hi) closer to (xi, yi) than sqrt(cut2): the candidate pairs
+// of a Gauss-Seidel list. AVX2: eight slots at a time (reads up to 7 slots past hi, masked off).
+inline void appendWithin(const float* xs, const float* ys, std::uint32_t lo, std::uint32_t hi, float xi, float yi,
+                         float cut2, std::vector<std::uint32_t>& out) {
+#if defined(__AVX2__)
+  const __m256 xv = _mm256_set1_ps(xi), yv = _mm256_set1_ps(yi), cv = _mm256_set1_ps(cut2);
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  for (std::uint32_t j = lo; j < hi; j += 8) {
+    const __m256 valid = _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(static_cast<int>(hi - j)), lane));
+    const __m256 ex = _mm256_sub_ps(xv, _mm256_loadu_ps(xs + j)), ey = _mm256_sub_ps(yv, _mm256_loadu_ps(ys + j));
+    const __m256 d2 = _mm256_add_ps(_mm256_mul_ps(ex, ex), _mm256_mul_ps(ey, ey));
+    for (unsigned m = static_cast<unsigned>(_mm256_movemask_ps(_mm256_and_ps(valid, _mm256_cmp_ps(d2, cv, _CMP_LT_OQ))));
+         m != 0; m &= m - 1)
+      out.push_back(j + static_cast<std::uint32_t>(__builtin_ctz(m)));
+  }
+#else
   for (std::uint32_t j = lo; j < hi; ++j) {
     const float ex = xi - xs[j], ey = yi - ys[j];
-    const float target = s * (ri + rad[j]);
+    if (ex * ex + ey * ey < cut2) out.push_back(j);
+  }
+#endif
+}
+
+// 1 / sqrt(x) for x > 0: the hardware estimate and one Newton step (relative error ~1e-7, a third
+// of the cost of sqrt + div).
+inline float inverseSqrt(float x) {
+#if defined(__AVX2__)
+  const float est = _mm_cvtss_f32(_mm_rsqrt_ss(_mm_set_ss(x)));
+  return 0.5f * est * (3.0f - x * est * est);
+#else
+  return 1.0f / std::sqrt(x);
+#endif
+}
+
+// The cell-ordered slots a Gauss-Seidel sweep reads and moves.
+struct SweepSlots {
+  float* x;
+  float* y;
+  // Per slot: the largest squared distance from its listed position it has been at in the sweep.
+  float* far;
+  const Vec2f* listed;  // positions when the pairs were listed
+  const float* radius;
+  const float* yield;
+  const std::uint32_t* agent;  // agent index (hashes the direction of coincident pairs)
+};
+
+// Corrections of agent i against its coincident partners (closer than 1e-7 target), along a
+// direction hashed from the pair; moves the partners and returns i's share. Rare, and out of line
+// so that the loop of projectPairs keeps its values in registers (a call there spills them).
+[[gnu::cold, gnu::noinline]] inline Vec2f coincidentCorrections(const SweepSlots& a, std::uint32_t i,
+                                                                 const std::uint32_t* js, std::uint32_t count,
+                                                                 float s) {
+  Vec2f share = Vec2f::Zero();
+  const float xi = a.x[i], yi = a.y[i], ri = a.radius[i], yieldI = a.yield[i];
+  for (std::uint32_t q = 0; q < count; ++q) {
+    const std::uint32_t j = js[q];
+    const float ex = xi - a.x[j], ey = yi - a.y[j];
+    const float target = s * (ri + a.radius[j]);
+    const float d2 = ex * ex + ey * ey;
+    if (d2 > 1e-14f * target * target) continue;
+    const Vec2f c = (target - std::sqrt(d2)) * coincidentDirection(a.agent[i], a.agent[j]);
+    const float si = yieldI < 0.75f ? a.yield[j] : 0.0f;
+    const float sj = yieldI * (2.0f - 2.0f * a.yield[j]);
+    share += si * c;
+    a.x[j] -= sj * c.x();
+    a.y[j] -= sj * c.y();
+    const float lx = a.x[j] - a.listed[j].x(), ly = a.y[j] - a.listed[j].y();
+    a.far[j] = std::max(a.far[j], lx * lx + ly * ly);
+  }
+  return share;
+}
+
+// Gauss-Seidel projections of agent i's listed pairs (i, js[q]): each pair closer than target =
+// s (r_i + r_j) is pushed apart to target along its centre line, i taking si = yield_j (0 if i is
+// scripted) of the correction and j taking sj = yield_i (2 - 2 yield_j) (0 if j is scripted):
+// equal and opposite for two movable agents. Each j is moved in place as it comes; i's shares are
+// taken from its position at the start and applied together at the end (coincident partners
+// last).
+inline void projectPairs(const SweepSlots& a, std::uint32_t i, const std::uint32_t* js, std::uint32_t count, float s) {
+  // The slot arrays do not overlap: without restrict every store would force the loads again.
+  float* __restrict x = a.x;
+  float* __restrict y = a.y;
+  float* __restrict far = a.far;
+  const Vec2f* __restrict listed = a.listed;
+  const float* __restrict radius = a.radius;
+  const float* __restrict yield = a.yield;
+  const float xi = x[i], yi = y[i], ri = radius[i], yieldI = yield[i];
+  const bool movableI = yieldI < 0.75f;  // yield 1/2: movable, 1: scripted
+  auto moved = [&](std::uint32_t k, float xk, float yk) {
+    x[k] = xk;
+    y[k] = yk;
+    const float lx = xk - listed[k].x(), ly = yk - listed[k].y();
+    far[k] = std::max(far[k], lx * lx + ly * ly);
+  };
+  float dx = 0.0f, dy = 0.0f;
+  bool coincident = false;
+  for (std::uint32_t q = 0; q < count; ++q) {
+    const std::uint32_t j = js[q];
+    const float xj = x[j], yj = y[j];
+    const float ex = xi - xj, ey = yi - yj;
+    const float target = s * (ri + radius[j]);
     const float d2 = ex * ex + ey * ey, t2 = target * target;
     if (d2 >= t2) continue;
-    const bool coincident = !(d2 > 1e-14f * t2);
-    if (coincident != coincidentOnly) continue;
+    if (!(d2 > 1e-14f * t2)) [[unlikely]] {
+      coincident = true;
+      continue;
+    }
+    const float f = target * inverseSqrt(d2) - 1.0f;  // (target - dist) / dist
     const float si = movableI ? yield[j] : 0.0f;
     const float sj = yieldI * (2.0f - 2.0f * yield[j]);
-    float cx, cy, len;
-    if (coincident) {
-      const Vec2f dir = coincidentDirection(agent[i], agent[j]);
-      len = target - std::sqrt(d2);
-      cx = len * dir.x();
-      cy = len * dir.y();
-    } else {
-      const float dist = std::sqrt(d2);
-      const float f = (target - dist) / dist;
-      len = target - dist;
-      cx = f * ex;
-      cy = f * ey;
-    }
-    dx += si * cx;
-    dy += si * cy;
-    pathI += si * len;
-    xs[j] -= sj * cx;
-    ys[j] -= sj * cy;
-    path[j] += sj * len;
-    changed |= si > 0.0f || sj > 0.0f;
+    dx += si * f * ex;
+    dy += si * f * ey;
+    if (sj > 0.0f) moved(j, xj - sj * f * ex, yj - sj * f * ey);
   }
-  return changed;
+  if (coincident) [[unlikely]] {
+    const Vec2f share = coincidentCorrections(a, i, js, count, s);
+    dx += share.x();
+    dy += share.y();
+  }
+  if (dx != 0.0f || dy != 0.0f) moved(i, xi + dx, yi + dy);
 }
 }  // namespace msim::crowd::collision_kernels

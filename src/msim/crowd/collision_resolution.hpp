@@ -23,8 +23,9 @@ struct CollisionResolutionParams {
   // Pairs closer than separation * d_min (d_min = r_i + r_j) are pushed to that distance. The
   // seed found a target "somewhat larger than d_min" gave smoother, jitter-free motion and a better
   // spacing (ch. 4.5.1). With the UIC's alpha = 0.64 packing and 6 Gauss-Seidel sweeps (the scene
-  // default), 1.2 gives the circle scene of Fig. 4.5 0.015% of agent-frames closer than d_min and
-  // a mean nearest-neighbour distance of 1.17 d_min in dense regions (the seed: 0.12% and 1.25).
+  // default), 1.2 gives the circle scene of Fig. 4.5 0.003-0.035% of agent-frames closer than
+  // d_min (chaotic: it moves with the sweep order) and a mean nearest-neighbour distance of 1.17
+  // d_min in dense regions (the seed: 0.12% and 1.25).
   float separation = 1.2f;
   // Most sweeps; each resolves isolated pairs exactly, clusters converge geometrically. 6
   // Gauss-Seidel sweeps give the circle scene the quality 12 Jacobi sweeps gave (the scene
@@ -45,23 +46,24 @@ struct CollisionResolutionParams {
 class CollisionResolver {
  public:
   // Moves agents.position in place. Gauss-Seidel (default): each pair closer than the target is
-  // projected once per sweep, both agents moved in place by half the correction (a scripted
-  // agent's partner by all of it). A cell handles its agents' pairs with the later agents of the
-  // cell, of the cell to its right and of the three cells above; that footprint spans two rows,
-  // so the even rows of cells run in parallel, then the odd rows: the order is fixed, and the
-  // result does not depend on the thread count. Pushes are equal and opposite, so the centroid is
-  // conserved to round-off unless an obstacle, the domain or a scripted agent intervenes. After
-  // each sweep agents are pushed out of obstacles and clamped into the domain. Jacobi: every
-  // displacement from the positions before the sweep, then applied. No allocation once warm.
+  // projected once per sweep, in place, both agents moved by half the correction (a scripted
+  // agent's partner by all of it). The pairs are listed once per call, those closer than the
+  // interaction range plus a skin, each owned by its first agent: an agent's partners are the
+  // later agents of its cell, of the cell to its right and of the three cells above. Those lie in
+  // two rows of cells, so the even rows of cells run in parallel, then the odd rows: the order is
+  // fixed, and the result does not depend on the thread count. Pushes are equal and opposite, so
+  // the centroid is conserved to round-off unless an obstacle, the domain or a scripted agent
+  // intervenes. After each sweep agents are pushed out of obstacles and clamped into the domain.
+  // Jacobi: every displacement from the positions before the sweep, then applied, over the 3x3
+  // cells around each agent. No allocation once warm.
   //
-  // The agents are bucketed once per call into cells a little larger than the interaction range
-  // and their positions, radii and models gathered in cell order; the sweeps run on that copy
-  // and the result is scattered back at the end. The buckets are redone when the distance an
-  // agent may have moved since bucketing could take a pair within range out of the 3x3 cells
-  // around an agent, so the pair sets are exact (Gauss-Seidel: that distance is bounded by the
-  // sum of the corrections, and a sweep that went too far is undone and redone on new buckets;
-  // only the first sweep on new buckets is kept regardless, which matters only from deep
-  // overlaps such as uniformly random positions).
+  // The agents are bucketed into cells and their positions, radii and models gathered in cell
+  // order; the sweeps run on that copy and the result is scattered back at the end. The pairs
+  // (Gauss-Seidel) or buckets (Jacobi) are redone when an agent may have moved far enough from
+  // where they were made for a pair within range to be missing, so the pair sets are exact
+  // (Gauss-Seidel: the farthest any agent has been is tracked through the sweep, and a sweep
+  // that went too far is undone and redone on a new list; only the first sweep on a new list is
+  // kept regardless, which matters only from deep overlaps such as uniformly random positions).
   void resolve(Agents& agents, const StaticObstacles& obstacles, const DomainBox& domain,
                const CollisionResolutionParams& params = {});
 
@@ -70,36 +72,49 @@ class CollisionResolver {
   int lastBucketings() const { return bucketings_; }
   // Sweeps the last resolve() ran (<= iterations; fewer when it converged).
   int lastSweeps() const { return sweeps_; }
-  // Gauss-Seidel sweeps of the last resolve() that were undone and redone on new buckets (an agent
-  // moved too far during the sweep for the buckets to be sure to hold all its pairs).
+  // Gauss-Seidel sweeps of the last resolve() that were undone and redone on a new pair list (an
+  // agent moved too far during the sweep for the list to be sure to hold all its pairs).
   int lastRedoneSweeps() const { return redone_; }
 
  private:
+  // The sweeps on the bucketed copy; range: the largest target distance, tolerance2: the squared
+  // largest displacement of a converged sweep.
+  void resolveGaussSeidel(const StaticObstacles& obstacles, const DomainBox& domain,
+                          const CollisionResolutionParams& params, float range, float tolerance2);
+  void resolveJacobi(const StaticObstacles& obstacles, const DomainBox& domain, const CollisionResolutionParams& params,
+                     float range, float tolerance2);
   void bucket(const Agents& agents, float cellSize);  // from the agents
-  void resizeCellFlags();  // one moved flag per cell of the current buckets
   void rebucket(float cellSize);                       // from the current cell-ordered copy
+  void resizeCellFlags();  // Jacobi: one moved flag per cell of the current buckets
   void scatter(Agents& agents) const;                  // positions back to agent order
-  // One Gauss-Seidel sweep in place over x_, y_ (start positions in prevX_, prevY_); returns the
-  // largest displacements. sinceBucket2 bounds the squared distance from bucketed_ of every
-  // position an agent had during the sweep (path lengths), so pairs in range were in the stencil.
+  // Gauss-Seidel: lists the pairs closer than `cut` (the buckets' cell size) at the bucketed
+  // positions, row of cells by row, and starts the sweeps from there.
+  void listPairs(float cut);
+  void listRow(int cy, float cut2);
+  // One Gauss-Seidel sweep in place over x_, y_ (start positions in prevX_, prevY_, end positions
+  // into nextX_, nextY_).
   struct SweepMoves {
-    float sinceBucket2 = 0.0f;  // squared bound on the distance from bucketed_ during the sweep
-    float end2 = 0.0f;          // squared largest distance from bucketed_ at its end
-    float sweep2 = 0.0f;        // squared largest displacement in the sweep
-    float path = 0.0f;          // largest distance moved in the sweep (sum of corrections)
+    float far2 = 0.0f;    // squared largest distance from bucketed_ at any moment of the sweep
+    float end2 = 0.0f;    // squared largest distance from bucketed_ at its end
+    float sweep2 = 0.0f;  // squared largest displacement in the sweep
   };
-  SweepMoves gaussSeidelSweep(const StaticObstacles& obstacles, const DomainBox& domain, float s, bool everything);
+  SweepMoves gaussSeidelSweep(const StaticObstacles& obstacles, const DomainBox& domain, float s);
+  // The end of a sweep for the slots [k0, k1): clamps them into the domain, records where they
+  // end and folds their distances into w.
+  void clampIntoDomain(std::size_t k0, std::size_t k1, const DomainBox& domain, SweepMoves& w);
 
   NeighbourGrid grid_;
   // Cell-ordered copies (slot k is agent agent_[k]).
   // Structure of arrays, padded with kPad far-away slots so the vector loops may read past a range.
   std::vector<float> x_, y_, nextX_, nextY_;  // positions before / after a sweep
   // Gauss-Seidel: positions at the start of the sweep (x_, y_ are updated in place; nextX_,
-  // nextY_ receive the end positions) and the distance each agent was moved in this sweep.
-  std::vector<float> prevX_, prevY_, path_;
-  std::vector<std::uint8_t> noop_;
-  float startEnd2_ = 0.0f;  // squared largest distance from bucketed_ at the start of the sweep  // per cell: its last Gauss-Seidel pass moved nobody
-  std::vector<Vec2f> bucketed_;              // positions when bucketed
+  // nextY_ receive the end positions), and per slot the squared largest distance from its
+  // bucketed position in the sweep so far.
+  std::vector<float> prevX_, prevY_, far_;
+  // Gauss-Seidel pair list, per row of cells: for each slot of the row in order, its number of
+  // partners, then the partners' slots.
+  std::vector<std::vector<std::uint32_t>> rowPairs_;
+  std::vector<Vec2f> bucketed_;  // positions when bucketed (Gauss-Seidel: when the pairs were listed)
   std::vector<float> radius_;
   std::vector<float> yield_;  // share of a push a neighbour of this agent takes: 1/2, or 1 if this one is scripted
   std::vector<std::uint8_t> scripted_;
@@ -109,13 +124,12 @@ class CollisionResolver {
   std::vector<float> tmpRadius_, tmpYield_;
   std::vector<std::uint8_t> tmpScripted_;
   std::vector<std::uint32_t> tmpAgent_;
-  // Per cell: whether any of its agents moved in the last sweep (and in the one being computed).
-  // A cell whose whole stencil did not move is skipped: its agents would not move either.
+  // Jacobi, per cell: whether any of its agents moved in the last sweep (and in the one being
+  // computed). A cell whose whole stencil did not move is skipped: its agents would not move either.
   std::vector<std::uint8_t> moved_, movedNext_;
   int bucketings_ = 0;
   int sweeps_ = 0;
   int redone_ = 0;
 };
-
 
 }  // namespace msim::crowd
