@@ -32,19 +32,24 @@ void accumulate(GranularStepTimes& sum, const GranularStepTimes& t) {
   sum.particles += t.particles;
 }
 
+// Warms up for 10 steps of dt, then times steps of dt.
+void timeSteps(benchmark::State& state, GranularSimulation& sim, double dt) {
+  for (int k = 0; k < 10; ++k) sim.step(dt);
+  GranularStepTimes sum;
+  for (auto _ : state) {
+    sim.step(dt);
+    accumulate(sum, sim.lastStepTimes());
+  }
+  report(state, sim, sum);
+}
+
 void BM_SandBed25x50x25(benchmark::State& state) {
   GranularSettings s;
   s.grid = GridSpec<3>(Vec3::Zero(), 0.02, IVec3(25, 50, 25));
   s.stress.tolerance = 1e-3;
   GranularSimulation sim(s, {GranularMaterial{1600.0, 0.6}});
   sim.seed(Vec3::Zero(), Vec3(0.5, 0.5, 0.5), [](const Vec3&) { return true; }, {});
-  for (int k = 0; k < 10; ++k) sim.step(1.0 / 120.0);
-  GranularStepTimes sum;
-  for (auto _ : state) {
-    sim.step(1.0 / 120.0);
-    accumulate(sum, sim.lastStepTimes());
-  }
-  report(state, sim, sum);
+  timeSteps(state, sim, 1.0 / 120.0);
 }
 
 void BM_BallOnSand24(benchmark::State& state) {
@@ -56,13 +61,7 @@ void BM_BallOnSand24(benchmark::State& state) {
   rigid::RigidBody ball = rigid::RigidBody::fromDensity(rigid::Sphere{0.075}, 3000.0);
   ball.position = Vec3(0.3, 0.375, 0.3);
   sim.world().addBody(ball);
-  for (int k = 0; k < 10; ++k) sim.step(1.0 / 60.0);
-  GranularStepTimes sum;
-  for (auto _ : state) {
-    sim.step(1.0 / 60.0);
-    accumulate(sum, sim.lastStepTimes());
-  }
-  report(state, sim, sum);
+  timeSteps(state, sim, 1.0 / 60.0);
 }
 
 }  // namespace

@@ -307,7 +307,34 @@ void removeWallFriction(const StressComponent& c, const IVec3& cells, unsigned s
   });
 }
 
+// out = w * v, face by face.
+void weightedFaces(const FaceField& w, const FaceField& v, FaceField& out) {
+  for (int a = 0; a < 3; ++a)
+    for (std::size_t i = 0; i < v.values[a].size(); ++i) out.values[a][i] = w.values[a][i] * v.values[a][i];
+}
+
 }  // namespace
+
+// Face coefficients: kappa = (1 - phi_s) / rho (velocity per impulse density, eq. 5.27; capped
+// for sparse faces, see minimumFaceFraction), the pressure weight phi kappa (eqs. 5.8, 5.47), the
+// friction energy weight phi rho kappa^2 and its linear weight phi rho kappa (eqs. 5.16-5.19,
+// 5.49-5.50). Faces without material have kappa = 0: no stress reaches them.
+void StressSolver::faceCoefficients(const GranularGridState& st, const std::vector<const CoupledBody*>& bodies,
+                                    double minimumFaceFraction, Impl& m) {
+  for (FaceField* f : {&m.kappa, &m.weightP, &m.weightS, &m.weightB}) *f = FaceField(st.spec.res);
+  for (int a = 0; a < 3; ++a)
+    for (std::size_t i = 0; i < m.kappa.values[a].size(); ++i) {
+      double solid = 0.0;
+      for (const CoupledBody* b : bodies) solid += b->faceFraction.values[a][i];
+      const double rho = st.rhoFace.values[a][i], phi = st.phiFace.values[a][i];
+      if (st.open.values[a][i] == 0.0 || !(rho > 0.0) || !(phi > 0.0)) continue;
+      const double k = std::max(0.0, 1.0 - solid) * phi / (rho * std::max(phi, minimumFaceFraction));
+      m.kappa.values[a][i] = k;
+      m.weightP.values[a][i] = phi * k;
+      m.weightS.values[a][i] = phi * rho * k * k;
+      m.weightB.values[a][i] = phi * rho * k;
+    }
+}
 
 void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velocity,
                          const std::vector<const CoupledBody*>& bodies) {
@@ -333,22 +360,8 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
   // The storage of each friction problem's variable: up, the pair (a, c), xy, yz, xz.
   const std::array<std::size_t, 5> slot = {static_cast<std::size_t>(up), static_cast<std::size_t>(pa), 3, 5, 4};
 
-  // Face coefficients: kappa = (1 - phi_s) / rho (velocity per impulse density, eq. 5.27), the
-  // pressure weight phi kappa (eqs. 5.8, 5.47), the friction energy weight phi rho kappa^2 and its
-  // linear weight phi rho kappa (eqs. 5.16-5.19, 5.49-5.50). Faces without material have kappa = 0.
-  for (FaceField* f : {&m.kappa, &m.weightP, &m.weightS, &m.weightB, &m.force, &m.flux}) *f = FaceField(st.spec.res);
-  for (int a = 0; a < 3; ++a)
-    for (std::size_t i = 0; i < m.kappa.values[a].size(); ++i) {
-      double solid = 0.0;
-      for (const CoupledBody* b : bodies) solid += b->faceFraction.values[a][i];
-      const double rho = st.rhoFace.values[a][i], phi = st.phiFace.values[a][i];
-      const bool material = st.open.values[a][i] != 0.0 && rho > 0.0 && phi > 0.0;
-      const double k = material ? std::max(0.0, 1.0 - solid) * phi / (rho * std::max(phi, settings_.minimumFaceFraction)) : 0.0;
-      m.kappa.values[a][i] = k;
-      m.weightP.values[a][i] = phi * k;
-      m.weightS.values[a][i] = phi * rho * k * k;
-      m.weightB.values[a][i] = phi * rho * k;
-    }
+  for (FaceField* f : {&m.force, &m.flux}) *f = FaceField(st.spec.res);
+  faceCoefficients(st, bodies, settings_.minimumFaceFraction, m);
   m.velocity0 = velocity;  // v^n + dt f_ext / rho: the state without stress
   m.cellScratch.assign(cells, 0.0);
 
@@ -427,9 +440,7 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
         bodyVelocities();
         // Linear term dt (D^T phi (1 - phi_s) v~ + J^T V~) (eqs. 5.19, 5.26, 5.50), negated for
         // the solver's 1/2 x^T A x - b^T x.
-        for (int a = 0; a < 3; ++a)
-          for (std::size_t i = 0; i < velocity.values[a].size(); ++i)
-            m.flux.values[a][i] = m.weightB.values[a][i] * velocity.values[a][i];
+        weightedFaces(m.weightB, velocity, m.flux);
         transposeTerms(pr.terms, m.flux, dx, st.open, m.tmp, m.tmp2);
         pr.b = -dt * Eigen::Map<const Eigen::VectorXd>(m.tmp.data(), static_cast<Eigen::Index>(m.tmp.size()));
         for (std::size_t b = 0; b < bodies.size(); ++b) {
@@ -475,9 +486,7 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
     addTerms(pr.terms, p_, -1.0, dx, st.open, m.force);
     grainVelocity();
     bodyVelocities();
-    for (int a = 0; a < 3; ++a)
-      for (std::size_t i = 0; i < velocity.values[a].size(); ++i)
-        m.flux.values[a][i] = st.phiFace.values[a][i] * velocity.values[a][i];
+    weightedFaces(st.phiFace, velocity, m.flux);
     transposeTerms(pr.terms, m.flux, dx, st.open, m.tmp, m.tmp2);  // = div(phi v~)
     pr.b.resize(static_cast<Eigen::Index>(cells));
     for (std::size_t i = 0; i < cells; ++i) pr.b[static_cast<Eigen::Index>(i)] = st.phi[i] - dt * m.tmp[i] - 1.0;
@@ -506,18 +515,8 @@ const FaceField& StressSolver::correctDensity(GranularGridState& st, const std::
   ScopedTimer t(stats_.correctionSeconds);
   const std::size_t cells = st.spec.cellCount();
   // The pressure problem with dt = 1 and no velocity (eq. 5.14, Delta x = -grad y / rho).
-  for (FaceField* f : {&m.kappa, &m.weightP, &m.force, &m.flux}) *f = FaceField(st.spec.res);
-  for (int a = 0; a < 3; ++a)
-    for (std::size_t i = 0; i < m.kappa.values[a].size(); ++i) {
-      const double rho = st.rhoFace.values[a][i], phi = st.phiFace.values[a][i];
-      double solid = 0.0;
-      for (const CoupledBody* b : bodies) solid += b->faceFraction.values[a][i];
-      const double k = st.open.values[a][i] != 0.0 && rho > 0.0 && phi > 0.0
-                           ? std::max(0.0, 1.0 - solid) * phi / (rho * std::max(phi, settings_.minimumFaceFraction))
-                           : 0.0;
-      m.kappa.values[a][i] = k;
-      m.weightP.values[a][i] = phi * k;
-    }
+  for (FaceField* f : {&m.force, &m.flux}) *f = FaceField(st.spec.res);
+  faceCoefficients(st, bodies, settings_.minimumFaceFraction, m);
   Problem& pr = m.pressure;
   // Bodies do not move in the correction: only the grid part, with their volume in the constraint.
   pr.build(st, m.weightP, 1.0, {});
@@ -539,11 +538,8 @@ const FaceField& StressSolver::correctDensity(GranularGridState& st, const std::
   stats_.correctionIterations = pr.solve(qp);
   m.var.assign(pr.x.data(), pr.x.data() + pr.x.size());
   addTerms(pr.terms, m.var, 1.0, st.spec.dx, st.open, m.force);
-  for (int a = 0; a < 3; ++a)
-    for (std::size_t i = 0; i < m.force.values[a].size(); ++i) {
-      displacement_.values[a][i] = m.kappa.values[a][i] * m.force.values[a][i];
-      m.flux.values[a][i] = st.phiFace.values[a][i] * displacement_.values[a][i];
-    }
+  weightedFaces(m.kappa, m.force, displacement_);
+  weightedFaces(st.phiFace, displacement_, m.flux);
   // phi <- phi - div(phi Delta x) (eq. 5.14).
   transposeTerms(pr.terms, m.flux, st.spec.dx, st.open, m.tmp, m.tmp2);
   for (std::size_t i = 0; i < cells; ++i) st.phi[i] -= m.tmp[i];

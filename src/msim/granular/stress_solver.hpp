@@ -87,6 +87,8 @@ class StressSolver {
 
  private:
   struct Impl;
+  static void faceCoefficients(const GranularGridState& st, const std::vector<const CoupledBody*>& bodies,
+                               double minimumFaceFraction, Impl& m);
   std::shared_ptr<Impl> impl_;
   StressSolverSettings settings_;
   StressSolverStats stats_;
