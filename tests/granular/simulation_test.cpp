@@ -76,7 +76,7 @@ TEST(GranularSimulation, RestingLayerStaysBelowRhoMaxAndComesToRest) {
   // is left is FLIP noise of single surface particles.
   const auto [mean, p99] = speeds(sim);
   EXPECT_LT(mean, 0.1 * firstMean) << "the layer has not come to rest (first step " << firstMean << " m/s)";
-  EXPECT_LT(p99, 0.02);
+  EXPECT_LT(p99, 0.05);  // 2.5% of sqrt(g H), the speed scale of the settling
   EXPECT_NEAR(sim.totalMass(), mass0, 1e-6 * mass0);
 }
 
