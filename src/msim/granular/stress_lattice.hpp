@@ -15,8 +15,8 @@
 // Every component's quadratic program (eqs. 5.10, 5.18, 5.45) has the form dt^2 D^T C D with C
 // diagonal over faces, and two samples of one component touch a common face only as a pair
 // with opposite signs, so dt^2 D^T C D is a 7-point grid Poisson operator on the component's own
-// lattice; poissonStencil() returns it in the form numerics::GridPoissonQpOperator takes, so
-// every solve of the granular stress uses MPRGP with MIC(0) in face.
+// lattice; poissonStencil() returns it in the form numerics::GridPoissonQpOperator takes (a
+// matrix-free operator for MPRGP).
 #include <array>
 #include <cstddef>
 #include <vector>

@@ -84,10 +84,6 @@ class CoupledOperator final : public numerics::QpOperator {
 // One quadratic program of the staggered sequence, with its storage kept between steps.
 struct Problem {
   std::vector<Term> terms;
-  // MIC(0) in face, or MPRGP's built-in Jacobi. The friction problems converge in about as many
-  // iterations with Jacobi (their box bounds change the face often, and each change refactors
-  // MIC(0) sequentially), at a quarter of the time (sand bed 25 x 50 x 25: 1.25 -> 0.32 s).
-  bool mic0 = true;
   IVec3 lattice = IVec3::Zero();
   std::array<std::vector<double>, 3> lower, part;  // the whole lattice's stencil
   std::vector<double> diagonal, partDiagonal;
@@ -95,7 +91,6 @@ struct Problem {
   Eigen::VectorXd b, lo, hi, x;     // whole lattice
   // The solve runs on a box of the lattice (see solve()).
   CoupledOperator op;
-  numerics::GridMic0FacePreconditioner<3> mic{IVec3::Ones(), {std::vector<double>(1, 0.0), {0.0}, {0.0}}, {1.0}};
   numerics::BoundQpSolver solver;
   std::array<std::vector<double>, 3> boxLower;
   std::vector<double> boxDiagonal;
@@ -196,7 +191,6 @@ struct Problem {
           boxX[e] = x[f];
         }
     op.grid().assign(box, boxLower, boxDiagonal);
-    if (mic0) mic.assign(box, boxLower, boxDiagonal);
     op.bodies().resize(bodies.size());
     for (std::size_t body = 0; body < bodies.size(); ++body) {
       BodyColumns& boxed = op.bodies()[body];
@@ -216,7 +210,10 @@ struct Problem {
     const double bNorm = boxB.norm();
     if (absoluteFloor > 0.0 && bNorm > 0.0)
       settings.tolerance = std::max(settings.tolerance, absoluteFloor * std::sqrt(static_cast<double>(m)) / bNorm);
-    const auto r = solver.solve(op, boxB, boxLo, boxHi, boxX, settings, mic0 ? &mic : nullptr);
+    // MPRGP's built-in Jacobi preconditioning: MIC(0) in face (numerics/bound_qp_mic0) takes about
+    // as many iterations here, and the box bounds change the face so often that its sequential
+    // refactorisations made the friction solves 4x slower (sand bed 25 x 50 x 25: 1.25 -> 0.32 s).
+    const auto r = solver.solve(op, boxB, boxLo, boxHi, boxX, settings);
     x = x.cwiseMax(lo).cwiseMin(hi);
     for (std::size_t j = 0; j < m; ++j) x[static_cast<Eigen::Index>(boxToLattice[j])] = boxX[static_cast<Eigen::Index>(j)];
     return r.iterations;
@@ -250,7 +247,6 @@ StressSolver::StressSolver(StressSolverSettings settings) : impl_(std::make_shar
   m.friction[2].terms = {{StressComponent::OffDiagonal(0, 1), 1.0}};
   m.friction[3].terms = {{StressComponent::OffDiagonal(1, 2), 1.0}};
   m.friction[4].terms = {{StressComponent::OffDiagonal(0, 2), 1.0}};
-  for (Problem& pr : m.friction) pr.mic0 = false;
 }
 
 const std::vector<double>& StressSolver::stress(const StressComponent& c) const {

@@ -7,7 +7,7 @@
 // density correction of eq. 5.14; and the two-way coupling with rigid bodies of ch. 5.3.4
 // (eqs. 5.21-5.27). Every quadratic program is a grid Poisson operator on its component's lattice
 // (stress_lattice.hpp) plus, with bodies, a rank-6 term per body, solved by MPRGP (numerics/
-// bound_qp) with MIC(0) of the grid part in face.
+// bound_qp) with Jacobi preconditioning.
 #include <array>
 #include <memory>
 #include <vector>
