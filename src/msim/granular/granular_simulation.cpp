@@ -104,6 +104,10 @@ std::size_t GranularSimulation::seed(const Vec3& lo, const Vec3& hi, const std::
   return added;
 }
 
+void GranularSimulation::resampleRenderPoints() {
+  if (renderPoints_) renderPoints_->sample(particles_);
+}
+
 double GranularSimulation::stableTimestep(double maxDt) const {
   const std::size_t n = particles_.size();
   double vmax = parallelMax(n, [&](std::size_t i) { return static_cast<double>(particles_.velocity[i].norm()); });

@@ -66,6 +66,10 @@ class GranularSimulation {
   std::size_t seed(const Vec3& lo, const Vec3& hi, const std::function<bool(const Vec3&)>& inside,
                    const SeedOptions& options);
 
+  // After the particles were replaced (a resumed run): samples new render points inside them.
+  // They are not the points of the interrupted run, which only follow particles' histories.
+  void resampleRenderPoints();
+
   // The largest stable step: cfl dx / (max particle speed + |g| dt), at most maxDt.
   double stableTimestep(double maxDt) const;
   // One step of length dt. Throws std::runtime_error if a velocity becomes non-finite.

@@ -91,12 +91,9 @@ class GranularPhenomenon final : public Phenomenon {
   void writeVolume(const fs::path& vdbFile) const override { writeGranularVdb(vdbFile, sim_, setup_.bodies); }
 
   void restore(const fs::path& vdbFile, double time) override {
-    // The render points are owned by the simulation, which can only sample them while seeding.
-    if (sim_.renderPoints())
-      throw InputError(fmt::format("{}: --resume is not supported for granular scenes with render points yet "
-                                   "(granular.render_points_per_particle > 0); run the scene again from the start",
-                                   source_));
     restoreGranularVdb(vdbFile, sim_, setup_.bodies, source_);
+    // Render points are not saved: new ones are sampled inside the restored particles.
+    sim_.resampleRenderPoints();
     time_ = time;
     for (std::size_t k = 0; k < fired_.size(); ++k) fired_[k] = setup_.explosions[k].time < time;
   }
