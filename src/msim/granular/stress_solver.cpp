@@ -9,222 +9,12 @@
 
 #include "msim/core/parallel.hpp"
 #include "msim/core/timer.hpp"
-#include "msim/numerics/bound_qp_mic0.hpp"
 
 namespace msim::granular {
 
-using Vec6 = Eigen::Matrix<double, 6, 1>;
-using Mat6 = Eigen::Matrix<double, 6, 6>;
-
-namespace {
-
-// A stress variable acting through one or two components with a sign: the pressure is
-// -(D_x + D_y + D_z) p, the pair of ch. 5.5.1 is s_xx = -s_yy / 2 + d, s_zz = -s_yy / 2 - d, so d
-// acts as +D_xx - D_zz; the others act as themselves.
-struct Term {
-  StressComponent c;
-  double sign;
-};
-
-// The rank-6 part of a body: J x = sum_q column[q] x_q over the samples its faces touch
-// (J = G Phi_s D of eqs. 5.21/5.22, G_f = [e_a; r_f x e_a] the generalized direction of face f).
-struct BodyColumns {
-  std::vector<std::size_t> sample;
-  std::vector<Vec6> column;
-  Mat6 inverseMass;
-  Vec6 apply(const Eigen::VectorXd& x) const {
-    Vec6 y = Vec6::Zero();
-    for (std::size_t k = 0; k < sample.size(); ++k) y += column[k] * x[static_cast<Eigen::Index>(sample[k])];
-    return y;
-  }
-};
-
-// dt^2 (D^T W D + V_c sum_b J_b^T M_b^-1 J_b): the grid Poisson part plus the bodies.
-class CoupledOperator final : public numerics::QpOperator {
- public:
-  CoupledOperator() : grid_(IVec3::Ones(), {std::vector<double>(1, 0.0), {0.0}, {0.0}}, {1.0}) {}
-  numerics::GridPoissonQpOperator<3>& grid() { return grid_; }
-  std::vector<BodyColumns>& bodies() { return bodies_; }
-  void setBodyWeight(double w) { bodyWeight_ = w; }
-
-  Eigen::Index size() const override { return grid_.size(); }
-  void apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const override {
-    grid_.apply(x, y);
-    for (const BodyColumns& b : bodies_) {
-      const Vec6 f = bodyWeight_ * (b.inverseMass * b.apply(x));
-      for (std::size_t k = 0; k < b.sample.size(); ++k) y[static_cast<Eigen::Index>(b.sample[k])] += b.column[k].dot(f);
-    }
-  }
-  void diagonal(Eigen::VectorXd& d) const override {
-    grid_.diagonal(d);
-    for (const BodyColumns& b : bodies_)
-      for (std::size_t k = 0; k < b.sample.size(); ++k)
-        d[static_cast<Eigen::Index>(b.sample[k])] += bodyWeight_ * b.column[k].dot(b.inverseMass * b.column[k]);
-  }
-  double normUpperBound() const override {
-    // Gershgorin for a rank-6 term: row q sums |c_q^T M^-1 c_q'| <= |c_q| |M^-1| sum |c_q'|.
-    double bound = grid_.normUpperBound();
-    for (const BodyColumns& b : bodies_) {
-      double sum = 0.0, largest = 0.0;
-      for (const Vec6& c : b.column) {
-        sum += c.norm();
-        largest = std::max(largest, c.norm());
-      }
-      bound += bodyWeight_ * b.inverseMass.norm() * largest * sum;
-    }
-    return bound;
-  }
-
- private:
-  numerics::GridPoissonQpOperator<3> grid_;
-  std::vector<BodyColumns> bodies_;
-  double bodyWeight_ = 0.0;
-};
-
-// One quadratic program of the staggered sequence, with its storage kept between steps.
-struct Problem {
-  std::vector<Term> terms;
-  IVec3 lattice = IVec3::Zero();
-  std::array<std::vector<double>, 3> lower, part;  // the whole lattice's stencil
-  std::vector<double> diagonal, partDiagonal;
-  std::vector<BodyColumns> bodies;  // J of each body, in whole-lattice sample indices
-  Eigen::VectorXd b, lo, hi, x;     // whole lattice
-  // The solve runs on a box of the lattice (see solve()).
-  CoupledOperator op;
-  numerics::BoundQpSolver solver;
-  std::array<std::vector<double>, 3> boxLower;
-  std::vector<double> boxDiagonal;
-  std::vector<std::size_t> boxToLattice;
-  Eigen::VectorXd boxB, boxLo, boxHi, boxX;
-
-  // Builds dt^2 (sum_terms D^T W D) for face weights W, and the bodies' columns.
-  void build(const GranularGridState& st, const FaceField& weight, double dt,
-             const std::vector<const CoupledBody*>& coupled) {
-    lattice = latticeSize(terms.front().c, st.spec.res);
-    const std::size_t n = static_cast<std::size_t>(lattice.prod());
-    for (auto& l : lower) l.assign(n, 0.0);
-    diagonal.assign(n, 0.0);
-    for (const Term& t : terms) {
-      poissonStencil(t.c, weight, st.spec.dx, st.open, 0.0, part, partDiagonal);
-      for (int a = 0; a < 3; ++a)
-        for (std::size_t i = 0; i < n; ++i) lower[a][i] += part[a][i];
-      for (std::size_t i = 0; i < n; ++i) diagonal[i] += partDiagonal[i];
-    }
-    const double dt2 = dt * dt;
-    for (auto& l : lower)
-      for (double& w : l) w *= dt2;
-    // Samples no material reaches decouple; any positive diagonal keeps the operator definite
-    // and their bounds (or right-hand sides) hold them at 0.
-    for (double& d : diagonal) d = d > 0.0 ? d * dt2 : 1.0;
-    op.setBodyWeight(dt2 * st.spec.cellVolume());
-    bodies.resize(coupled.size());
-    for (std::size_t k = 0; k < coupled.size(); ++k) bodyColumns(st, *coupled[k], bodies[k]);
-  }
-
-  void bodyColumns(const GranularGridState& st, const CoupledBody& body, BodyColumns& out) const {
-    out.inverseMass = body.inverseMass;
-    out.sample.clear();
-    out.column.clear();
-    const double invDx = 1.0 / st.spec.dx;
-    for (int a = 0; a < 3; ++a) {
-      const IVec3 n = st.open.size(a);
-      const std::vector<double>& frac = body.faceFraction.values[a];
-      for (std::size_t i = 0; i < frac.size(); ++i) {
-        if (frac[i] <= 0.0 || st.open.values[a][i] == 0.0) continue;
-        const IVec3 f(static_cast<int>(i % n[0]), static_cast<int>(i / n[0] % n[1]), static_cast<int>(i / n[0] / n[1]));
-        Vec3 x = st.spec.origin + (f.cast<double>().array() + 0.5).matrix() * st.spec.dx;
-        x[a] -= 0.5 * st.spec.dx;
-        Vec6 g;
-        g.head<3>() = Vec3::Unit(a);
-        g.tail<3>() = Vec3(x - body.centre).cross(Vec3(Vec3::Unit(a)));
-        g *= frac[i] * invDx;
-        for (const Term& t : terms)
-          forEachFaceSample(t.c, lattice, a, f, [&](std::size_t q, double sign) {
-            out.sample.push_back(q);
-            out.column.push_back(t.sign * sign * g);
-          });
-      }
-    }
-  }
-
-  // Solves on the bounding box of the samples whose bounds leave room (lo < hi): the others are
-  // fixed at their bound, which is 0 for the friction (no pressure, no friction) - the friction
-  // lives only where the material is packed, often a small part of the grid. Samples outside the
-  // box count as Dirichlet neighbours at 0 (the stencil keeps their links in the diagonal).
-  // absoluteFloor: a projected-gradient norm per sqrt(sample) below which the solve stops even
-  // if the relative tolerance is not met (0: relative only).
-  int solve(numerics::BoundQpSettings settings, double absoluteFloor = 0.0) {
-    IVec3 first = lattice, last = IVec3::Constant(-1);
-    for (int k = 0; k < lattice[2]; ++k)
-      for (int j = 0; j < lattice[1]; ++j)
-        for (int i = 0; i < lattice[0]; ++i) {
-          const Eigen::Index q = (static_cast<Eigen::Index>(k) * lattice[1] + j) * lattice[0] + i;
-          if (!(lo[q] < hi[q])) continue;
-          first = first.cwiseMin(IVec3(i, j, k));
-          last = last.cwiseMax(IVec3(i, j, k));
-        }
-    if ((last.array() < 0).any()) {
-      x = x.cwiseMax(lo).cwiseMin(hi);
-      return 0;
-    }
-    const IVec3 box = last - first + IVec3::Ones();
-    const std::size_t m = static_cast<std::size_t>(box.prod());
-    for (auto& l : boxLower) l.resize(m);
-    boxDiagonal.resize(m);
-    boxToLattice.resize(m);
-    boxB.resize(static_cast<Eigen::Index>(m));
-    boxLo.resize(static_cast<Eigen::Index>(m));
-    boxHi.resize(static_cast<Eigen::Index>(m));
-    boxX.resize(static_cast<Eigen::Index>(m));
-    std::size_t k = 0;
-    for (int z = first[2]; z <= last[2]; ++z)
-      for (int y = first[1]; y <= last[1]; ++y)
-        for (int xx = first[0]; xx <= last[0]; ++xx, ++k) {
-          const std::size_t q = (static_cast<std::size_t>(z) * lattice[1] + y) * lattice[0] + xx;
-          boxToLattice[k] = q;
-          for (int a = 0; a < 3; ++a) boxLower[a][k] = lower[a][q];
-          boxDiagonal[k] = diagonal[q];
-          const Eigen::Index e = static_cast<Eigen::Index>(k), f = static_cast<Eigen::Index>(q);
-          boxB[e] = b[f];
-          boxLo[e] = lo[f];
-          boxHi[e] = hi[f];
-          boxX[e] = x[f];
-        }
-    op.grid().assign(box, boxLower, boxDiagonal);
-    op.bodies().resize(bodies.size());
-    for (std::size_t body = 0; body < bodies.size(); ++body) {
-      BodyColumns& boxed = op.bodies()[body];
-      boxed.inverseMass = bodies[body].inverseMass;
-      boxed.sample.clear();
-      boxed.column.clear();
-      for (std::size_t j = 0; j < bodies[body].sample.size(); ++j) {
-        const std::size_t q = bodies[body].sample[j];
-        const int qx = static_cast<int>(q % lattice[0]), qy = static_cast<int>(q / lattice[0] % lattice[1]),
-                  qz = static_cast<int>(q / lattice[0] / lattice[1]);
-        const IVec3 c = IVec3(qx, qy, qz) - first;
-        if ((c.array() < 0).any() || (c.array() >= box.array()).any()) continue;
-        boxed.sample.push_back((static_cast<std::size_t>(c[2]) * box[1] + c[1]) * box[0] + c[0]);
-        boxed.column.push_back(bodies[body].column[j]);
-      }
-    }
-    const double bNorm = boxB.norm();
-    if (absoluteFloor > 0.0 && bNorm > 0.0)
-      settings.tolerance = std::max(settings.tolerance, absoluteFloor * std::sqrt(static_cast<double>(m)) / bNorm);
-    // MPRGP's built-in Jacobi preconditioning: MIC(0) in face (numerics/bound_qp_mic0) takes about
-    // as many iterations here, and the box bounds change the face so often that its sequential
-    // refactorisations made the friction solves 4x slower (sand bed 25 x 50 x 25: 1.25 -> 0.32 s).
-    const auto r = solver.solve(op, boxB, boxLo, boxHi, boxX, settings);
-    x = x.cwiseMax(lo).cwiseMin(hi);
-    for (std::size_t j = 0; j < m; ++j) x[static_cast<Eigen::Index>(boxToLattice[j])] = boxX[static_cast<Eigen::Index>(j)];
-    return r.iterations;
-  }
-};
-
-}  // namespace
-
 struct StressSolver::Impl {
-  Problem pressure;
-  std::array<Problem, 5> friction;  // up diagonal, the other pair, and the three off-diagonals
+  StressProblem pressure;
+  std::array<StressProblem, 5> friction;  // up diagonal, the other pair, and the three off-diagonals
   FaceField kappa, weightP, weightS, weightB, force, flux, velocity0;
   std::vector<double> tmp, tmp2, smax, var, cellScratch;
   struct BodyFace {
@@ -255,23 +45,6 @@ const std::vector<double>& StressSolver::stress(const StressComponent& c) const 
 }
 
 namespace {
-
-// Sum over terms of sign * D_term x, added into force (per unit volume).
-void addTerms(const std::vector<Term>& terms, const std::vector<double>& x, double scale, double dx,
-              const FaceField& mask, FaceField& force) {
-  for (const Term& t : terms) addDivergence(t.c, x, scale * t.sign, dx, mask, force);
-}
-
-// out = sum over terms of sign * D_term^T u.
-void transposeTerms(const std::vector<Term>& terms, const FaceField& u, double dx, const FaceField& mask,
-                    std::vector<double>& out, std::vector<double>& tmp) {
-  out.clear();
-  for (const Term& t : terms) {
-    divergenceTranspose(t.c, u, dx, mask, tmp);
-    if (out.empty()) out.assign(tmp.size(), 0.0);
-    for (std::size_t i = 0; i < tmp.size(); ++i) out[i] += t.sign * tmp[i];
-  }
-}
 
 // Cell value averaged onto the samples of a component's lattice (the cells around an edge).
 void toLattice(const StressComponent& c, const IVec3& cells, const std::vector<double>& cell, std::vector<double>& out) {
@@ -414,14 +187,14 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
   m.pressure.build(st, m.weightP, dt, bodies);
   // Friction operators do not depend on p: built once per step.
   if (settings_.friction)
-    for (Problem& pr : m.friction) pr.build(st, m.weightS, dt, bodies);
+    for (StressProblem& pr : m.friction) pr.build(st, m.weightS, dt, bodies);
 
   std::vector<double>& var = m.var;
   for (int iteration = 0; iteration < settings_.staggeredIterations; ++iteration) {
     if (settings_.friction) {
       ScopedTimer t(stats_.frictionSeconds);
       for (std::size_t k = 0; k < m.friction.size(); ++k) {
-        Problem& pr = m.friction[k];
+        StressProblem& pr = m.friction[k];
         const std::vector<double>& sUp = s_[static_cast<std::size_t>(up)];
         // Remove this variable's share of F (v~|_{s_c = 0} of eq. 5.46). The pair removes both
         // its components and puts back their trace-free part -s_up / 2 for the current s_up.
@@ -481,7 +254,7 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
       }
     }
     ScopedTimer t(stats_.pressureSeconds);
-    Problem& pr = m.pressure;
+    StressProblem& pr = m.pressure;
     // Remove the pressure's share, then predict phi + phi_s without it (eqs. 5.7-5.8, 5.25):
     // phi* = phi^n - dt div(phi v~) = phi^n + dt sum_a D_a^T (phi v~).
     addTerms(pr.terms, p_, -1.0, dx, st.open, m.force);
@@ -518,7 +291,7 @@ const FaceField& StressSolver::correctDensity(GranularGridState& st, const std::
   // The pressure problem with dt = 1 and no velocity (eq. 5.14, Delta x = -grad y / rho).
   for (FaceField* f : {&m.force, &m.flux}) *f = FaceField(st.spec.res);
   faceCoefficients(st, bodies, settings_.minimumFaceFraction, m);
-  Problem& pr = m.pressure;
+  StressProblem& pr = m.pressure;
   // Bodies do not move in the correction: only the grid part, with their volume in the constraint.
   pr.build(st, m.weightP, 1.0, {});
   pr.b.resize(static_cast<Eigen::Index>(cells));

@@ -1,0 +1,120 @@
+#pragma once
+// One quadratic program of the granular stress (Narain 2011 eqs. 5.13, 5.20, 5.44-5.46 with the
+// body terms of 5.25-5.26): a stress variable on its lattice (stress_lattice.hpp), the operator
+// dt^2 (D^T W D + V sum_bodies J^T M^-1 J), bounds, and its MPRGP solve on the box of the samples
+// that can move. The staggered sequence of these problems is stress_solver.hpp.
+#include <array>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "msim/granular/grid_state.hpp"
+#include "msim/granular/stress_lattice.hpp"
+#include "msim/numerics/bound_qp.hpp"
+#include "msim/numerics/bound_qp_mic0.hpp"
+
+namespace msim::granular {
+
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+
+// A stress variable acting through one or two components with a sign: the pressure is
+// -(D_x + D_y + D_z) p, the pair of ch. 5.5.1 is s_xx = -s_yy / 2 + d, s_zz = -s_yy / 2 - d, so d
+// acts as +D_xx - D_zz; the others act as themselves.
+struct StressTerm {
+  StressComponent c;
+  double sign;
+};
+
+// The rank-6 part of a body: J x = sum_q column[q] x_q over the samples its faces touch
+// (J = G Phi_s D of eqs. 5.21/5.22, G_f = [e_a; r_f x e_a] the generalized direction of face f).
+struct BodyColumns {
+  std::vector<std::size_t> sample;
+  std::vector<Vec6> column;
+  Mat6 inverseMass;
+  Vec6 apply(const Eigen::VectorXd& x) const {
+    Vec6 y = Vec6::Zero();
+    for (std::size_t k = 0; k < sample.size(); ++k) y += column[k] * x[static_cast<Eigen::Index>(sample[k])];
+    return y;
+  }
+};
+
+// dt^2 (D^T W D + V_c sum_b J_b^T M_b^-1 J_b): the grid Poisson part plus the bodies.
+class CoupledOperator final : public numerics::QpOperator {
+ public:
+  CoupledOperator() : grid_(IVec3::Ones(), {std::vector<double>(1, 0.0), {0.0}, {0.0}}, {1.0}) {}
+  numerics::GridPoissonQpOperator<3>& grid() { return grid_; }
+  std::vector<BodyColumns>& bodies() { return bodies_; }
+  void setBodyWeight(double w) { bodyWeight_ = w; }
+
+  Eigen::Index size() const override { return grid_.size(); }
+  void apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const override {
+    grid_.apply(x, y);
+    for (const BodyColumns& b : bodies_) {
+      const Vec6 f = bodyWeight_ * (b.inverseMass * b.apply(x));
+      for (std::size_t k = 0; k < b.sample.size(); ++k) y[static_cast<Eigen::Index>(b.sample[k])] += b.column[k].dot(f);
+    }
+  }
+  void diagonal(Eigen::VectorXd& d) const override {
+    grid_.diagonal(d);
+    for (const BodyColumns& b : bodies_)
+      for (std::size_t k = 0; k < b.sample.size(); ++k)
+        d[static_cast<Eigen::Index>(b.sample[k])] += bodyWeight_ * b.column[k].dot(b.inverseMass * b.column[k]);
+  }
+  double normUpperBound() const override {
+    // Gershgorin for a rank-6 term: row q sums |c_q^T M^-1 c_q'| <= |c_q| |M^-1| sum |c_q'|.
+    double bound = grid_.normUpperBound();
+    for (const BodyColumns& b : bodies_) {
+      double sum = 0.0, largest = 0.0;
+      for (const Vec6& c : b.column) {
+        sum += c.norm();
+        largest = std::max(largest, c.norm());
+      }
+      bound += bodyWeight_ * b.inverseMass.norm() * largest * sum;
+    }
+    return bound;
+  }
+
+ private:
+  numerics::GridPoissonQpOperator<3> grid_;
+  std::vector<BodyColumns> bodies_;
+  double bodyWeight_ = 0.0;
+};
+
+// One quadratic program of the staggered sequence, with its storage kept between steps.
+struct StressProblem {
+  std::vector<StressTerm> terms;
+  IVec3 lattice = IVec3::Zero();
+  std::array<std::vector<double>, 3> lower, part;  // the whole lattice's stencil
+  std::vector<double> diagonal, partDiagonal;
+  std::vector<BodyColumns> bodies;  // J of each body, in whole-lattice sample indices
+  Eigen::VectorXd b, lo, hi, x;     // whole lattice
+  // The solve runs on a box of the lattice (see solve()).
+  CoupledOperator op;
+  numerics::BoundQpSolver solver;
+  std::array<std::vector<double>, 3> boxLower;
+  std::vector<double> boxDiagonal;
+  std::vector<std::size_t> boxToLattice;
+  Eigen::VectorXd boxB, boxLo, boxHi, boxX;
+
+  // Builds dt^2 (sum_terms D^T W D) for face weights W, and the bodies' columns.
+  void build(const GranularGridState& st, const FaceField& weight, double dt,
+             const std::vector<const CoupledBody*>& coupled);
+  void bodyColumns(const GranularGridState& st, const CoupledBody& body, BodyColumns& out) const;
+  // Solves on the bounding box of the samples whose bounds leave room (lo < hi): the others are
+  // fixed at their bound, which is 0 for the friction (no pressure, no friction) - the friction
+  // lives only where the material is packed, often a small part of the grid. Samples outside the
+  // box count as Dirichlet neighbours at 0 (the stencil keeps their links in the diagonal).
+  // absoluteFloor: a projected-gradient norm per sqrt(sample) below which the solve stops even
+  // if the relative tolerance is not met (0: relative only). Returns the MPRGP iterations.
+  int solve(numerics::BoundQpSettings settings, double absoluteFloor = 0.0);
+};
+
+// Sum over terms of sign * D_term x, added into force (per unit volume).
+void addTerms(const std::vector<StressTerm>& terms, const std::vector<double>& x, double scale, double dx,
+              const FaceField& mask, FaceField& force);
+// out = sum over terms of sign * D_term^T u (tmp: scratch).
+void transposeTerms(const std::vector<StressTerm>& terms, const FaceField& u, double dx, const FaceField& mask,
+                    std::vector<double>& out, std::vector<double>& tmp);
+
+}  // namespace msim::granular
