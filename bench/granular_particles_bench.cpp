@@ -106,7 +106,7 @@ void BM_SplitMerge(benchmark::State& state) {
   }
   perParticle(state, deformed.size());
   std::size_t invalid = 0;
-  for (const Shape& a : deformed.shape) invalid += !isValidShape(shapeMatrix(a), splitMerge.radius());
+  for (const ParticleShape& a : deformed.shape) invalid += !isValidShape(shapeMatrix(a), splitMerge.radius());
   state.counters["invalid"] = static_cast<double>(invalid);
   state.counters["splits"] = static_cast<double>(stats.splits);
   state.counters["merges"] = static_cast<double>(stats.merges);

@@ -30,8 +30,8 @@ TEST(GranularMaterial, RejectsNonPhysicalValues) {
 TEST(GranularParticles, ShapeRoundTripsThroughSixFloats) {
   Eigen::Matrix3d a;
   a << 4, 1, 2, 1, 5, 3, 2, 3, 6;
-  const Shape s = toShape(a);
-  EXPECT_EQ(s, (Shape{4, 5, 6, 1, 2, 3}));
+  const ParticleShape s = toShape(a);
+  EXPECT_EQ(s, (ParticleShape{4, 5, 6, 1, 2, 3}));
   EXPECT_EQ(shapeMatrix(s), a);
 }
 

@@ -18,7 +18,7 @@ constexpr double kDx = 0.1;
 const double kR = defaultParticleRadius(kDx);
 
 // Semi-axes relative to r, ascending.
-Vec3 semiAxesOverR(const Shape& s) {
+Vec3 semiAxesOverR(const ParticleShape& s) {
   return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(shapeMatrix(s)).eigenvalues().cwiseSqrt() / kR;
 }
 
@@ -182,7 +182,7 @@ TEST(GranularSplitMerge, DeterministicAcrossRuns) {
   GranularParticles a;
   seedBox(a, grid, Vec3::Constant(0.3), Vec3::Constant(0.9), materials);
   Rng rng(4);
-  for (Shape& s : a.shape) s[0] *= float(rng.uniform(0.2, 3.0));  // some too thin, some too long
+  for (ParticleShape& s : a.shape) s[0] *= float(rng.uniform(0.2, 3.0));  // some too thin, some too long
   GranularParticles b = a;
   SplitMerge first(kR), second(kR);
   first.apply(a);

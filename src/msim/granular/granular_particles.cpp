@@ -24,7 +24,7 @@ void validate(std::span<const GranularMaterial> materials) {
   for (std::size_t i = 0; i < materials.size(); ++i) validate(materials[i], i);
 }
 
-Eigen::Matrix3d shapeMatrix(const Shape& s) {
+Eigen::Matrix3d shapeMatrix(const ParticleShape& s) {
   Eigen::Matrix3d a;
   a << s[0], s[3], s[4],  //
       s[3], s[1], s[5],   //
@@ -32,7 +32,7 @@ Eigen::Matrix3d shapeMatrix(const Shape& s) {
   return a;
 }
 
-Shape toShape(const Eigen::Matrix3d& a) {
+ParticleShape toShape(const Eigen::Matrix3d& a) {
   return {static_cast<float>(a(0, 0)), static_cast<float>(a(1, 1)), static_cast<float>(a(2, 2)),
           static_cast<float>(a(0, 1)), static_cast<float>(a(0, 2)), static_cast<float>(a(1, 2))};
 }
@@ -41,7 +41,7 @@ void GranularParticles::resize(std::size_t n) {
   position.resize(n, Vecf<3>::Zero());
   velocity.resize(n, Vecf<3>::Zero());
   mass.resize(n, 0.0f);
-  shape.resize(n, Shape{});
+  shape.resize(n, ParticleShape{});
   material.resize(n, 0);
 }
 
@@ -53,7 +53,7 @@ void GranularParticles::reserve(std::size_t n) {
   material.reserve(n);
 }
 
-std::size_t GranularParticles::append(const Vecf<3>& x, const Vecf<3>& v, float m, const Shape& a,
+std::size_t GranularParticles::append(const Vecf<3>& x, const Vecf<3>& v, float m, const ParticleShape& a,
                                       std::uint16_t materialIndex) {
   position.push_back(x);
   velocity.push_back(v);
@@ -88,7 +88,7 @@ std::size_t seedRegion(GranularParticles& particles, const GridSpec<3>& grid, co
   const double dx = grid.dx;
   const double r = defaultParticleRadius(dx);
   const float mass = static_cast<float>(options.fillFraction * materials[options.material].density * dx * dx * dx / 8.0);
-  const Shape sphere = toShape(r * r * Eigen::Matrix3d::Identity());
+  const ParticleShape sphere = toShape(r * r * Eigen::Matrix3d::Identity());
   const Vecf<3> velocity = options.velocity.cast<float>();
 
   IVec3 first, last;  // cells overlapping the box, clipped to the grid

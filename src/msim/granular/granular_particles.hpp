@@ -32,15 +32,15 @@ void validate(const GranularMaterial& material, std::size_t index = 0);
 void validate(std::span<const GranularMaterial> materials);
 
 // Symmetric 3x3 shape matrix stored as (xx, yy, zz, xy, xz, yz).
-using Shape = std::array<float, 6>;
-Eigen::Matrix3d shapeMatrix(const Shape& s);
-Shape toShape(const Eigen::Matrix3d& a);  // reads the upper triangle
+using ParticleShape = std::array<float, 6>;
+Eigen::Matrix3d shapeMatrix(const ParticleShape& s);
+ParticleShape toShape(const Eigen::Matrix3d& a);  // reads the upper triangle
 
 struct GranularParticles {
   std::vector<Vecf<3>> position;  // [m]
   std::vector<Vecf<3>> velocity;  // [m/s]
   std::vector<float> mass;        // [kg]
-  std::vector<Shape> shape;       // A_i [m^2]
+  std::vector<ParticleShape> shape;       // A_i [m^2]
   std::vector<std::uint16_t> material;
 
   std::size_t size() const { return position.size(); }
@@ -48,7 +48,7 @@ struct GranularParticles {
   void resize(std::size_t n);
   void reserve(std::size_t n);
   void clear() { resize(0); }
-  std::size_t append(const Vecf<3>& x, const Vecf<3>& v, float m, const Shape& a, std::uint16_t materialIndex);
+  std::size_t append(const Vecf<3>& x, const Vecf<3>& v, float m, const ParticleShape& a, std::uint16_t materialIndex);
   // Copies particle `from` of `source` into slot `to` of this set (which must be large enough).
   void copyFrom(const GranularParticles& source, std::size_t from, std::size_t to);
 };

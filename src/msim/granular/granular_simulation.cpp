@@ -129,8 +129,8 @@ void GranularSimulation::buildGridState() {
     state_.phi[i] = fields_.volume[i] * invV;
     state_.alpha[i] = fields_.friction[i];
   });
-  state_.phiFace = FaceField(g.res);
-  state_.rhoFace = FaceField(g.res);
+  state_.phiFace.reset(g.res);
+  state_.rhoFace.reset(g.res);
   for (int a = 0; a < 3; ++a) {
     const std::vector<float>& volume = fields_.faceVolume.component(a).data();
     const std::vector<float>& mass = fields_.faceMass.component(a).data();
@@ -257,7 +257,8 @@ void GranularSimulation::step(double dt) {
   }
   const bool corrected = stress_.stats().correctionIterations > 0;
   // v* = v^n + dt g on the open faces that hold material (eq. 5.5 without stress); walls at rest.
-  FaceField velocity(settings_.grid.res);
+  FaceField& velocity = predicted_;
+  velocity.reset(settings_.grid.res);
   for (int a = 0; a < 3; ++a) {
     const std::vector<float>& v = fields_.velocity.component(a).data();
     for (std::size_t i = 0; i < v.size(); ++i)

@@ -107,6 +107,7 @@ class GranularSimulation {
   ParticleGridFields fields_;
   GranularGridState state_;
   FaceField wallFaces_;  // 1 open, 0 closed by the domain or a static solid
+  FaceField predicted_;  // v* of the step, then v~ (solver storage kept between steps)
   StressSolver stress_;
   SplitMerge splitMerge_;
   SplitMergeStats splitMergeStats_;

@@ -174,7 +174,7 @@ void SplitMerge::emit(const GranularParticles& in, GranularParticles& out) const
         }
         const Vec3 x = in.position[i].cast<double>();
         const float m = in.mass[i] / static_cast<float>(count);  // exact: a power of two
-        const Shape child = toShape(a);
+        const ParticleShape child = toShape(a);
         for (int c = 0; c < count; ++c) {
           out.position[at + c] = (x + offset[c]).cast<float>();
           out.velocity[at + c] = in.velocity[i];

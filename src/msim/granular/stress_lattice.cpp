@@ -28,6 +28,14 @@ void FaceField::fill(double value) {
   for (auto& v : values) std::fill(v.begin(), v.end(), value);
 }
 
+void FaceField::reset(const IVec3& cells) {
+  if (cells != res) {
+    *this = FaceField(cells);
+    return;
+  }
+  fill(0.0);
+}
+
 IVec3 latticeSize(const StressComponent& c, const IVec3& cells) {
   IVec3 n = cells;
   if (!c.diagonal()) {

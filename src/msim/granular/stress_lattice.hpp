@@ -35,6 +35,9 @@ struct FaceField {
   IVec3 size(int axis) const;
   std::size_t index(int axis, const IVec3& q) const;
   void fill(double value);
+  // Zeroes the field for a grid of `cells`, keeping the storage when the size is unchanged (the
+  // per-step scratch of the solver does not reallocate).
+  void reset(const IVec3& cells);
 };
 
 // A stress component: Diagonal(a) at cells (a = b), OffDiagonal(a, b) with a < b on edges.

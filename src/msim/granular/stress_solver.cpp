@@ -95,7 +95,7 @@ void weightedFaces(const FaceField& w, const FaceField& v, FaceField& out) {
 // 5.49-5.50). Faces without material have kappa = 0: no stress reaches them.
 void StressSolver::faceCoefficients(const GranularGridState& st, const std::vector<const CoupledBody*>& bodies,
                                     double minimumFaceFraction, Impl& m) {
-  for (FaceField* f : {&m.kappa, &m.weightP, &m.weightS, &m.weightB}) *f = FaceField(st.spec.res);
+  for (FaceField* f : {&m.kappa, &m.weightP, &m.weightS, &m.weightB}) f->reset(st.spec.res);
   for (int a = 0; a < 3; ++a)
     for (std::size_t i = 0; i < m.kappa.values[a].size(); ++i) {
       double solid = 0.0;
@@ -134,7 +134,7 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
   // The storage of each friction problem's variable: up, the pair (a, c), xy, yz, xz.
   const std::array<std::size_t, 5> slot = {static_cast<std::size_t>(up), static_cast<std::size_t>(pa), 3, 5, 4};
 
-  for (FaceField* f : {&m.force, &m.flux}) *f = FaceField(st.spec.res);
+  for (FaceField* f : {&m.force, &m.flux}) f->reset(st.spec.res);
   faceCoefficients(st, bodies, settings_.minimumFaceFraction, m);
   m.velocity0 = velocity;  // v^n + dt f_ext / rho: the state without stress
   m.cellScratch.assign(cells, 0.0);
@@ -289,7 +289,7 @@ const FaceField& StressSolver::correctDensity(GranularGridState& st, const std::
   ScopedTimer t(stats_.correctionSeconds);
   const std::size_t cells = st.spec.cellCount();
   // The pressure problem with dt = 1 and no velocity (eq. 5.14, Delta x = -grad y / rho).
-  for (FaceField* f : {&m.force, &m.flux}) *f = FaceField(st.spec.res);
+  for (FaceField* f : {&m.force, &m.flux}) f->reset(st.spec.res);
   faceCoefficients(st, bodies, settings_.minimumFaceFraction, m);
   StressProblem& pr = m.pressure;
   // Bodies do not move in the correction: only the grid part, with their volume in the constraint.
@@ -300,7 +300,7 @@ const FaceField& StressSolver::correctDensity(GranularGridState& st, const std::
     for (const CoupledBody* b : bodies) solid += b->cellFraction[i];
     pr.b[static_cast<Eigen::Index>(i)] = st.phi[i] + solid - 1.0;
   }
-  displacement_ = FaceField(st.spec.res);
+  displacement_.reset(st.spec.res);
   stats_.correctionIterations = 0;
   if (!(pr.b.maxCoeff() > 0.0)) return displacement_;
   pr.lo = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(cells));

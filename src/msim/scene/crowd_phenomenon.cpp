@@ -20,6 +20,7 @@
 #include "msim/render/floor_plan.hpp"
 #include "msim/render/plot.hpp"
 #include "msim/scene/crowd_scene_keys.hpp"
+#include "msim/scene/phenomenon_support.hpp"
 #include "msim/scene/scene_file.hpp"
 
 namespace msim::scene {
@@ -133,11 +134,7 @@ class CrowdPhenomenon final : public Phenomenon {
     const io::PointCloud points = io::readPoints(vdbFile, kAgentPoints);
     const io::PointCloud state = io::readPoints(vdbFile, kStatePoints);
     auto attribute = [&](const io::PointCloud& cloud, const std::string& name) -> const std::vector<float>& {
-      const io::PointAttribute* a = cloud.find(name);
-      if (!a && !cloud.positions.empty())
-        throw InputError(fmt::format("{}: {} has no point attribute '{}' to resume from", source_, vdbFile.string(), name));
-      static const std::vector<float> none;
-      return a ? a->values : none;
+      return savedPointAttribute(cloud, name, vdbFile, source_);
     };
     crowd::Agents agents;
     agents.reserve(points.positions.size());

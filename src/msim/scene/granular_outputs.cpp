@@ -6,6 +6,7 @@
 #include "msim/io/ply.hpp"
 #include "msim/io/vdb.hpp"
 #include "msim/scene/granular_bodies.hpp"
+#include "msim/scene/phenomenon_support.hpp"
 
 namespace msim::scene {
 namespace {
@@ -111,11 +112,7 @@ void restoreGranularVdb(const fs::path& file, granular::GranularSimulation& sim,
   const io::PointCloud points = io::readPoints(file, kParticles);
   const io::PointCloud state = bodies.empty() ? io::PointCloud{} : io::readPoints(file, kBodies);
   auto values = [&](const io::PointCloud& cloud, const std::string& name) -> const std::vector<float>& {
-    const io::PointAttribute* a = cloud.find(name);
-    if (!a && !cloud.positions.empty())
-      throw InputError(fmt::format("{}: {} has no point attribute '{}' to resume from", source, file.string(), name));
-    static const std::vector<float> none;
-    return a ? a->values : none;
+    return savedPointAttribute(cloud, name, file, source);
   };
   if (state.positions.size() != bodies.size())
     throw InputError(fmt::format("{}: cannot resume from {}: it holds {} bodies, the scene has {}", source,

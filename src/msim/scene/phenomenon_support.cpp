@@ -34,6 +34,15 @@ void restoreGrid(const std::filesystem::path& file, const std::string& name, Gri
   std::copy(saved.data().begin(), saved.data().end(), target.data().begin());
 }
 
+const std::vector<float>& savedPointAttribute(const io::PointCloud& cloud, const std::string& name,
+                                              const std::filesystem::path& vdbFile, const std::string& sceneSource) {
+  const io::PointAttribute* a = cloud.find(name);
+  if (!a && !cloud.positions.empty())
+    throw InputError(fmt::format("{}: {} has no point attribute '{}' to resume from", sceneSource, vdbFile.string(), name));
+  static const std::vector<float> none;
+  return a ? a->values : none;
+}
+
 render::PreviewSettings previewSettings(const Scene& scene) {
   const nlohmann::json& p = scene.resolved.at("outputs").at("preview");
   auto axis = [](const nlohmann::json& name) { return name.get<std::string>()[0] - 'x'; };

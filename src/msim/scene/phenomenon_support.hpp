@@ -12,6 +12,7 @@
 
 #include "msim/core/grid.hpp"
 #include "msim/geometry/shape.hpp"
+#include "msim/io/point_cloud.hpp"
 #include "msim/render/density_preview.hpp"
 
 namespace msim::scene {
@@ -27,6 +28,12 @@ void requireFinite(const Grid<float, D>& grid, const std::string& field, long st
 template <int D>
 void restoreGrid(const std::filesystem::path& vdbFile, const std::string& name, Grid<float, D>& target,
                  const std::string& sceneSource);
+
+// Point attribute `name` of a cloud read back from a saved frame for --resume; InputError naming
+// the scene and file when the cloud has points but not the attribute (an empty list for an empty
+// cloud).
+const std::vector<float>& savedPointAttribute(const io::PointCloud& cloud, const std::string& name,
+                                              const std::filesystem::path& vdbFile, const std::string& sceneSource);
 
 // outputs.preview of a resolved scene.
 render::PreviewSettings previewSettings(const Scene& scene);
