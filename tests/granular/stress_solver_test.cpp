@@ -4,6 +4,7 @@
 // carried by the material's pressure.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "msim/granular/stress_solver.hpp"
@@ -109,6 +110,29 @@ TEST(GranularStress, DivergingFlowFeelsNoPressure) {
   solver.solve(st, kDt, v, {});
   EXPECT_EQ(maxAbs(solver.pressure()), 0.0);
   for (std::size_t i = 0; i < v.values[1].size(); ++i) EXPECT_DOUBLE_EQ(v.values[1][i], before.values[1][i]);
+}
+
+TEST(GranularStress, BilateralMaterialIsHeldTogetherLikeALiquid) {
+  // The same pull as above with the bilateral (liquid) constraint: the material resists the
+  // expansion with negative pressure, and div(phi v) vanishes in every full cell: the column
+  // moves as one, with the mean of the face velocities it had (momentum is conserved; the faces
+  // of the material, 2..10, carry 4 x -1 and 5 x +1, so 1/9 m/s).
+  const IVec3 res(4, 12, 4);
+  GranularGridState st = block(res, IVec3(0, 2, 0), IVec3(4, 10, 4), 0.0);
+  FaceField v(res);
+  for (std::size_t i = 0; i < v.values[1].size(); ++i) {
+    const int j = static_cast<int>(i / res[0] % (res[1] + 1));
+    if (st.open.values[1][i] != 0.0 && st.rhoFace.values[1][i] > 0.0) v.values[1][i] = j >= res[1] / 2 ? 1.0 : -1.0;
+  }
+  StressSolver solver(StressSolverSettings{.friction = false, .tolerance = 1e-8, .bilateral = true});
+  solver.solve(st, kDt, v, {});
+  const std::vector<double>& p = solver.pressure();
+  EXPECT_LT(*std::min_element(p.begin(), p.end()), 0.0);
+  for (int j = 2; j < 10; ++j) {
+    const std::size_t lo = st.open.index(1, IVec3(1, j, 1)), hi = st.open.index(1, IVec3(1, j + 1, 1));
+    EXPECT_NEAR(v.values[1][hi], v.values[1][lo], 1e-5) << "row " << j;  // div v = 0 in the full cell
+    EXPECT_NEAR(v.values[1][hi], 1.0 / 9.0, 1e-4) << "row " << j;
+  }
 }
 
 TEST(GranularStress, ConvergingFlowStopsAtTheDensityBound) {

@@ -147,8 +147,9 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
   for (std::size_t k = 3; k < 6; ++k) addDivergence(comps[k], s_[k], 1.0, dx, st.open, m.force);
   auto grainVelocity = [&] {
     for (int a = 0; a < 3; ++a)
-      for (std::size_t i = 0; i < velocity.values[a].size(); ++i)
+      parallelFor(0, velocity.values[a].size(), [&](std::size_t i) {
         velocity.values[a][i] = m.velocity0.values[a][i] + dt * m.kappa.values[a][i] * m.force.values[a][i];
+      }, 4096);
   };
   // Each body's faces: phi_s G_f (G_f = [e_a; r_f x e_a]).
   m.bodyFaces.resize(bodies.size());
@@ -201,11 +202,13 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
         if (k == 1) {
           for (int axis : {pa, pc}) {
             std::vector<double>& s = s_[static_cast<std::size_t>(axis)];
-            for (std::size_t i = 0; i < cells; ++i) m.cellScratch[i] = -0.5 * sUp[i] - s[i];
+            parallelFor(0, cells, [&](std::size_t i) { m.cellScratch[i] = -0.5 * sUp[i] - s[i]; }, 4096);
             addDivergence(StressComponent::Diagonal(axis), m.cellScratch, 1.0, dx, st.open, m.force);
           }
           var.resize(cells);
-          for (std::size_t i = 0; i < cells; ++i) var[i] = 0.5 * (s_[static_cast<std::size_t>(pa)][i] - s_[static_cast<std::size_t>(pc)][i]);
+          parallelFor(0, cells, [&](std::size_t i) {
+            var[i] = 0.5 * (s_[static_cast<std::size_t>(pa)][i] - s_[static_cast<std::size_t>(pc)][i]);
+          }, 4096);
         } else {
           var = s_[slot[k]];
           addTerms(pr.terms, var, -1.0, dx, st.open, m.force);
@@ -223,20 +226,21 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
             pr.b[static_cast<Eigen::Index>(bc.sample[j])] -= dt * bc.column[j].dot(m.bodyVelocity[b]);
         }
         // Bounds |s_ij| <= alpha p (eq. 5.15); the pair keeps s_a and s_c within them given s_up.
-        for (std::size_t i = 0; i < cells; ++i) m.cellScratch[i] = st.alpha[i] * p_[i];
+        parallelFor(0, cells, [&](std::size_t i) { m.cellScratch[i] = st.alpha[i] * p_[i]; }, 4096);
         toLattice(pr.terms.front().c, st.spec.res, m.cellScratch, m.smax);
         if (settings_.slipWalls != 0) removeWallFriction(pr.terms.front().c, st.spec.res, settings_.slipWalls, m.smax);
         const Eigen::Index n = static_cast<Eigen::Index>(m.smax.size());
         pr.lo.resize(n);
         pr.hi.resize(n);
         pr.x.resize(n);
-        for (Eigen::Index i = 0; i < n; ++i) {
-          const double half = k == 1 ? 0.5 * std::abs(sUp[static_cast<std::size_t>(i)]) : 0.0;
-          const double bound = std::max(0.0, m.smax[static_cast<std::size_t>(i)] - half);
-          pr.lo[i] = -bound;
-          pr.hi[i] = bound;
-          pr.x[i] = var[static_cast<std::size_t>(i)];
-        }
+        parallelFor(0, static_cast<std::size_t>(n), [&](std::size_t i) {
+          const double half = k == 1 ? 0.5 * std::abs(sUp[i]) : 0.0;
+          const double bound = std::max(0.0, m.smax[i] - half);
+          const Eigen::Index e = static_cast<Eigen::Index>(i);
+          pr.lo[e] = -bound;
+          pr.hi[e] = bound;
+          pr.x[e] = var[i];
+        }, 4096);
         // A friction gradient of dt / dx * delta_v per sample is a velocity error of about
         // delta_v: below velocityTolerance the solve has nothing left worth removing (at rest the
         // relative tolerance would chase particle noise to ever smaller absolute levels).
@@ -244,10 +248,10 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
         var.assign(pr.x.data(), pr.x.data() + pr.x.size());
         addTerms(pr.terms, var, 1.0, dx, st.open, m.force);
         if (k == 1) {
-          for (std::size_t i = 0; i < cells; ++i) {
+          parallelFor(0, cells, [&](std::size_t i) {
             s_[static_cast<std::size_t>(pa)][i] = -0.5 * sUp[i] + var[i];
             s_[static_cast<std::size_t>(pc)][i] = -0.5 * sUp[i] - var[i];
-          }
+          }, 4096);
         } else {
           s_[slot[k]] = var;
         }
@@ -263,7 +267,12 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
     weightedFaces(st.phiFace, velocity, m.flux);
     transposeTerms(pr.terms, m.flux, dx, st.open, m.tmp, m.tmp2);  // = div(phi v~)
     pr.b.resize(static_cast<Eigen::Index>(cells));
-    for (std::size_t i = 0; i < cells; ++i) pr.b[static_cast<Eigen::Index>(i)] = st.phi[i] - dt * m.tmp[i] - 1.0;
+    // Unilateral: phi^{n+1} <= 1 (eq. 5.10). Bilateral cells (at least half full): phi^{n+1} =
+    // min(phi^n, 1), i.e. div(phi v) = 0 unless overfull, with p free.
+    auto bilateralCell = [&](std::size_t i) { return settings_.bilateral && st.phi[i] >= 0.5; };
+    for (std::size_t i = 0; i < cells; ++i)
+      pr.b[static_cast<Eigen::Index>(i)] =
+          st.phi[i] - dt * m.tmp[i] - (bilateralCell(i) ? std::min(st.phi[i], 1.0) : 1.0);
     // Bodies: + phi_s^{n+1}|p=0 = phi_s^n + dt J1^T V~ (the columns carry the pressure's -1).
     for (std::size_t b = 0; b < bodies.size(); ++b) {
       const BodyColumns& bc = pr.bodies[b];
@@ -272,6 +281,8 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
         pr.b[static_cast<Eigen::Index>(bc.sample[j])] -= dt * bc.column[j].dot(m.bodyVelocity[b]);
     }
     pr.lo = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(cells));
+    for (std::size_t i = 0; i < cells; ++i)
+      if (bilateralCell(i)) pr.lo[static_cast<Eigen::Index>(i)] = -std::numeric_limits<double>::infinity();
     pr.hi = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(cells), std::numeric_limits<double>::infinity());
     pr.x = Eigen::Map<const Eigen::VectorXd>(p_.data(), static_cast<Eigen::Index>(cells));
     stats_.pressureIterations += pr.solve(qp);

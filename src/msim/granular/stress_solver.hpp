@@ -32,6 +32,11 @@ struct StressSolverSettings {
   // Bit w set: the domain walls normal to axis w have no friction (the material slides along
   // them freely), e.g. the side walls of a quasi-2D slab. Walls are frictional by default.
   unsigned slipWalls = 0;
+  // Bilateral incompressibility: cells at least half full also resist expansion (p may be
+  // negative there, holding div(phi v) = 0), which makes a frictionless material an inviscid
+  // liquid (FLIP with a particle free surface). Off: the unilateral constraint of eq. 5.10, under
+  // which material dilates freely, as grains do. Not in the seed: for comparing sand with a liquid.
+  bool bilateral = false;
 };
 
 // Time spent and work done in the last step (for the performance split of Table 5.1).

@@ -38,6 +38,9 @@ Schema granularKeys() {
   g.number("tolerance", "", 1e-5, "relative projected-gradient tolerance of each QP solve").min(0.0, Bound::Exclusive).max(1.0);
   g.integer("max_iterations", 400, "MPRGP iterations per QP solve").min(1);
   g.boolean("friction", true, "frictional stress (off: a frictionless, pressure-only material)");
+  g.boolean("bilateral", false,
+            "cells at least half full also resist expansion (with friction off: an inviscid liquid, for comparison "
+            "with sand; off: the unilateral constraint of the seed, grains dilate freely)");
   g.boolean("split_merge", true, "split stretched particles and merge crowded ones (ch. 5.4.1)");
   g.integer("render_points_per_particle", 0, "render points per particle (ch. 5.6); 0 = none").min(0).max(256);
   g.number("max_step", "s", 0.01, "longest time step").min(0.0, Bound::Exclusive);
@@ -110,6 +113,7 @@ struct Builder {
     s.stress.tolerance = g.at("tolerance").get<double>();
     s.stress.maxIterations = g.at("max_iterations").get<int>();
     s.stress.friction = g.at("friction").get<bool>();
+    s.stress.bilateral = g.at("bilateral").get<bool>();
     s.splitMerge = g.at("split_merge").get<bool>();
     s.renderPointsPerParticle = g.at("render_points_per_particle").get<std::size_t>();
     out.maxStep = g.at("max_step").get<double>();
