@@ -4,6 +4,7 @@
 // dt^2 (D^T W D + V sum_bodies J^T M^-1 J), bounds, and its MPRGP solve on the box of the samples
 // that can move. The staggered sequence of these problems is stress_solver.hpp.
 #include <array>
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
@@ -39,6 +40,14 @@ struct BodyColumns {
   }
 };
 
+// The bodies' part of an operator, V_c sum_b J_b^T M_b^-1 J_b times `weight`: y += it x, d += its
+// diagonal, and a Gershgorin bound of its norm (row q sums |c_q^T M^-1 c_q'| <= |c_q| |M^-1|
+// sum |c_q'|).
+void addBodyProducts(const std::vector<BodyColumns>& bodies, double weight, const Eigen::VectorXd& x,
+                     Eigen::VectorXd& y);
+void addBodyDiagonal(const std::vector<BodyColumns>& bodies, double weight, Eigen::VectorXd& d);
+double bodyNormBound(const std::vector<BodyColumns>& bodies, double weight);
+
 // dt^2 (D^T W D + V_c sum_b J_b^T M_b^-1 J_b): the grid Poisson part plus the bodies.
 class CoupledOperator final : public numerics::QpOperator {
  public:
@@ -50,35 +59,38 @@ class CoupledOperator final : public numerics::QpOperator {
   Eigen::Index size() const override { return grid_.size(); }
   void apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const override {
     grid_.apply(x, y);
-    for (const BodyColumns& b : bodies_) {
-      const Vec6 f = bodyWeight_ * (b.inverseMass * b.apply(x));
-      for (std::size_t k = 0; k < b.sample.size(); ++k) y[static_cast<Eigen::Index>(b.sample[k])] += b.column[k].dot(f);
-    }
+    addBodyProducts(bodies_, bodyWeight_, x, y);
   }
   void diagonal(Eigen::VectorXd& d) const override {
     grid_.diagonal(d);
-    for (const BodyColumns& b : bodies_)
-      for (std::size_t k = 0; k < b.sample.size(); ++k)
-        d[static_cast<Eigen::Index>(b.sample[k])] += bodyWeight_ * b.column[k].dot(b.inverseMass * b.column[k]);
+    addBodyDiagonal(bodies_, bodyWeight_, d);
   }
-  double normUpperBound() const override {
-    // Gershgorin for a rank-6 term: row q sums |c_q^T M^-1 c_q'| <= |c_q| |M^-1| sum |c_q'|.
-    double bound = grid_.normUpperBound();
-    for (const BodyColumns& b : bodies_) {
-      double sum = 0.0, largest = 0.0;
-      for (const Vec6& c : b.column) {
-        sum += c.norm();
-        largest = std::max(largest, c.norm());
-      }
-      bound += bodyWeight_ * b.inverseMass.norm() * largest * sum;
-    }
-    return bound;
-  }
+  double normUpperBound() const override { return grid_.normUpperBound() + bodyNormBound(bodies_, bodyWeight_); }
 
  private:
   numerics::GridPoissonQpOperator<3> grid_;
   std::vector<BodyColumns> bodies_;
   double bodyWeight_ = 0.0;
+};
+
+// The same operator restricted to a list of samples (those free to move): each row is its
+// diagonal and up to six links to other listed samples (an absent link points at the row itself
+// with weight 0, so the product has no branches), plus the bodies.
+class CompactCoupledOperator final : public numerics::QpOperator {
+ public:
+  struct Row {
+    std::array<std::uint32_t, 6> neighbour;
+    std::array<double, 6> weight;  // A_ij = -weight
+  };
+  std::vector<double> diagonalValues;
+  std::vector<Row> rows;
+  std::vector<BodyColumns> bodies;  // in listed-sample indices
+  double bodyWeight = 0.0;
+
+  Eigen::Index size() const override { return static_cast<Eigen::Index>(rows.size()); }
+  void apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const override;
+  void diagonal(Eigen::VectorXd& d) const override;
+  double normUpperBound() const override;
 };
 
 // One quadratic program of the staggered sequence, with its storage kept between steps.
@@ -91,11 +103,14 @@ struct StressProblem {
   Eigen::VectorXd b, lo, hi, x;     // whole lattice
   // The solve runs on a box of the lattice (see solve()).
   CoupledOperator op;
+  CompactCoupledOperator compact;  // when few samples of the box are free (see solve())
   numerics::BoundQpSolver solver;
   std::array<std::vector<double>, 3> boxLower;
   std::vector<double> boxDiagonal;
   std::vector<std::size_t> boxToLattice;
   Eigen::VectorXd boxB, boxLo, boxHi, boxX;
+  std::vector<std::uint32_t> freeToLattice;
+  std::vector<std::int32_t> latticeToFree;  // -1 for samples held at a bound
 
   // Builds dt^2 (sum_terms D^T W D) for face weights W, and the bodies' columns.
   void build(const GranularGridState& st, const FaceField& weight, double dt,
@@ -107,7 +122,15 @@ struct StressProblem {
   // box count as Dirichlet neighbours at 0 (the stencil keeps their links in the diagonal).
   // absoluteFloor: a projected-gradient norm per sqrt(sample) below which the solve stops even
   // if the relative tolerance is not met (0: relative only). Returns the MPRGP iterations.
+  // When fewer than half the samples of the box are free, the solve runs on the list of free
+  // samples instead (CompactCoupledOperator), with the held ones' products moved to b.
   int solve(numerics::BoundQpSettings settings, double absoluteFloor = 0.0);
+
+ private:
+  int solveOnBox(const IVec3& first, const IVec3& last, numerics::BoundQpSettings settings, double absoluteFloor);
+  int solveOnFreeSamples(std::size_t freeCount, numerics::BoundQpSettings settings, double absoluteFloor);
+  // The relative tolerance raised to the absolute floor for n samples (see solve()).
+  static void applyFloor(numerics::BoundQpSettings& settings, double absoluteFloor, std::size_t n, double bNorm);
 };
 
 // Sum over terms of sign * D_term x, added into force (per unit volume).
