@@ -95,16 +95,26 @@ TEST(GranularStress, RestingColumnIsHydrostatic) {
   }
 }
 
-TEST(GranularStress, DivergingFlowFeelsNoPressure) {
-  // No cohesion: material pulled apart (the upper half moving up, the lower half down) keeps its
-  // velocity; an incompressible fluid would be held together.
-  const IVec3 res(4, 12, 4);
-  GranularGridState st = block(res, IVec3(0, 2, 0), IVec3(4, 10, 4), 0.5);
-  FaceField v(res);
-  for (std::size_t i = 0; i < v.values[1].size(); ++i) {
-    const int j = static_cast<int>(i / res[0] % (res[1] + 1));
-    if (st.open.values[1][i] != 0.0 && st.rhoFace.values[1][i] > 0.0) v.values[1][i] = j >= res[1] / 2 ? 1.0 : -1.0;
+// A packed block in rows 2..9 of a 4 x 12 x 4 box pulled apart: faces with material in the upper
+// half move up at 1 m/s, those in the lower half down.
+struct PulledApartBlock {
+  IVec3 res{4, 12, 4};
+  GranularGridState st;
+  FaceField v{res};
+  explicit PulledApartBlock(double alpha) : st(block(res, IVec3(0, 2, 0), IVec3(4, 10, 4), alpha)) {
+    for (std::size_t i = 0; i < v.values[1].size(); ++i) {
+      const int j = static_cast<int>(i / res[0] % (res[1] + 1));
+      if (st.open.values[1][i] != 0.0 && st.rhoFace.values[1][i] > 0.0) v.values[1][i] = j >= res[1] / 2 ? 1.0 : -1.0;
+    }
   }
+};
+
+TEST(GranularStress, DivergingFlowFeelsNoPressure) {
+  // No cohesion: material pulled apart keeps its velocity; an incompressible fluid would be held
+  // together.
+  PulledApartBlock pulled(0.5);
+  const GranularGridState& st = pulled.st;
+  FaceField& v = pulled.v;
   const FaceField before = v;
   StressSolver solver;
   solver.solve(st, kDt, v, {});
@@ -117,13 +127,9 @@ TEST(GranularStress, BilateralMaterialIsHeldTogetherLikeALiquid) {
   // expansion with negative pressure, and div(phi v) vanishes in every full cell: the column
   // moves as one, with the mean of the face velocities it had (momentum is conserved; the faces
   // of the material, 2..10, carry 4 x -1 and 5 x +1, so 1/9 m/s).
-  const IVec3 res(4, 12, 4);
-  GranularGridState st = block(res, IVec3(0, 2, 0), IVec3(4, 10, 4), 0.0);
-  FaceField v(res);
-  for (std::size_t i = 0; i < v.values[1].size(); ++i) {
-    const int j = static_cast<int>(i / res[0] % (res[1] + 1));
-    if (st.open.values[1][i] != 0.0 && st.rhoFace.values[1][i] > 0.0) v.values[1][i] = j >= res[1] / 2 ? 1.0 : -1.0;
-  }
+  PulledApartBlock pulled(0.0);
+  const GranularGridState& st = pulled.st;
+  FaceField& v = pulled.v;
   StressSolver solver(StressSolverSettings{.friction = false, .tolerance = 1e-8, .bilateral = true});
   solver.solve(st, kDt, v, {});
   const std::vector<double>& p = solver.pressure();

@@ -2,7 +2,8 @@
 // One quadratic program of the granular stress (Narain 2011 eqs. 5.13, 5.20, 5.44-5.46 with the
 // body terms of 5.25-5.26): a stress variable on its lattice (stress_lattice.hpp), the operator
 // dt^2 (D^T W D + V sum_bodies J^T M^-1 J), bounds, and its MPRGP solve on the box of the samples
-// that can move. The staggered sequence of these problems is stress_solver.hpp.
+// that can move, or on the list of those samples when they fill less than half of the box. The
+// staggered sequence of these problems is stress_solver.hpp.
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -120,16 +121,17 @@ struct StressProblem {
   // fixed at their bound, which is 0 for the friction (no pressure, no friction) - the friction
   // lives only where the material is packed, often a small part of the grid. Samples outside the
   // box count as Dirichlet neighbours at 0 (the stencil keeps their links in the diagonal).
-  // absoluteFloor: a projected-gradient norm per sqrt(sample) below which the solve stops even
-  // if the relative tolerance is not met (0: relative only). Returns the MPRGP iterations.
   // When fewer than half the samples of the box are free, the solve runs on the list of free
   // samples instead (CompactCoupledOperator), with the held ones' products moved to b.
+  // absoluteFloor: a projected-gradient norm per sqrt(free sample) below which the solve stops
+  // even if the relative tolerance is not met (0: relative only). Returns the MPRGP iterations.
   int solve(numerics::BoundQpSettings settings, double absoluteFloor = 0.0);
 
  private:
-  int solveOnBox(const IVec3& first, const IVec3& last, numerics::BoundQpSettings settings, double absoluteFloor);
+  int solveOnBox(const IVec3& first, const IVec3& last, std::size_t freeCount, numerics::BoundQpSettings settings,
+                 double absoluteFloor);
   int solveOnFreeSamples(std::size_t freeCount, numerics::BoundQpSettings settings, double absoluteFloor);
-  // The relative tolerance raised to the absolute floor for n samples (see solve()).
+  // The relative tolerance raised to the absolute floor for n free samples (see solve()).
   static void applyFloor(numerics::BoundQpSettings& settings, double absoluteFloor, std::size_t n, double bNorm);
 };
 
