@@ -111,16 +111,19 @@ TEST(GranularAdvection, PositionsMoveByCorrectionThenVelocityAndStayInTheDomain)
   p.append(x0.cast<float>(), Vecf<3>::Zero(), 1.0f, toShape(1e-4 * Eigen::Matrix3d::Identity()), 0);
   p.append(Vecf<3>(0.99f, 0.0f, 0.0f), Vecf<3>::Zero(), 1.0f, toShape(1e-4 * Eigen::Matrix3d::Identity()), 0);
   const double dt = 0.1;
-  advectParticles(p, velocity, dt, &displacement);
+  std::vector<ParticleMotion> motion;
+  advectParticles(p, velocity, dt, &displacement, &motion);
   const Vec3 corrected = x0 + Vec3::Constant(0.05);
   EXPECT_LE((p.position[0].cast<double>() - (corrected + dt * (g * corrected + b))).norm(), 1e-6);
   // The second one is pushed through x = 1: it stops just inside.
   EXPECT_NEAR(p.position[1][0], 1.0 - kBoundaryEpsilonCells * kGrid.dx, 1e-6);
   EXPECT_LT(p.position[1][0], 1.0f);
 
-  std::vector<Vecf<3>> points{x0.cast<float>()};
-  advectPoints(points, velocity, dt, &displacement);
-  EXPECT_EQ(points[0], p.position[0]);
+  // A point carried by the first particle, 5 mm off its centre: the same correction, then the
+  // (here exact) linear flow about the particle.
+  const Vec3 r(0.005, -0.002, 0.003);
+  const Vec3 carried = carriedPosition(motion[0], x0 + r, dt, kGrid);
+  EXPECT_LE((carried - (corrected + r + dt * (g * (corrected + r) + b))).norm(), 1e-6);
 }
 
 }  // namespace

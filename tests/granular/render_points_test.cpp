@@ -63,9 +63,18 @@ TEST(GranularRenderPoints, FollowTheFlowInsideTheirParticlesThroughSplits) {
   std::size_t splits = 0, resampled = 0;
   double worstAfterAdvection = 0.0;
   const double dt = 0.025;
+  std::vector<ParticleMotion> motion;
+  double worstEulerError = 0.0;
   for (int step = 0; step < 30; ++step) {
-    advectParticles(p, velocity, dt);
-    points.advect(velocity, dt);
+    const std::vector<Vecf<3>> before(points.positions().begin(), points.positions().end());
+    advectParticles(p, velocity, dt, nullptr, &motion);
+    points.advect(motion, dt, velocity.spec());
+    // The flow is linear, so the expansion about the particle is the flow itself: each point takes
+    // the forward-Euler step x + dt G (x - centre) of the analytic field.
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      const Vec3 x = before[k].cast<double>();
+      worstEulerError = std::max(worstEulerError, (points.positions()[k].cast<double>() - (x + dt * g * (x - centre))).norm());
+    }
     // In a linear flow a point moves with the same map F = I + dt G as its particle's ellipsoid
     // (A <- F A F^T), so its Mahalanobis distance does not change.
     worstAfterAdvection = std::max(worstAfterAdvection, worstDistance(points, p));
@@ -77,6 +86,7 @@ TEST(GranularRenderPoints, FollowTheFlowInsideTheirParticlesThroughSplits) {
   std::printf("render points: %zu points, worst distance after advection %.6f, %zu splits, %zu resampled\n",
               points.size(), worstAfterAdvection, splits, resampled);
   EXPECT_LE(worstAfterAdvection, 1.0 + kEscapeMargin);
+  EXPECT_LE(worstEulerError, 1e-5);  // float positions of order 1 m
   EXPECT_GT(splits, 0u);
   EXPECT_EQ(points.size(), 16 * std::size_t(8 * 4 * 4 * 4));  // the total is kept
   // Split children (at +-(sqrt3/2) a e, half as long) do not cover their parent's middle, so about

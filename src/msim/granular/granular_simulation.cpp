@@ -282,8 +282,8 @@ void GranularSimulation::step(double dt) {
     ScopedTimer t(times_.particles);
     transfer_.toParticles(fields_.velocity, velocityNew_, particles_, settings_.flipRatio);
     if (corrected) removeVelocityAgainstCorrection();
-    advectParticles(particles_, velocityNew_, dt, corrected ? &displacement_ : nullptr);
-    if (renderPoints_) renderPoints_->advect(velocityNew_, dt, corrected ? &displacement_ : nullptr);
+    advectParticles(particles_, velocityNew_, dt, corrected ? &displacement_ : nullptr, renderPoints_ ? &motion_ : nullptr);
+    if (renderPoints_) renderPoints_->advect(motion_, dt, settings_.grid);
     pushOutOfSolids();
     if (settings_.splitMerge) {
       splitMergeStats_ = splitMerge_.apply(particles_);

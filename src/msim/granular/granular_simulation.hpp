@@ -20,6 +20,7 @@
 #include "msim/geometry/shape.hpp"
 #include "msim/granular/granular_particles.hpp"
 #include "msim/granular/particle_grid_transfer.hpp"
+#include "msim/granular/particle_advection.hpp"
 #include "msim/granular/render_points.hpp"
 #include "msim/granular/split_merge.hpp"
 #include "msim/granular/stress_solver.hpp"
@@ -116,6 +117,7 @@ class GranularSimulation {
   std::vector<int> bodyIndex_;  // world index of each coupled body
   MacGrid<3> velocityNew_, displacement_;
   std::vector<Vecf<3>> correctionAt_;  // the correction displacement at each particle
+  std::vector<ParticleMotion> motion_;  // each particle's last step, for its render points
   GranularStepTimes times_;
   double time_ = 0.0;
 };

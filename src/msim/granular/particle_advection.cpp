@@ -67,21 +67,16 @@ Vec3 corrected(const Vecf<3>& x, const GridSpec<3>& domain, const MacGrid<3>* di
 }  // namespace
 
 void advectParticles(GranularParticles& particles, const MacGrid<3>& velocity, double dt,
-                     const MacGrid<3>* displacement) {
+                     const MacGrid<3>* displacement, std::vector<ParticleMotion>* motion) {
   const GridSpec<3>& domain = velocity.spec();
+  if (motion) motion->resize(particles.size());
   parallelFor(0, particles.size(), [&](std::size_t i) {
+    const Vec3 start = particles.position[i].cast<double>();
     const Vec3 x = corrected(particles.position[i], domain, displacement);
     const VelocitySample v = sampleVelocityAndJacobian(velocity, x);
     particles.shape[i] = toShape(deformShape(shapeMatrix(particles.shape[i]), v.jacobian, dt));
     particles.position[i] = clampIntoDomain(domain, x + dt * v.value).cast<float>();
-  });
-}
-
-void advectPoints(std::span<Vecf<3>> points, const MacGrid<3>& velocity, double dt, const MacGrid<3>* displacement) {
-  const GridSpec<3>& domain = velocity.spec();
-  parallelFor(0, points.size(), [&](std::size_t i) {
-    const Vec3 x = corrected(points[i], domain, displacement);
-    points[i] = clampIntoDomain(domain, x + dt * sampleLinear<3>(velocity, x)).cast<float>();
+    if (motion) (*motion)[i] = ParticleMotion{start, x - start, v.value, v.jacobian};
   });
 }
 

@@ -4,6 +4,7 @@
 // applied, then the particle moves with the grid velocity (forward Euler), and its shape follows
 // the local velocity gradient.
 #include <span>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -33,14 +34,29 @@ Eigen::Matrix3d deformShape(const Eigen::Matrix3d& a, const Eigen::Matrix3d& jac
 inline constexpr double kBoundaryEpsilonCells = 1e-3;
 Vec3 clampIntoDomain(const GridSpec<3>& domain, const Vec3& x);
 
+// What one particle's step did, for the points it carries (render points): its position before
+// the step, its correction displacement, and the velocity and velocity gradient it moved with.
+struct ParticleMotion {
+  Vec3 start, displacement, velocity;
+  Eigen::Matrix3d jacobian;
+};
+
 // x <- clamp(x + dx_corr(x)); then A <- F A F^T with F = I + dt J_v(x) and x <- clamp(x + dt v(x)),
 // v and J_v interpolated trilinearly at the corrected position. `displacement` (optional) is the
-// density-correction displacement on a MAC grid of the same domain [m]. Parallel.
+// density-correction displacement on a MAC grid of the same domain [m]. `motion` (optional)
+// receives each particle's ParticleMotion. Parallel.
 void advectParticles(GranularParticles& particles, const MacGrid<3>& velocity, double dt,
-                     const MacGrid<3>* displacement = nullptr);
+                     const MacGrid<3>* displacement = nullptr, std::vector<ParticleMotion>* motion = nullptr);
 
-// The same motion for passive points (render points): positions only.
-void advectPoints(std::span<Vecf<3>> points, const MacGrid<3>& velocity, double dt,
-                  const MacGrid<3>* displacement = nullptr);
+// A point carried by a particle (render points, ch. 5.6) after the particle's step `m`:
+// clamp(x + dx_p + dt (v_p + J_p (x - x_p))), the first-order expansion of the grid motion about
+// the particle. It is the map that deforms the particle's ellipsoid (x_p + r -> x_p' + F r,
+// F = I + dt J_p), so a point inside its particle stays inside (up to the clamp into the domain
+// and the particle's push out of solids), and it costs a 3x3 product where sampling the grid
+// twice (velocity and correction) cost about ten times more.
+inline Vec3 carriedPosition(const ParticleMotion& m, const Vec3& x, double dt, const GridSpec<3>& domain) {
+  const Vec3 r = x - m.start;
+  return clampIntoDomain(domain, m.start + m.displacement + r + dt * (m.velocity + m.jacobian * r));
+}
 
 }  // namespace msim::granular

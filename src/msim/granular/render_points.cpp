@@ -45,8 +45,10 @@ void RenderPoints::sample(const GranularParticles& particles) {
   });
 }
 
-void RenderPoints::advect(const MacGrid<3>& velocity, double dt, const MacGrid<3>* displacement) {
-  advectPoints(positions_, velocity, dt, displacement);
+void RenderPoints::advect(std::span<const ParticleMotion> motion, double dt, const GridSpec<3>& domain) {
+  parallelFor(0, size(), [&](std::size_t p) {
+    positions_[p] = carriedPosition(motion[parents_[p]], positions_[p].cast<double>(), dt, domain).cast<float>();
+  }, 4096);
 }
 
 void RenderPoints::reassign(const GranularParticles& particles, std::span<const SplitMerge::Successors> successors) {
@@ -71,16 +73,20 @@ void RenderPoints::reassign(const GranularParticles& particles, std::span<const 
 std::size_t RenderPoints::resampleEscaped(const GranularParticles& particles) {
   ++generation_;
   escaped_.resize(size());
+  // Each particle's factor once, not once per point (tens of points per particle).
+  inverseFactor_.resize(particles.size());
+  parallelFor(0, particles.size(), [&](std::size_t i) {
+    inverseFactor_[i] = Eigen::LLT<Eigen::Matrix3d>(shapeMatrix(particles.shape[i])).matrixL().solve(Eigen::Matrix3d::Identity());
+  });
   parallelFor(0, size(), [&](std::size_t p) {
     const std::uint32_t i = parents_[p];
-    const Eigen::Matrix3d a = shapeMatrix(particles.shape[i]);
     const Vec3 centre = particles.position[i].cast<double>();
-    escaped_[p] = mahalanobisDistance(a, positions_[p].cast<double>() - centre) > 1.0 + kEscapeMargin;
+    escaped_[p] = (inverseFactor_[i] * (positions_[p].cast<double>() - centre)).norm() > 1.0 + kEscapeMargin;
     if (escaped_[p]) {
       Rng rng = streamFor(p);
-      positions_[p] = (centre + sampleInEllipsoid(a, rng)).cast<float>();
+      positions_[p] = (centre + sampleInEllipsoid(shapeMatrix(particles.shape[i]), rng)).cast<float>();
     }
-  });
+  }, 4096);
   return static_cast<std::size_t>(parallelSum(size(), [&](std::size_t p) { return escaped_[p]; }));
 }
 

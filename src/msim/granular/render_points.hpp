@@ -1,7 +1,8 @@
 #pragma once
 // Render points of a granular material (Narain 2011 ch. 5.6, seed lines 1518-1520): every
-// simulation particle owns points sampled uniformly inside its ellipsoid; they are advected
-// passively with the grid velocity, handed to a child or the merged particle on split/merge, and
+// simulation particle owns points sampled uniformly inside its ellipsoid; they are carried
+// passively with the flow (the grid motion expanded to first order about their particle, the
+// map that also deforms its ellipsoid), handed to a child or the merged particle on split/merge, and
 // resampled inside their particle's ellipsoid when they leave it. Everything is O(points), parallel
 // and deterministic (each point draws from its own stream of core/rng.hpp).
 //
@@ -17,6 +18,7 @@
 #include "msim/core/mac_grid.hpp"
 #include "msim/core/rng.hpp"
 #include "msim/granular/granular_particles.hpp"
+#include "msim/granular/particle_advection.hpp"
 #include "msim/granular/split_merge.hpp"
 
 namespace msim::granular {
@@ -38,8 +40,9 @@ class RenderPoints {
 
   // Replaces every point: perParticle of them inside each particle.
   void sample(const GranularParticles& particles);
-  // Moves the points like the particles (advectPoints of particle_advection.hpp).
-  void advect(const MacGrid<3>& velocity, double dt, const MacGrid<3>* displacement = nullptr);
+  // Moves each point with its particle's motion of the step (carriedPosition of
+  // particle_advection.hpp; `motion` from advectParticles, one per particle).
+  void advect(std::span<const ParticleMotion> motion, double dt, const GridSpec<3>& domain);
   // After SplitMerge::apply: each point goes to the successor of its particle whose ellipsoid
   // holds it best (smallest Mahalanobis distance).
   void reassign(const GranularParticles& particles, std::span<const SplitMerge::Successors> successors);
@@ -59,6 +62,7 @@ class RenderPoints {
   std::vector<Vecf<3>> positions_;
   std::vector<std::uint32_t> parents_;
   std::vector<std::uint8_t> escaped_;
+  std::vector<Eigen::Matrix3d> inverseFactor_;  // per particle L^-1 with A = L L^T (resampleEscaped)
 };
 
 }  // namespace msim::granular
