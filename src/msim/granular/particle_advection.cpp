@@ -50,12 +50,6 @@ Eigen::Matrix3d deformShape(const Eigen::Matrix3d& a, const Eigen::Matrix3d& jac
   return f * a * f.transpose();
 }
 
-Vec3 clampIntoDomain(const GridSpec<3>& domain, const Vec3& x) {
-  const double eps = kBoundaryEpsilonCells * domain.dx;
-  const Vec3 lo = domain.origin.array() + eps, hi = domain.upper().array() - eps;
-  return x.cwiseMax(lo).cwiseMin(hi);
-}
-
 namespace {
 
 // The position after the density correction, before the velocity step.

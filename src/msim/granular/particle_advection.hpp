@@ -32,7 +32,12 @@ Eigen::Matrix3d deformShape(const Eigen::Matrix3d& a, const Eigen::Matrix3d& jac
 // Particles and points are kept inside the velocity grid's domain box, this many cells inside its
 // faces, so that every later transfer sees them within the grid.
 inline constexpr double kBoundaryEpsilonCells = 1e-3;
-Vec3 clampIntoDomain(const GridSpec<3>& domain, const Vec3& x);
+// Inline: it runs for every particle and render point of every step.
+inline Vec3 clampIntoDomain(const GridSpec<3>& domain, const Vec3& x) {
+  const double eps = kBoundaryEpsilonCells * domain.dx;
+  const Vec3 lo = domain.origin.array() + eps, hi = domain.upper().array() - eps;
+  return x.cwiseMax(lo).cwiseMin(hi);
+}
 
 // What one particle's step did, for the points it carries (render points): its position before
 // the step, its correction displacement, and the velocity and velocity gradient it moved with.

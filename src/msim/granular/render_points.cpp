@@ -75,16 +75,22 @@ std::size_t RenderPoints::resampleEscaped(const GranularParticles& particles) {
   escaped_.resize(size());
   // Each particle's factor once, not once per point (tens of points per particle).
   inverseFactor_.resize(particles.size());
+  // The test in single precision (the positions are floats; its relative error, ~1e-6, is far
+  // below kEscapeMargin).
   parallelFor(0, particles.size(), [&](std::size_t i) {
-    inverseFactor_[i] = Eigen::LLT<Eigen::Matrix3d>(shapeMatrix(particles.shape[i])).matrixL().solve(Eigen::Matrix3d::Identity());
+    inverseFactor_[i] = Eigen::LLT<Eigen::Matrix3d>(shapeMatrix(particles.shape[i]))
+                            .matrixL()
+                            .solve(Eigen::Matrix3d::Identity())
+                            .cast<float>();
   });
+  constexpr float kLimit2 = static_cast<float>((1.0 + kEscapeMargin) * (1.0 + kEscapeMargin));
   parallelFor(0, size(), [&](std::size_t p) {
     const std::uint32_t i = parents_[p];
-    const Vec3 centre = particles.position[i].cast<double>();
-    escaped_[p] = (inverseFactor_[i] * (positions_[p].cast<double>() - centre)).norm() > 1.0 + kEscapeMargin;
+    escaped_[p] = (inverseFactor_[i] * (positions_[p] - particles.position[i])).squaredNorm() > kLimit2;
     if (escaped_[p]) {
       Rng rng = streamFor(p);
-      positions_[p] = (centre + sampleInEllipsoid(shapeMatrix(particles.shape[i]), rng)).cast<float>();
+      positions_[p] =
+          (particles.position[i].cast<double>() + sampleInEllipsoid(shapeMatrix(particles.shape[i]), rng)).cast<float>();
     }
   }, 4096);
   return static_cast<std::size_t>(parallelSum(size(), [&](std::size_t p) { return escaped_[p]; }));

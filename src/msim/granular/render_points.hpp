@@ -62,7 +62,7 @@ class RenderPoints {
   std::vector<Vecf<3>> positions_;
   std::vector<std::uint32_t> parents_;
   std::vector<std::uint8_t> escaped_;
-  std::vector<Eigen::Matrix3d> inverseFactor_;  // per particle L^-1 with A = L L^T (resampleEscaped)
+  std::vector<Eigen::Matrix3f> inverseFactor_;  // per particle L^-1 with A = L L^T (resampleEscaped)
 };
 
 }  // namespace msim::granular
