@@ -100,7 +100,7 @@ int StressProblem::solve(numerics::BoundQpSettings settings, double absoluteFloo
   x = x.cwiseMax(lo).cwiseMin(hi);
   if ((found.last.array() < 0).any()) return 0;
   const double boxSize = (found.last - found.first + IVec3::Ones()).cast<double>().prod();
-  // The box's structured stencil is about three times cheaper per sample than the listed rows.
+  // The box's structured stencil is cheaper per sample than the listed rows (no indirection).
   if (static_cast<double>(found.free) < 0.5 * boxSize) return solveOnFreeSamples(found.free, settings, absoluteFloor);
   return solveOnBox(found.first, found.last, found.free, settings, absoluteFloor);
 }
@@ -117,10 +117,10 @@ int StressProblem::solveOnBox(const IVec3& first, const IVec3& last, std::size_t
   for (auto& l : boxLower) l.resize(m);
   boxDiagonal.resize(m);
   boxToLattice.resize(m);
-  boxB.resize(static_cast<Eigen::Index>(m));
-  boxLo.resize(static_cast<Eigen::Index>(m));
-  boxHi.resize(static_cast<Eigen::Index>(m));
-  boxX.resize(static_cast<Eigen::Index>(m));
+  subB.resize(static_cast<Eigen::Index>(m));
+  subLo.resize(static_cast<Eigen::Index>(m));
+  subHi.resize(static_cast<Eigen::Index>(m));
+  subX.resize(static_cast<Eigen::Index>(m));
   parallelForCells<3>(box, [&](const IVec3& c, std::size_t k) {
     const std::size_t q =
         (static_cast<std::size_t>(c[2] + first[2]) * lattice[1] + c[1] + first[1]) * lattice[0] + c[0] + first[0];
@@ -128,10 +128,10 @@ int StressProblem::solveOnBox(const IVec3& first, const IVec3& last, std::size_t
     for (int a = 0; a < 3; ++a) boxLower[a][k] = lower[a][q];
     boxDiagonal[k] = diagonal[q];
     const Eigen::Index e = static_cast<Eigen::Index>(k), f = static_cast<Eigen::Index>(q);
-    boxB[e] = b[f];
-    boxLo[e] = lo[f];
-    boxHi[e] = hi[f];
-    boxX[e] = x[f];
+    subB[e] = b[f];
+    subLo[e] = lo[f];
+    subHi[e] = hi[f];
+    subX[e] = x[f];
   });
   op.grid().assign(box, boxLower, boxDiagonal);
   op.bodies().resize(bodies.size());
@@ -150,12 +150,12 @@ int StressProblem::solveOnBox(const IVec3& first, const IVec3& last, std::size_t
       boxed.column.push_back(bodies[body].column[j]);
     }
   }
-  applyFloor(settings, absoluteFloor, freeCount, boxB.norm());
+  applyFloor(settings, absoluteFloor, freeCount, subB.norm());
   // MPRGP's built-in Jacobi preconditioning: MIC(0) in face (numerics/bound_qp_mic0) takes about
   // as many iterations here, and the box bounds change the face so often that its sequential
   // refactorisations made the friction solves 4x slower (sand bed 25 x 50 x 25: 1.25 -> 0.32 s).
-  const auto r = solver.solve(op, boxB, boxLo, boxHi, boxX, settings);
-  parallelFor(0, m, [&](std::size_t j) { x[static_cast<Eigen::Index>(boxToLattice[j])] = boxX[static_cast<Eigen::Index>(j)]; }, 4096);
+  const auto r = solver.solve(op, subB, subLo, subHi, subX, settings);
+  parallelFor(0, m, [&](std::size_t j) { x[static_cast<Eigen::Index>(boxToLattice[j])] = subX[static_cast<Eigen::Index>(j)]; }, 4096);
   return r.iterations;
 }
 
@@ -174,10 +174,10 @@ int StressProblem::solveOnFreeSamples(std::size_t freeCount, numerics::BoundQpSe
   const Eigen::Index m = static_cast<Eigen::Index>(freeCount);
   compact.rows.resize(freeCount);
   compact.diagonalValues.resize(freeCount);
-  boxB.resize(m);
-  boxLo.resize(m);
-  boxHi.resize(m);
-  boxX.resize(m);
+  subB.resize(m);
+  subLo.resize(m);
+  subHi.resize(m);
+  subX.resize(m);
   const std::array<std::size_t, 3> stride = {1, static_cast<std::size_t>(lattice[0]),
                                              static_cast<std::size_t>(lattice[0]) * static_cast<std::size_t>(lattice[1])};
   parallelFor(0, freeCount, [&](std::size_t i) {
@@ -206,10 +206,10 @@ int StressProblem::solveOnFreeSamples(std::size_t freeCount, numerics::BoundQpSe
     }
     compact.diagonalValues[i] = diagonal[q];
     const Eigen::Index e = static_cast<Eigen::Index>(i), f = static_cast<Eigen::Index>(q);
-    boxB[e] = rhs;
-    boxLo[e] = lo[f];
-    boxHi[e] = hi[f];
-    boxX[e] = x[f];
+    subB[e] = rhs;
+    subLo[e] = lo[f];
+    subHi[e] = hi[f];
+    subX[e] = x[f];
   }, 1024);
   // Bodies: the columns of the free samples; the held samples' share of J x moves to b.
   compact.bodies.resize(bodies.size());
@@ -231,12 +231,12 @@ int StressProblem::solveOnFreeSamples(std::size_t freeCount, numerics::BoundQpSe
     }
     const Vec6 f = compact.bodyWeight * (all.inverseMass * held);
     for (std::size_t k = 0; k < listed.sample.size(); ++k)
-      boxB[static_cast<Eigen::Index>(listed.sample[k])] -= listed.column[k].dot(f);
+      subB[static_cast<Eigen::Index>(listed.sample[k])] -= listed.column[k].dot(f);
   }
-  applyFloor(settings, absoluteFloor, freeCount, boxB.norm());
-  const auto r = solver.solve(compact, boxB, boxLo, boxHi, boxX, settings);
+  applyFloor(settings, absoluteFloor, freeCount, subB.norm());
+  const auto r = solver.solve(compact, subB, subLo, subHi, subX, settings);
   parallelFor(0, freeCount, [&](std::size_t i) {
-    x[static_cast<Eigen::Index>(freeToLattice[i])] = boxX[static_cast<Eigen::Index>(i)];
+    x[static_cast<Eigen::Index>(freeToLattice[i])] = subX[static_cast<Eigen::Index>(i)];
   }, 4096);
   return r.iterations;
 }

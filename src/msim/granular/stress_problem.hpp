@@ -42,8 +42,7 @@ struct BodyColumns {
 };
 
 // The bodies' part of an operator, V_c sum_b J_b^T M_b^-1 J_b times `weight`: y += it x, d += its
-// diagonal, and a Gershgorin bound of its norm (row q sums |c_q^T M^-1 c_q'| <= |c_q| |M^-1|
-// sum |c_q'|).
+// diagonal, and a bound of its norm (the sum of the bodies' exact norms).
 void addBodyProducts(const std::vector<BodyColumns>& bodies, double weight, const Eigen::VectorXd& x,
                      Eigen::VectorXd& y);
 void addBodyDiagonal(const std::vector<BodyColumns>& bodies, double weight, Eigen::VectorXd& d);
@@ -102,14 +101,14 @@ struct StressProblem {
   std::vector<double> diagonal, partDiagonal;
   std::vector<BodyColumns> bodies;  // J of each body, in whole-lattice sample indices
   Eigen::VectorXd b, lo, hi, x;     // whole lattice
-  // The solve runs on a box of the lattice (see solve()).
-  CoupledOperator op;
-  CompactCoupledOperator compact;  // when few samples of the box are free (see solve())
+  // The solve runs on a box of the lattice or on the list of its free samples (see solve()).
+  CoupledOperator op;               // box
+  CompactCoupledOperator compact;   // list
   numerics::BoundQpSolver solver;
   std::array<std::vector<double>, 3> boxLower;
   std::vector<double> boxDiagonal;
   std::vector<std::size_t> boxToLattice;
-  Eigen::VectorXd boxB, boxLo, boxHi, boxX;
+  Eigen::VectorXd subB, subLo, subHi, subX;  // the restricted problem (box or list)
   std::vector<std::uint32_t> freeToLattice;
   std::vector<std::int32_t> latticeToFree;  // -1 for samples held at a bound
 
