@@ -88,6 +88,7 @@ void BM_CollisionResolutionStep(benchmark::State& state) {
   }
   state.counters["bucketings"] = resolver.lastBucketings();
   state.counters["sweeps"] = resolver.lastSweeps();
+  state.counters["local"] = resolver.lastLocalSweeps();
   state.counters["redone"] = resolver.lastRedoneSweeps();
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(n));
 }

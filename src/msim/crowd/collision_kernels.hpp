@@ -1,14 +1,13 @@
 #pragma once
 // The inner loops of pairwise collision resolution (collision_resolution.cpp), on the cell-ordered
 // structure-of-arrays copy of the agents: Jacobi pushes (scalar and AVX2, eight neighbours at a
-// time), the candidate search that lists Gauss-Seidel pairs, the Gauss-Seidel pair projections,
-// and the hashed direction that separates coincident agents. Internal to the resolver; kept apart so that file holds the algorithm, this one the
-// arithmetic.
+// time), the Gauss-Seidel pair projections (over slot ranges, eight at a time, and over a list of
+// partners), and the hashed direction that separates coincident agents. Internal to the resolver;
+// kept apart so that file holds the algorithm, this one the arithmetic.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <vector>
 
 #if defined(__AVX2__)
 #include <immintrin.h>
@@ -105,29 +104,6 @@ inline float sum8(__m256 v) {
 }
 #endif
 
-// Appends to `out` the slots j in [lo, hi) closer to (xi, yi) than sqrt(cut2): the candidate pairs
-// of a Gauss-Seidel list. AVX2: eight slots at a time (reads up to 7 slots past hi, masked off).
-inline void appendWithin(const float* xs, const float* ys, std::uint32_t lo, std::uint32_t hi, float xi, float yi,
-                         float cut2, std::vector<std::uint32_t>& out) {
-#if defined(__AVX2__)
-  const __m256 xv = _mm256_set1_ps(xi), yv = _mm256_set1_ps(yi), cv = _mm256_set1_ps(cut2);
-  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-  for (std::uint32_t j = lo; j < hi; j += 8) {
-    const __m256 valid = _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(static_cast<int>(hi - j)), lane));
-    const __m256 ex = _mm256_sub_ps(xv, _mm256_loadu_ps(xs + j)), ey = _mm256_sub_ps(yv, _mm256_loadu_ps(ys + j));
-    const __m256 d2 = _mm256_add_ps(_mm256_mul_ps(ex, ex), _mm256_mul_ps(ey, ey));
-    for (unsigned m = static_cast<unsigned>(_mm256_movemask_ps(_mm256_and_ps(valid, _mm256_cmp_ps(d2, cv, _CMP_LT_OQ))));
-         m != 0; m &= m - 1)
-      out.push_back(j + static_cast<std::uint32_t>(__builtin_ctz(m)));
-  }
-#else
-  for (std::uint32_t j = lo; j < hi; ++j) {
-    const float ex = xi - xs[j], ey = yi - ys[j];
-    if (ex * ex + ey * ey < cut2) out.push_back(j);
-  }
-#endif
-}
-
 // 1 / sqrt(x) for x > 0: the hardware estimate and one Newton step (relative error ~1e-7, a third
 // of the cost of sqrt + div).
 inline float inverseSqrt(float x) {
@@ -143,41 +119,42 @@ inline float inverseSqrt(float x) {
 struct SweepSlots {
   float* x;
   float* y;
-  // Per slot: the largest squared distance from its listed position it has been at in the sweep.
+  // Per slot: the largest squared distance from its bucketed position it has been at in the sweep.
   float* far;
-  const Vec2f* listed;  // positions when the pairs were listed
+  const float* bucketX;  // positions when bucketed (padded like x and y)
+  const float* bucketY;
   const float* radius;
   const float* yield;
   const std::uint32_t* agent;  // agent index (hashes the direction of coincident pairs)
 };
 
-// Corrections of agent i against its coincident partners (closer than 1e-7 target), along a
-// direction hashed from the pair; moves the partners and returns i's share. Rare, and out of line
-// so that the loop of projectPairs keeps its values in registers (a call there spills them).
-[[gnu::cold, gnu::noinline]] inline Vec2f coincidentCorrections(const SweepSlots& a, std::uint32_t i,
-                                                                 const std::uint32_t* js, std::uint32_t count,
-                                                                 float s) {
+// Corrections of agent i against its coincident partners (closer than 1e-7 target) among the
+// slots forEachPartner(f) enumerates, along a direction hashed from the pair; moves the partners
+// and returns i's share. Rare, and out of line so that the loops of projectPairs and
+// projectRanges keep their values in registers (a call there spills them).
+template <typename ForEachPartner>
+[[gnu::cold, gnu::noinline]] Vec2f coincidentCorrections(const SweepSlots& a, std::uint32_t i,
+                                                          const ForEachPartner& forEachPartner, float s) {
   Vec2f share = Vec2f::Zero();
   const float xi = a.x[i], yi = a.y[i], ri = a.radius[i], yieldI = a.yield[i];
-  for (std::uint32_t q = 0; q < count; ++q) {
-    const std::uint32_t j = js[q];
+  forEachPartner([&](std::uint32_t j) {
     const float ex = xi - a.x[j], ey = yi - a.y[j];
     const float target = s * (ri + a.radius[j]);
     const float d2 = ex * ex + ey * ey;
-    if (d2 > 1e-14f * target * target) continue;
+    if (j == i || d2 > 1e-14f * target * target) return;
     const Vec2f c = (target - std::sqrt(d2)) * coincidentDirection(a.agent[i], a.agent[j]);
     const float si = yieldI < 0.75f ? a.yield[j] : 0.0f;
     const float sj = yieldI * (2.0f - 2.0f * a.yield[j]);
     share += si * c;
     a.x[j] -= sj * c.x();
     a.y[j] -= sj * c.y();
-    const float lx = a.x[j] - a.listed[j].x(), ly = a.y[j] - a.listed[j].y();
+    const float lx = a.x[j] - a.bucketX[j], ly = a.y[j] - a.bucketY[j];
     a.far[j] = std::max(a.far[j], lx * lx + ly * ly);
-  }
+  });
   return share;
 }
 
-// Gauss-Seidel projections of agent i's listed pairs (i, js[q]): each pair closer than target =
+// Gauss-Seidel projections of agent i's pairs with the partners js[q]: each pair closer than target =
 // s (r_i + r_j) is pushed apart to target along its centre line, i taking si = yield_j (0 if i is
 // scripted) of the correction and j taking sj = yield_i (2 - 2 yield_j) (0 if j is scripted):
 // equal and opposite for two movable agents. Each j is moved in place as it comes; i's shares are
@@ -188,7 +165,8 @@ inline void projectPairs(const SweepSlots& a, std::uint32_t i, const std::uint32
   float* __restrict x = a.x;
   float* __restrict y = a.y;
   float* __restrict far = a.far;
-  const Vec2f* __restrict listed = a.listed;
+  const float* __restrict bucketX = a.bucketX;
+  const float* __restrict bucketY = a.bucketY;
   const float* __restrict radius = a.radius;
   const float* __restrict yield = a.yield;
   const float xi = x[i], yi = y[i], ri = radius[i], yieldI = yield[i];
@@ -196,7 +174,7 @@ inline void projectPairs(const SweepSlots& a, std::uint32_t i, const std::uint32
   auto moved = [&](std::uint32_t k, float xk, float yk) {
     x[k] = xk;
     y[k] = yk;
-    const float lx = xk - listed[k].x(), ly = yk - listed[k].y();
+    const float lx = xk - bucketX[k], ly = yk - bucketY[k];
     far[k] = std::max(far[k], lx * lx + ly * ly);
   };
   float dx = 0.0f, dy = 0.0f;
@@ -220,10 +198,111 @@ inline void projectPairs(const SweepSlots& a, std::uint32_t i, const std::uint32
     if (sj > 0.0f) moved(j, xj - sj * f * ex, yj - sj * f * ey);
   }
   if (coincident) [[unlikely]] {
-    const Vec2f share = coincidentCorrections(a, i, js, count, s);
+    const Vec2f share = coincidentCorrections(
+        a, i, [&](const auto& f) { for (std::uint32_t q = 0; q < count; ++q) f(js[q]); }, s);
     dx += share.x();
     dy += share.y();
   }
   if (dx != 0.0f || dy != 0.0f) moved(i, xi + dx, yi + dy);
+}
+
+// Gauss-Seidel projections of agent i against every slot of the ranges [lo[q], hi[q]), q < count
+// (no j == i among them): the pairs of projectPairs without a list, found by testing the
+// distances at the current positions. Equal to projectPairs over the same slots: i's shares are
+// taken from its start position and applied at the end, so its partners do not depend on each
+// other and eight are projected at a time (AVX2; reads up to 7 slots past a range, masked off).
+inline void projectRanges(const SweepSlots& a, std::uint32_t i, const std::uint32_t* lo, const std::uint32_t* hi,
+                          int count, float s) {
+  const float xi = a.x[i], yi = a.y[i], ri = a.radius[i], yieldI = a.yield[i];
+  const bool movableI = yieldI < 0.75f;
+  float dx = 0.0f, dy = 0.0f;
+  bool coincident = false;
+#if defined(__AVX2__)
+  float* __restrict x = a.x;
+  float* __restrict y = a.y;
+  float* __restrict far = a.far;
+  const __m256 xv = _mm256_set1_ps(xi), yv = _mm256_set1_ps(yi), rv = _mm256_set1_ps(ri), sv = _mm256_set1_ps(s);
+  const __m256 siMask = movableI ? _mm256_castsi256_ps(_mm256_set1_epi32(-1)) : _mm256_setzero_ps();
+  const __m256 yieldIv = _mm256_set1_ps(yieldI), two = _mm256_set1_ps(2.0f), one = _mm256_set1_ps(1.0f);
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  __m256 ax = _mm256_setzero_ps(), ay = _mm256_setzero_ps();
+  for (int r = 0; r < count; ++r)
+    for (std::uint32_t j = lo[r]; j < hi[r]; j += 8) {
+      const __m256 valid =
+          _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(static_cast<int>(hi[r] - j)), lane));
+      const __m256 xj = _mm256_loadu_ps(x + j), yj = _mm256_loadu_ps(y + j);
+      const __m256 ex = _mm256_sub_ps(xv, xj), ey = _mm256_sub_ps(yv, yj);
+      const __m256 d2 = _mm256_add_ps(_mm256_mul_ps(ex, ex), _mm256_mul_ps(ey, ey));
+      const __m256 target = _mm256_mul_ps(sv, _mm256_add_ps(rv, _mm256_loadu_ps(a.radius + j)));
+      const __m256 t2 = _mm256_mul_ps(target, target);
+      const __m256 in = _mm256_and_ps(valid, _mm256_cmp_ps(d2, t2, _CMP_LT_OQ));
+      if (_mm256_testz_ps(in, in)) continue;
+      const __m256 apart = _mm256_cmp_ps(d2, _mm256_mul_ps(_mm256_set1_ps(1e-14f), t2), _CMP_GT_OQ);
+      coincident |= !_mm256_testz_ps(in, _mm256_andnot_ps(apart, in));
+      const __m256 m = _mm256_and_ps(in, apart);
+      // (target - dist) / dist with 1 / dist as in inverseSqrt (same rounding as projectPairs).
+      const __m256 est = _mm256_rsqrt_ps(d2);
+      const __m256 inv = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(0.5f), est),
+                                       _mm256_sub_ps(_mm256_set1_ps(3.0f), _mm256_mul_ps(_mm256_mul_ps(d2, est), est)));
+      const __m256 f = _mm256_sub_ps(_mm256_mul_ps(target, inv), one);
+      const __m256 yieldJ = _mm256_loadu_ps(a.yield + j);
+      const __m256 si = _mm256_and_ps(siMask, yieldJ);
+      const __m256 sj = _mm256_mul_ps(yieldIv, _mm256_sub_ps(two, _mm256_mul_ps(two, yieldJ)));
+      ax = _mm256_add_ps(ax, _mm256_and_ps(m, _mm256_mul_ps(_mm256_mul_ps(si, f), ex)));
+      ay = _mm256_add_ps(ay, _mm256_and_ps(m, _mm256_mul_ps(_mm256_mul_ps(si, f), ey)));
+      // The partners move now (in place), and their farthest distance from the bucketed positions.
+      const __m256 nx = _mm256_sub_ps(xj, _mm256_mul_ps(_mm256_mul_ps(sj, f), ex));
+      const __m256 ny = _mm256_sub_ps(yj, _mm256_mul_ps(_mm256_mul_ps(sj, f), ey));
+      const __m256i store = _mm256_castps_si256(m);
+      _mm256_maskstore_ps(x + j, store, nx);
+      _mm256_maskstore_ps(y + j, store, ny);
+      const __m256 lx = _mm256_sub_ps(nx, _mm256_loadu_ps(a.bucketX + j));
+      const __m256 ly = _mm256_sub_ps(ny, _mm256_loadu_ps(a.bucketY + j));
+      const __m256 e2 = _mm256_add_ps(_mm256_mul_ps(lx, lx), _mm256_mul_ps(ly, ly));
+      _mm256_maskstore_ps(far + j, store, _mm256_max_ps(_mm256_loadu_ps(far + j), e2));
+    }
+  dx = sum8(ax);
+  dy = sum8(ay);
+#else
+  for (int r = 0; r < count; ++r)
+    for (std::uint32_t j = lo[r]; j < hi[r]; ++j) {
+      const float ex = xi - a.x[j], ey = yi - a.y[j];
+      const float target = s * (ri + a.radius[j]);
+      const float d2 = ex * ex + ey * ey, t2 = target * target;
+      if (d2 >= t2) continue;
+      if (!(d2 > 1e-14f * t2)) {
+        coincident = true;
+        continue;
+      }
+      const float f = target * inverseSqrt(d2) - 1.0f;
+      const float si = movableI ? a.yield[j] : 0.0f;
+      const float sj = yieldI * (2.0f - 2.0f * a.yield[j]);
+      dx += si * f * ex;
+      dy += si * f * ey;
+      if (sj > 0.0f) {
+        a.x[j] -= sj * f * ex;
+        a.y[j] -= sj * f * ey;
+        const float lx = a.x[j] - a.bucketX[j], ly = a.y[j] - a.bucketY[j];
+        a.far[j] = std::max(a.far[j], lx * lx + ly * ly);
+      }
+    }
+#endif
+  if (coincident) [[unlikely]] {
+    const Vec2f share = coincidentCorrections(
+        a, i,
+        [&](const auto& f) {
+          for (int r = 0; r < count; ++r)
+            for (std::uint32_t j = lo[r]; j < hi[r]; ++j) f(j);
+        },
+        s);
+    dx += share.x();
+    dy += share.y();
+  }
+  if (dx != 0.0f || dy != 0.0f) {
+    a.x[i] = xi + dx;
+    a.y[i] = yi + dy;
+    const float lx = a.x[i] - a.bucketX[i], ly = a.y[i] - a.bucketY[i];
+    a.far[i] = std::max(a.far[i], lx * lx + ly * ly);
+  }
 }
 }  // namespace msim::crowd::collision_kernels

@@ -15,12 +15,15 @@ namespace msim::crowd {
 using namespace collision_kernels;
 
 namespace {
-// Skins on top of the interaction range (fractions of it). Gauss-Seidel: pairs are listed up to
-// 1.5 ranges apart: in the 100k circle (0.68 rho_max) 2.3 listed pairs per agent, about one of
-// them in range; after 6 sweeps the farthest agent is about 0.9 of the allowed 0.25 range from
-// where it was listed, so one list per call most of the time. Jacobi: cells 1.5 ranges wide.
-constexpr float kListSkin = 0.5f;
+// Skins on top of the interaction range (fractions of it): cells 1.5 ranges wide, so agents may
+// move a quarter range from where they were bucketed before a pair within range could lie beyond
+// the neighbouring cells. In the 100k circle the farthest agent gets to about 0.9 of that in a
+// call, so one bucketing per call most of the time.
 constexpr float kCellSkin = 0.5f;
+// Gauss-Seidel sweeps after the first project the whole list while more than one agent in
+// kLocalShare is active, else only around the active agents: serially, at about 15 times the
+// cost per agent of a whole sweep on the list over two cores (0.45 us against 30 ns, circle 100k).
+constexpr std::size_t kLocalShare = 16;
 }  // namespace
 
 void CollisionResolver::bucket(const Agents& agents, float cellSize) {
@@ -30,10 +33,12 @@ void CollisionResolver::bucket(const Agents& agents, float cellSize) {
   const std::span<const std::uint32_t> order = grid_.cellOrder();
   const std::span<const Vec2f> sorted = grid_.sortedPoints();
   // Padding: far away (the squared distance overflows to inf), so never within range.
-  for (auto* v : {&x_, &y_, &nextX_, &nextY_, &prevX_, &prevY_}) v->resize(n + kPad, 1e30f);
+  for (auto* v : {&x_, &y_, &nextX_, &nextY_, &prevX_, &prevY_, &bucketX_, &bucketY_}) v->resize(n + kPad, 1e30f);
   for (auto* v : {&radius_, &yield_, &tmpRadius_, &tmpYield_}) v->resize(n + kPad, 0.0f);
-  far_.resize(n);
-  bucketed_.resize(n);
+  far_.resize(n + kPad, 0.0f);
+  for (auto* v : {&checkX_, &checkY_}) v->resize(n);
+  active_.resize(n);
+  touchedMark_.assign(n, 0);
   scripted_.resize(n);
   agent_.resize(n);
   parallelFor(
@@ -41,9 +46,8 @@ void CollisionResolver::bucket(const Agents& agents, float cellSize) {
       [&](std::size_t k) {
         const std::uint32_t i = order[k];
         agent_[k] = i;
-        bucketed_[k] = sorted[k];
-        x_[k] = sorted[k].x();
-        y_[k] = sorted[k].y();
+        x_[k] = bucketX_[k] = sorted[k].x();
+        y_[k] = bucketY_[k] = sorted[k].y();
         radius_[k] = agents.radius[i];
         scripted_[k] = agents.model[i] == AgentModel::Scripted ? 1 : 0;
         yield_[k] = scripted_[k] ? 1.0f : 0.5f;
@@ -68,9 +72,8 @@ void CollisionResolver::rebucket(float cellSize) {
       0, n,
       [&](std::size_t k) {
         const std::uint32_t old = from[k];
-        bucketed_[k] = sorted[k];
-        x_[k] = sorted[k].x();
-        y_[k] = sorted[k].y();
+        x_[k] = bucketX_[k] = sorted[k].x();
+        y_[k] = bucketY_[k] = sorted[k].y();
         tmpRadius_[k] = radius_[old];
         tmpYield_[k] = yield_[old];
         tmpScripted_[k] = scripted_[old];
@@ -87,17 +90,18 @@ void CollisionResolver::resolve(Agents& agents, const StaticObstacles& obstacles
                                 const CollisionResolutionParams& params) {
   bucketings_ = 0;
   sweeps_ = 0;
+  localSweeps_ = 0;
   redone_ = 0;
   const std::size_t n = agents.size();
   if (n == 0 || params.iterations <= 0) return;
   const float rmax = static_cast<float>(parallelMax(n, [&](std::size_t i) { return agents.radius[i]; }));
   if (!(rmax > 0.0f)) return;
-  // Interaction range: no pair farther apart than this is pushed. The pairs are listed (the cells
-  // made) with a skin on top, so agents may move a little before they have to be redone.
+  // Interaction range: no pair farther apart than this is pushed. The cells are made with a skin
+  // on top, so agents may move a little before they have to be bucketed again.
   const float range = params.separation * 2.0f * rmax;
   const float tolerance = params.tolerance * 2.0f * rmax;
   const bool gaussSeidel = params.sweeps == CollisionResolutionParams::Sweeps::GaussSeidel;
-  bucket(agents, range * (1.0f + (gaussSeidel ? kListSkin : kCellSkin)));
+  bucket(agents, range * (1.0f + kCellSkin));
   if (gaussSeidel)
     resolveGaussSeidel(obstacles, domain, params, range, tolerance * tolerance);
   else
@@ -107,108 +111,113 @@ void CollisionResolver::resolve(Agents& agents, const StaticObstacles& obstacles
 
 void CollisionResolver::resolveGaussSeidel(const StaticObstacles& obstacles, const DomainBox& domain,
                                            const CollisionResolutionParams& params, float range, float tolerance2) {
-  const float cut = range * (1.0f + kListSkin);
-  // A pair within range at some moment of a sweep was within range + 2 F when listed, F bounding
-  // every agent's distance from its listed position during the sweep: it is in the list while
-  // that is below the cut (with a margin for round-off).
-  auto tooFar = [&](float f) { return range + 2.0f * f * 1.001f + 1e-6f * range >= cut; };
-  auto relist = [&] {
-    rebucket(cut);
-    listPairs(cut);
+  const float cellSize = range * (1.0f + kCellSkin), s = params.separation;
+  const std::size_t n = agent_.size();
+  // A pair within range at some moment of a sweep was within range + 2 F when bucketed, F bounding
+  // every agent's distance from its bucketed position during the sweep: its agents are in
+  // neighbouring cells while that is below the cell size (with a margin for round-off).
+  auto tooFar = [&](float f) { return range + 2.0f * f * 1.001f + 1e-6f * range >= cellSize; };
+  auto restoreSweepStart = [&] {
+    std::copy(prevX_.begin(), prevX_.begin() + static_cast<std::ptrdiff_t>(n), x_.begin());
+    std::copy(prevY_.begin(), prevY_.begin() + static_cast<std::ptrdiff_t>(n), y_.begin());
   };
-  listPairs(cut);
-  bool fresh = true;  // the first sweep on the current list
-  float start = 0.0f;  // largest distance from the listed positions at the start of the sweep
-  for (int it = 0; it < params.iterations; ++it) {
-    SweepMoves moves = gaussSeidelSweep(obstacles, domain, params.separation);
-    // A pair may have been missed: undo the sweep and redo it on a new list. (Not on a new list:
-    // there a single sweep moved that far, from deep overlaps, and is kept.)
-    if (!fresh && tooFar(std::sqrt(moves.far2))) {
-      ++redone_;
-      std::copy(prevX_.begin(), prevX_.begin() + static_cast<std::ptrdiff_t>(agent_.size()), x_.begin());
-      std::copy(prevY_.begin(), prevY_.begin() + static_cast<std::ptrdiff_t>(agent_.size()), y_.begin());
-      relist();
-      start = 0.0f;
-      moves = gaussSeidelSweep(obstacles, domain, params.separation);
-    }
-    fresh = false;
+  auto wholeSweep = [&] {
+    const SweepMoves moves = gaussSeidelSweep(obstacles, domain, s, tolerance2);
     prevX_.swap(nextX_);  // the end positions start the next sweep
     prevY_.swap(nextY_);
-    ++sweeps_;
-    // Converged: the last sweep moved nobody by more than the tolerance (the max is exact whatever
-    // the thread count, so the number of sweeps is deterministic too).
-    if (it + 1 == params.iterations || moves.sweep2 <= tolerance2) break;
-    // Gauss-Seidel corrections shrink from sweep to sweep: expect the next one to carry agents
-    // beyond where this one left them by at most half as far as this one carried them beyond
-    // where it started, and re-list before it if that would not fit. (Guessing short costs a
-    // redone sweep, guessing long a list.)
+    return moves;
+  };
+  // A whole sweep on new buckets (the first sweep on them is kept whatever it moved: there a
+  // single sweep moved that far, from deep overlaps).
+  auto sweepOnNewBuckets = [&] {
+    startSweeps();
+    return wholeSweep();
+  };
+  SweepMoves moves = sweepOnNewBuckets();
+  ++sweeps_;
+  float start = 0.0f;  // largest distance from the bucketed positions at the start of the sweep
+  bool fresh = true;   // the last sweep was the first on its buckets
+  bool activeListed = false;  // activeSlots_ holds the active slots (a local sweep listed them)
+  // Converged: no agent moved more than the tolerance since its pairs were last projected (the
+  // count does not depend on the thread count, so the number of sweeps is deterministic too).
+  while (sweeps_ < params.iterations && moves.active > 0) {
     const float end = std::sqrt(moves.end2);
+    if (moves.active * kLocalShare <= n && tolerance2 > 0.0f) {
+      if (!activeListed) gatherActive();
+      moves = localSweep(obstacles, domain, s, range, tolerance2, moves.end2);
+      activeListed = true;
+      ++localSweeps_;
+      ++sweeps_;
+      fresh = false;
+      start = std::sqrt(moves.end2);
+      continue;
+    }
+    activeListed = false;
+    // Gauss-Seidel corrections shrink from sweep to sweep: expect the next one to carry agents
+    // beyond where the last one left them by at most half as far as that one carried them beyond
+    // where it started, and bucket again before it if that would not fit. (Guessing short costs a
+    // redone sweep, guessing long a bucketing.)
     const float excursion = std::max(std::sqrt(moves.far2) - start, 0.0f);
     start = end;
     if (tooFar(end + 0.5f * excursion)) {
-      relist();
+      rebucket(cellSize);
+      moves = sweepOnNewBuckets();
       fresh = true;
       start = 0.0f;
+      ++sweeps_;
+      continue;
     }
+    moves = gaussSeidelSweep(obstacles, domain, s, tolerance2);
+    if (!fresh && tooFar(std::sqrt(moves.far2))) {  // a pair may have been missed: redo on new buckets
+      ++redone_;
+      restoreSweepStart();
+      rebucket(cellSize);
+      moves = sweepOnNewBuckets();
+      fresh = true;
+      start = 0.0f;
+    } else {
+      prevX_.swap(nextX_);
+      prevY_.swap(nextY_);
+      fresh = false;
+    }
+    ++sweeps_;
   }
 }
 
-void CollisionResolver::listPairs(float cut) {
-  const int ny = grid_.cellsY();
+void CollisionResolver::startSweeps() {
   const std::size_t n = agent_.size();
-  rowPairs_.resize(static_cast<std::size_t>(ny));  // keeps the rows' capacity
-  const int grain = static_cast<int>(std::max<std::size_t>(1, static_cast<std::size_t>(ny) * 2048 / n));
-  tbb::parallel_for(tbb::blocked_range<int>(0, ny, grain), [&](const tbb::blocked_range<int>& r) {
-    for (int cy = r.begin(); cy != r.end(); ++cy) listRow(cy, cut * cut);
-  });
-  // The sweeps start from the listed positions.
-  std::fill(far_.begin(), far_.end(), 0.0f);
+  std::fill(far_.begin(), far_.begin() + static_cast<std::ptrdiff_t>(n), 0.0f);
   std::copy(x_.begin(), x_.begin() + static_cast<std::ptrdiff_t>(n), prevX_.begin());
   std::copy(y_.begin(), y_.begin() + static_cast<std::ptrdiff_t>(n), prevY_.begin());
 }
 
-void CollisionResolver::listRow(int cy, float cut2) {
-  const int nx = grid_.cellsX(), ny = grid_.cellsY();
-  const std::uint32_t* start = grid_.cellStarts().data();
-  std::vector<std::uint32_t>& out = rowPairs_[static_cast<std::size_t>(cy)];
-  out.clear();
-  for (int cx = 0; cx < nx; ++cx) {
-    const std::size_t c = static_cast<std::size_t>(cy) * nx + cx;
-    const std::uint32_t first = start[c], last = start[c + 1];
-    if (first == last) continue;
-    // Partners: the later slots of the cell and those of the cell to its right (contiguous), and
-    // the three cells above (contiguous): every pair once, within two rows.
-    const std::uint32_t endSame = start[c + (cx + 1 < nx ? 2 : 1)];
-    std::uint32_t lo2 = 0, hi2 = 0;
-    if (cy + 1 < ny) {
-      const std::size_t row = static_cast<std::size_t>(cy + 1) * nx;
-      lo2 = start[row + std::max(cx - 1, 0)];
-      hi2 = start[row + std::min(cx + 1, nx - 1) + 1];
-    }
-    for (std::uint32_t i = first; i < last; ++i) {
-      const std::size_t at = out.size();
-      out.push_back(0);
-      appendWithin(x_.data(), y_.data(), i + 1, endSame, x_[i], y_[i], cut2, out);
-      appendWithin(x_.data(), y_.data(), lo2, hi2, x_[i], y_[i], cut2, out);
-      out[at] = static_cast<std::uint32_t>(out.size() - at - 1);
-    }
-  }
-}
-
 CollisionResolver::SweepMoves CollisionResolver::gaussSeidelSweep(const StaticObstacles& obstacles,
-                                                                  const DomainBox& domain, float s) {
+                                                                  const DomainBox& domain, float s, float tolerance2) {
   const int nx = grid_.cellsX(), ny = grid_.cellsY();
   const std::uint32_t* start = grid_.cellStarts().data();
   const std::size_t n = agent_.size();
-  const SweepSlots slots{x_.data(),      y_.data(),     far_.data(), bucketed_.data(),
-                         radius_.data(), yield_.data(), agent_.data()};
+  const SweepSlots slots{x_.data(),      y_.data(),     far_.data(),   bucketX_.data(),
+                         bucketY_.data(), radius_.data(), yield_.data(), agent_.data()};
+  // Each pair once, owned by its first agent in cell order: an agent's partners are the later
+  // slots of its cell and those of the cell to its right (one contiguous range), and the slots of
+  // the three cells above (another).
   auto sweepRow = [&](int cy) {
-    const std::uint32_t* p = rowPairs_[static_cast<std::size_t>(cy)].data();
-    const std::uint32_t last = start[static_cast<std::size_t>(cy + 1) * nx];
-    for (std::uint32_t i = start[static_cast<std::size_t>(cy) * nx]; i < last; ++i) {
-      const std::uint32_t count = *p++;
-      projectPairs(slots, i, p, count, s);
-      p += count;
+    for (int cx = 0; cx < nx; ++cx) {
+      const std::size_t c = static_cast<std::size_t>(cy) * nx + cx;
+      const std::uint32_t first = start[c], last = start[c + 1];
+      if (first == last) continue;
+      std::uint32_t lo[2], hi[2];
+      hi[0] = start[c + (cx + 1 < nx ? 2 : 1)];
+      lo[1] = hi[1] = 0;
+      if (cy + 1 < ny) {
+        const std::size_t row = static_cast<std::size_t>(cy + 1) * nx;
+        lo[1] = start[row + std::max(cx - 1, 0)];
+        hi[1] = start[row + std::min(cx + 1, nx - 1) + 1];
+      }
+      for (std::uint32_t i = first; i < last; ++i) {
+        lo[0] = i + 1;
+        projectRanges(slots, i, lo, hi, 2, s);
+      }
     }
   };
   // A row's pairs reach into that row and the one above only, so the even rows can be done in
@@ -240,15 +249,16 @@ CollisionResolver::SweepMoves CollisionResolver::gaussSeidelSweep(const StaticOb
   return tbb::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, n, 4096), SweepMoves{},
       [&](const tbb::blocked_range<std::size_t>& r, SweepMoves w) {
-        clampIntoDomain(r.begin(), r.end(), domain, w);
+        clampIntoDomain(r.begin(), r.end(), domain, tolerance2, w);
         return w;
       },
       [](const SweepMoves& a, const SweepMoves& b) {
-        return SweepMoves{std::max(a.far2, b.far2), std::max(a.end2, b.end2), std::max(a.sweep2, b.sweep2)};
+        return SweepMoves{std::max(a.far2, b.far2), std::max(a.end2, b.end2), a.active + b.active};
       });
 }
 
-void CollisionResolver::clampIntoDomain(std::size_t k0, std::size_t k1, const DomainBox& domain, SweepMoves& w) {
+void CollisionResolver::clampIntoDomain(std::size_t k0, std::size_t k1, const DomainBox& domain, float tolerance2,
+                                        SweepMoves& w) {
   // Branch-free, so that it vectorizes.
   float* __restrict xs = x_.data();
   float* __restrict ys = y_.data();
@@ -259,26 +269,102 @@ void CollisionResolver::clampIntoDomain(std::size_t k0, std::size_t k1, const Do
   const float* __restrict startY = prevY_.data();
   const float* __restrict rad = radius_.data();
   const std::uint8_t* __restrict scripted = scripted_.data();
-  const Vec2f* __restrict bucketed = bucketed_.data();
+  const float* __restrict bucketX = bucketX_.data();
+  const float* __restrict bucketY = bucketY_.data();
+  float* __restrict checkX = checkX_.data();
+  float* __restrict checkY = checkY_.data();
+  std::uint8_t* __restrict active = active_.data();
   const float midX = 0.5f * (domain.lo.x() + domain.hi.x()), midY = 0.5f * (domain.lo.y() + domain.hi.y());
-  float far2 = w.far2, end2 = w.end2, sweep2 = w.sweep2;
+  float far2 = w.far2, end2 = w.end2;
+  std::size_t count = w.active;
   for (std::size_t k = k0; k < k1; ++k) {
     const float r = rad[k];
     const float loX = domain.lo.x() + r, hiX = domain.hi.x() - r, loY = domain.lo.y() + r, hiY = domain.hi.y() - r;
     const float cx = loX <= hiX ? std::min(std::max(xs[k], loX), hiX) : midX;
     const float cy = loY <= hiY ? std::min(std::max(ys[k], loY), hiY) : midY;
     const float x = scripted[k] ? xs[k] : cx, y = scripted[k] ? ys[k] : cy;
-    const float bx = x - bucketed[k].x(), by = y - bucketed[k].y();
+    const float bx = x - bucketX[k], by = y - bucketY[k];
     const float sx = x - startX[k], sy = y - startY[k];
     const float e2 = bx * bx + by * by;
     far2 = std::max(far2, far[k]);
     end2 = std::max(end2, e2);
-    sweep2 = std::max(sweep2, sx * sx + sy * sy);
+    // A whole sweep projected every pair, each agent's last during the sweep: from where it
+    // started, it counts as active if it moved more than the tolerance since.
+    const std::uint8_t moved = sx * sx + sy * sy > tolerance2 ? 1 : 0;
+    active[k] = moved;
+    count += moved;
+    checkX[k] = startX[k];
+    checkY[k] = startY[k];
     far[k] = e2;  // where the next sweep starts
     xs[k] = endX[k] = x;
     ys[k] = endY[k] = y;
   }
-  w = SweepMoves{far2, end2, sweep2};
+  w = SweepMoves{far2, end2, count};
+}
+
+void CollisionResolver::gatherActive() {
+  activeSlots_.clear();
+  for (std::size_t k = 0; k < active_.size(); ++k)
+    if (active_[k]) activeSlots_.push_back(static_cast<std::uint32_t>(k));
+}
+
+CollisionResolver::SweepMoves CollisionResolver::localSweep(const StaticObstacles& obstacles, const DomainBox& domain,
+                                                            float s, float range, float tolerance2, float lastEnd2) {
+  const SweepSlots slots{x_.data(),      y_.data(),     far_.data(),   bucketX_.data(),
+                         bucketY_.data(), radius_.data(), yield_.data(), agent_.data()};
+  touched_.clear();
+  auto touch = [&](std::uint32_t k) {
+    if (touchedMark_[k]) return;
+    touchedMark_[k] = 1;
+    touched_.push_back(k);
+  };
+  // Every agent within range of i now is in the cells within range + F of i, F bounding every
+  // agent's distance from where it was bucketed (the cells hold the bucketed positions), so the
+  // sweep needs no new list however far the agents go; F grows as the sweep moves them.
+  float farthest2 = lastEnd2;
+  for (const std::uint32_t i : activeSlots_) {
+    partners_.clear();
+    const float xi = x_[i], yi = y_[i], ri = radius_[i];
+    grid_.forEachSlotNear(Vec2f(xi, yi), range + std::sqrt(farthest2) * 1.001f + 1e-6f * range, [&](std::uint32_t j) {
+      // The pairs projectPairs will push: only those partners are touched.
+      const float ex = xi - x_[j], ey = yi - y_[j], target = s * (ri + radius_[j]);
+      if (j != i && ex * ex + ey * ey < target * target) partners_.push_back(j);
+    });
+    touch(i);
+    checkX_[i] = xi;  // all of i's pairs are projected now
+    checkY_[i] = yi;
+    for (const std::uint32_t j : partners_) touch(j);
+    projectPairs(slots, i, partners_.data(), static_cast<std::uint32_t>(partners_.size()), s);
+    farthest2 = std::max(farthest2, far_[i]);
+    for (const std::uint32_t j : partners_) farthest2 = std::max(farthest2, far_[j]);
+  }
+  // The end of the sweep for the agents it moved (the others stay where the last sweep left
+  // them): obstacles, domain, distances, and the next sweep's active agents in slot order.
+  SweepMoves moves{lastEnd2, lastEnd2, 0};
+  activeSlots_.clear();
+  for (const std::uint32_t k : touched_) {
+    Vec2f x(x_[k], y_[k]);
+    if (!scripted_[k]) {
+      if (!obstacles.empty()) x = obstacles.pushOut(x, radius_[k]);
+      for (int a = 0; a < 2; ++a) {
+        const float lo = domain.lo[a] + radius_[k], hi = domain.hi[a] - radius_[k];
+        x[a] = lo <= hi ? std::clamp(x[a], lo, hi) : 0.5f * (domain.lo[a] + domain.hi[a]);
+      }
+    }
+    x_[k] = prevX_[k] = x.x();  // prevX_ == x_ between sweeps
+    y_[k] = prevY_[k] = x.y();
+    touchedMark_[k] = 0;
+    const float e2 = (x - Vec2f(bucketX_[k], bucketY_[k])).squaredNorm();
+    moves.far2 = std::max({moves.far2, far_[k], e2});
+    moves.end2 = std::max(moves.end2, e2);
+    far_[k] = e2;
+    const float cx = x.x() - checkX_[k], cy = x.y() - checkY_[k];
+    active_[k] = cx * cx + cy * cy > tolerance2 ? 1 : 0;
+    if (active_[k]) activeSlots_.push_back(k);
+  }
+  moves.active = activeSlots_.size();
+  std::sort(activeSlots_.begin(), activeSlots_.end());
+  return moves;
 }
 
 namespace {
@@ -309,7 +395,8 @@ void CollisionResolver::resolveJacobi(const StaticObstacles& obstacles, const Do
     const float* ys = y_.data();
     float* nextX = nextX_.data();
     float* nextY = nextY_.data();
-    const Vec2f* bucketed = bucketed_.data();
+    const float* bucketX = bucketX_.data();
+    const float* bucketY = bucketY_.data();
     const float* rad = radius_.data();
     const float* yield = yield_.data();
     const std::uint8_t* scripted = scripted_.data();
@@ -377,7 +464,7 @@ void CollisionResolver::resolveJacobi(const StaticObstacles& obstacles, const Do
         nextX[k] = x.x();
         nextY[k] = x.y();
         cellMoved = 1;
-        worst.sinceBucket2 = std::max(worst.sinceBucket2, (x - bucketed[k]).squaredNorm());
+        worst.sinceBucket2 = std::max(worst.sinceBucket2, (x - Vec2f(bucketX[k], bucketY[k])).squaredNorm());
         worst.sweep2 = std::max(worst.sweep2, (x - xi).squaredNorm());
       }
       movedNext[st.cell] = cellMoved;

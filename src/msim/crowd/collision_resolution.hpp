@@ -37,43 +37,54 @@ struct CollisionResolutionParams {
   // as Jacobi. Jacobi: all pushes from the positions before the sweep (Treuille et al. 2006).
   enum class Sweeps { GaussSeidel, Jacobi };
   Sweeps sweeps = Sweeps::GaussSeidel;
-  // Sweeps stop early once none moves an agent by more than this fraction of d_min (the largest
-  // one's): after a step only a few pairs overlap, and those settle in a few sweeps. 0 = always
-  // run `iterations` sweeps.
+  // Convergence, as a fraction of d_min (the largest one's). Gauss-Seidel converges locally: after
+  // a sweep only the neighbourhoods of agents that moved more than this since their pairs were
+  // last projected are projected again (the whole crowd while many did, else just those agents'
+  // pairs), and the sweeps stop once there are none. After a step a few pairs overlap: at 100k
+  // agents 0.5% of them move beyond the tolerance in the first sweep, so the later sweeps cost
+  // little. Jacobi stops once a sweep moved nobody by more. 0 = always run `iterations` sweeps
+  // over the whole crowd.
   float tolerance = 0.01f;
 };
 
 class CollisionResolver {
  public:
   // Moves agents.position in place. Gauss-Seidel (default): each pair closer than the target is
-  // projected once per sweep, in place, both agents moved by half the correction (a scripted
-  // agent's partner by all of it). The pairs are listed once per call, those closer than the
-  // interaction range plus a skin, each owned by its first agent: an agent's partners are the
-  // later agents of its cell, of the cell to its right and of the three cells above. Those lie in
-  // two rows of cells, so the even rows of cells run in parallel, then the odd rows: the order is
-  // fixed, and the result does not depend on the thread count. Pushes are equal and opposite, so
-  // the centroid is conserved to round-off unless an obstacle, the domain or a scripted agent
-  // intervenes. After each sweep agents are pushed out of obstacles and clamped into the domain.
+  // projected in place, both agents moved by half the correction (a scripted agent's partner by
+  // all of it). A whole sweep takes each pair once, owned by its first agent in cell order: an
+  // agent's partners are the later agents of its cell, of the cell to its right and of the three
+  // cells above, tested eight at a time. Those lie in two rows of cells, so the even rows of
+  // cells run in parallel, then the odd rows: the order is fixed, and the result does not depend
+  // on the thread count. Pushes are equal and opposite, so the centroid is conserved to round-off
+  // unless an obstacle, the domain or a scripted agent intervenes. After each sweep agents are
+  // pushed out of obstacles and clamped into the domain. After the first sweep only the agents
+  // that moved more than the tolerance since their own pairs were last projected ("active") have
+  // their pairs projected again: while over a 16th of the crowd is active, by a whole sweep;
+  // else one active agent after the other in slot order (serial, so still deterministic), each
+  // with every agent near it.
   // Jacobi: every displacement from the positions before the sweep, then applied, over the 3x3
   // cells around each agent. No allocation once warm.
   //
   // The agents are bucketed into cells and their positions, radii and models gathered in cell
-  // order; the sweeps run on that copy and the result is scattered back at the end. The pairs
-  // (Gauss-Seidel) or buckets (Jacobi) are redone when an agent may have moved far enough from
-  // where they were made for a pair within range to be missing, so the pair sets are exact
-  // (Gauss-Seidel: the farthest any agent has been is tracked through the sweep, and a sweep
-  // that went too far is undone and redone on a new list; only the first sweep on a new list is
-  // kept regardless, which matters only from deep overlaps such as uniformly random positions).
+  // order; the sweeps run on that copy and the result is scattered back at the end. The buckets
+  // are redone when an agent may have moved far enough from where they were made for a pair
+  // within range to lie beyond neighbouring cells, so the pair sets are exact (Gauss-Seidel: the
+  // farthest any agent has been is tracked through the sweep, and a whole sweep that went too far
+  // is undone and redone on new buckets; only the first sweep on new buckets is kept regardless,
+  // which matters only from deep overlaps such as uniformly random positions; the local sweeps
+  // search as far around an agent as the farthest agent has gone, so they need no new buckets).
   void resolve(Agents& agents, const StaticObstacles& obstacles, const DomainBox& domain,
                const CollisionResolutionParams& params = {});
 
   // Times the agents were bucketed in the last resolve() (1 unless agents moved far), for tests
   // and benchmarks.
   int lastBucketings() const { return bucketings_; }
-  // Sweeps the last resolve() ran (<= iterations; fewer when it converged).
+  // Sweeps the last resolve() ran (<= iterations; fewer when it converged), whole or local.
   int lastSweeps() const { return sweeps_; }
-  // Gauss-Seidel sweeps of the last resolve() that were undone and redone on a new pair list (an
-  // agent moved too far during the sweep for the list to be sure to hold all its pairs).
+  // Gauss-Seidel sweeps of the last resolve() that projected only around active agents.
+  int lastLocalSweeps() const { return localSweeps_; }
+  // Gauss-Seidel sweeps of the last resolve() that were undone and redone on new buckets (an
+  // agent moved too far during the sweep for the cells to be sure to hold all its pairs).
   int lastRedoneSweeps() const { return redone_; }
 
  private:
@@ -87,21 +98,24 @@ class CollisionResolver {
   void rebucket(float cellSize);                       // from the current cell-ordered copy
   void resizeCellFlags();  // Jacobi: one moved flag per cell of the current buckets
   void scatter(Agents& agents) const;                  // positions back to agent order
-  // Gauss-Seidel: lists the pairs closer than `cut` (the buckets' cell size) at the bucketed
-  // positions, row of cells by row, and starts the sweeps from there.
-  void listPairs(float cut);
-  void listRow(int cy, float cut2);
-  // One Gauss-Seidel sweep in place over x_, y_ (start positions in prevX_, prevY_, end positions
-  // into nextX_, nextY_).
+  // Gauss-Seidel: the sweeps start from the bucketed positions.
+  void startSweeps();
   struct SweepMoves {
-    float far2 = 0.0f;    // squared largest distance from bucketed_ at any moment of the sweep
-    float end2 = 0.0f;    // squared largest distance from bucketed_ at its end
-    float sweep2 = 0.0f;  // squared largest displacement in the sweep
+    float far2 = 0.0f;        // squared largest distance from the bucketed positions at any moment
+    float end2 = 0.0f;        // the same at the end of the sweep
+    std::size_t active = 0;   // agents active after the sweep
   };
-  SweepMoves gaussSeidelSweep(const StaticObstacles& obstacles, const DomainBox& domain, float s);
-  // The end of a sweep for the slots [k0, k1): clamps them into the domain, records where they
-  // end and folds their distances into w.
-  void clampIntoDomain(std::size_t k0, std::size_t k1, const DomainBox& domain, SweepMoves& w);
+  // One whole Gauss-Seidel sweep in place over x_, y_ (start positions in prevX_, prevY_, end
+  // positions into nextX_, nextY_).
+  SweepMoves gaussSeidelSweep(const StaticObstacles& obstacles, const DomainBox& domain, float s, float tolerance2);
+  // The end of a whole sweep for the slots [k0, k1): clamps them into the domain, records where
+  // they end, marks the active ones and folds their distances into w.
+  void clampIntoDomain(std::size_t k0, std::size_t k1, const DomainBox& domain, float tolerance2, SweepMoves& w);
+  // One local sweep over the active agents (activeSlots_), which it replaces by those of the next
+  // sweep. lastEnd2: end2 of the sweep before (the agents it does not move stay there).
+  SweepMoves localSweep(const StaticObstacles& obstacles, const DomainBox& domain, float s, float range,
+                        float tolerance2, float lastEnd2);
+  void gatherActive();  // activeSlots_ from active_
 
   NeighbourGrid grid_;
   // Cell-ordered copies (slot k is agent agent_[k]).
@@ -111,10 +125,13 @@ class CollisionResolver {
   // nextY_ receive the end positions), and per slot the squared largest distance from its
   // bucketed position in the sweep so far.
   std::vector<float> prevX_, prevY_, far_;
-  // Gauss-Seidel pair list, per row of cells: for each slot of the row in order, its number of
-  // partners, then the partners' slots.
-  std::vector<std::vector<std::uint32_t>> rowPairs_;
-  std::vector<Vec2f> bucketed_;  // positions when bucketed (Gauss-Seidel: when the pairs were listed)
+  // Gauss-Seidel, per slot: where the agent was when its pairs were last all projected, and
+  // whether it moved more than the tolerance from there (active). Local sweeps: the active slots
+  // in slot order, the slots a sweep moves (with a mark), and one agent's partners.
+  std::vector<float> checkX_, checkY_;
+  std::vector<std::uint8_t> active_, touchedMark_;
+  std::vector<std::uint32_t> activeSlots_, touched_, partners_;
+  std::vector<float> bucketX_, bucketY_;  // positions when bucketed
   std::vector<float> radius_;
   std::vector<float> yield_;  // share of a push a neighbour of this agent takes: 1/2, or 1 if this one is scripted
   std::vector<std::uint8_t> scripted_;
@@ -129,6 +146,7 @@ class CollisionResolver {
   std::vector<std::uint8_t> moved_, movedNext_;
   int bucketings_ = 0;
   int sweeps_ = 0;
+  int localSweeps_ = 0;
   int redone_ = 0;
 };
 

@@ -29,6 +29,13 @@ class NeighbourGrid {
   // Calls f(j) for every built point j with |x_j - x| < radius.
   template <typename F>
   void forEachWithin(const Vecf<2>& x, float radius, F&& f) const;
+  // Calls f(slot) for every slot of cellOrder() in the cells a disc of the radius around x
+  // touches: a superset of the built points within the radius (no distance test), for callers
+  // that keep their own cell-ordered copies.
+  template <typename F>
+  void forEachSlotNear(const Vecf<2>& x, float radius, F&& f) const {
+    visitCells(x, radius, f);
+  }
 
   // The built points (a copy, in input order).
   std::span<const Vecf<2>> points() const { return points_; }

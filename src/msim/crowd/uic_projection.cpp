@@ -412,7 +412,7 @@ void UicProjection::renorm(const MacGrid<2>& u, MacGrid<2>& out) const {
           wv += otherRho[gi] * other[gi];
         }
       const float tangential = wSum > 0.0f ? wv / wSum : 0.0f;
-      const float speed = std::hypot(in[idx], tangential);
+      const float speed = std::sqrt(in[idx] * in[idx] + tangential * tangential);
       const float target =
           settings_.weidmannSpeeds
               ? static_cast<float>(vmax[idx] * weidmannSpeed(rho[idx], settings_.weidmann) / settings_.weidmann.v0)

@@ -337,9 +337,11 @@ struct Builder {
       const std::uint32_t goal = opposite ? 0 : goalIndex(g, key);
       const Vec2 centre = regionCentre(g.at("region"), region);
       Rng groupRng = rng.split(k);
-      for (long long n = 0; n < count; ++n) {
+      std::vector<Vec2> points(static_cast<std::size_t>(count));
+      for (Vec2& x : points) x = randomPoint(groupRng, region, base.radius, key + ".region");
+      crowd::sortSpatially(points);
+      for (const Vec2& x : points) {
         crowd::AgentSpec a = base;
-        const Vec2 x = randomPoint(groupRng, region, base.radius, key + ".region");
         a.position = x.cast<float>();
         a.goal = goal;
         if (opposite && !scripted) {
