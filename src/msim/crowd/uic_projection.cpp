@@ -344,6 +344,22 @@ numerics::BoundQpResult UicProjection::solve(const Eigen::VectorXd& rhs, Eigen::
     boxRhs_[static_cast<Eigen::Index>(local)] = rhs[static_cast<Eigen::Index>(k)];
     boxPressure_[static_cast<Eigen::Index>(local)] = p[static_cast<Eigen::Index>(k)];
   });
+  // No cell asks for pressure (b <= 0): p = 0 meets the KKT conditions (A 0 - b >= 0), the usual
+  // case in a crowd below capacity everywhere, and no solve is needed.
+  const double largest = tbb::parallel_reduce(
+      tbb::blocked_range<Eigen::Index>(0, boxCells, 4096), -std::numeric_limits<double>::infinity(),
+      [&](const tbb::blocked_range<Eigen::Index>& r, double m) {
+        for (Eigen::Index i = r.begin(); i != r.end(); ++i) m = std::max(m, boxRhs_[i]);
+        return m;
+      },
+      [](double a, double b) { return std::max(a, b); });
+  if (largest <= 0.0) {
+    forBox([&](std::size_t, std::size_t k) { p[static_cast<Eigen::Index>(k)] = 0.0; });
+    numerics::BoundQpResult none;
+    none.activeCount = static_cast<int>(boxCells);
+    none.converged = true;
+    return none;
+  }
   numerics::BoundQpSettings qp;
   const double norm = std::sqrt(parallelSum(static_cast<std::size_t>(boxCells), [&](std::size_t i) {
     return boxRhs_[static_cast<Eigen::Index>(i)] * boxRhs_[static_cast<Eigen::Index>(i)];
