@@ -60,8 +60,8 @@ class CollisionResolver {
   // pushed out of obstacles and clamped into the domain. After the first sweep only the agents
   // that moved more than the tolerance since their own pairs were last projected ("active") have
   // their pairs projected again: while over a 16th of the crowd is active, by a whole sweep;
-  // else one active agent after the other in slot order (serial, so still deterministic), each
-  // with every agent near it.
+  // else each active agent with every agent near it, rows of cells three apart in parallel and
+  // each row's agents in slot order (still independent of the thread count).
   // Jacobi: every displacement from the positions before the sweep, then applied, over the 3x3
   // cells around each agent. No allocation once warm.
   //
@@ -126,11 +126,20 @@ class CollisionResolver {
   // bucketed position in the sweep so far.
   std::vector<float> prevX_, prevY_, far_;
   // Gauss-Seidel, per slot: where the agent was when its pairs were last all projected, and
-  // whether it moved more than the tolerance from there (active). Local sweeps: the active slots
-  // in slot order, the slots a sweep moves (with a mark), and one agent's partners.
+  // whether it moved more than the tolerance from there (active), and whether the local sweep
+  // under way moved it. The active slots in slot order.
   std::vector<float> checkX_, checkY_;
   std::vector<std::uint8_t> active_, touchedMark_;
-  std::vector<std::uint32_t> activeSlots_, touched_, partners_;
+  std::vector<std::uint32_t> activeSlots_;
+  // Local sweeps: the active agents of one row of cells (activeSlots_[begin, end)), the agents
+  // the group moved, its scratch, the agents it left to the serial pass, and its F^2.
+  struct RowGroup {
+    int row = 0;
+    std::size_t begin = 0, end = 0;
+    std::vector<std::uint32_t> touched, partners, deferred;
+    float farthest2 = 0.0f;
+  };
+  std::vector<RowGroup> rowGroups_;
   std::vector<float> bucketX_, bucketY_;  // positions when bucketed
   std::vector<float> radius_;
   std::vector<float> yield_;  // share of a push a neighbour of this agent takes: 1/2, or 1 if this one is scripted
