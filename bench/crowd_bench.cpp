@@ -6,10 +6,13 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <fmt/format.h>
+#include <tbb/global_control.h>
 
 #include "msim/core/timer.hpp"
 #include "msim/scene/scene_file.hpp"
@@ -17,6 +20,14 @@
 using namespace msim;
 
 namespace {
+
+// CROWD_BENCH_THREADS=k limits the TBB workers (k = 1: the work per step, steadier on a shared
+// machine than the wall time over two cores).
+const std::unique_ptr<tbb::global_control> kThreads = [] {
+  const char* k = std::getenv("CROWD_BENCH_THREADS");
+  return k ? std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, std::atoi(k))
+           : nullptr;
+}();
 
 std::string scenePath(const std::string& name) { return std::string(MSIM_SOURCE_DIR) + "/scenes/" + name + ".json"; }
 

@@ -253,13 +253,22 @@ inline void projectRanges(const SweepSlots& a, std::uint32_t i, const std::uint3
       // The partners move now (in place), and their farthest distance from the bucketed positions.
       const __m256 nx = _mm256_sub_ps(xj, _mm256_mul_ps(_mm256_mul_ps(sj, f), ex));
       const __m256 ny = _mm256_sub_ps(yj, _mm256_mul_ps(_mm256_mul_ps(sj, f), ey));
-      const __m256i store = _mm256_castps_si256(m);
-      _mm256_maskstore_ps(x + j, store, nx);
-      _mm256_maskstore_ps(y + j, store, ny);
       const __m256 lx = _mm256_sub_ps(nx, _mm256_loadu_ps(a.bucketX + j));
       const __m256 ly = _mm256_sub_ps(ny, _mm256_loadu_ps(a.bucketY + j));
       const __m256 e2 = _mm256_add_ps(_mm256_mul_ps(lx, lx), _mm256_mul_ps(ly, ly));
-      _mm256_maskstore_ps(far + j, store, _mm256_max_ps(_mm256_loadu_ps(far + j), e2));
+      const __m256 farJ = _mm256_loadu_ps(far + j);
+      if (j + 8 <= hi[r]) {
+        // All eight lanes are slots of the range, which only this agent's row moves now: store
+        // them whole, the others unchanged (masked stores are slow on some cores).
+        _mm256_storeu_ps(x + j, _mm256_blendv_ps(xj, nx, m));
+        _mm256_storeu_ps(y + j, _mm256_blendv_ps(yj, ny, m));
+        _mm256_storeu_ps(far + j, _mm256_blendv_ps(farJ, _mm256_max_ps(farJ, e2), m));
+      } else {  // lanes past the range may belong to rows other tasks move
+        const __m256i store = _mm256_castps_si256(m);
+        _mm256_maskstore_ps(x + j, store, nx);
+        _mm256_maskstore_ps(y + j, store, ny);
+        _mm256_maskstore_ps(far + j, store, _mm256_max_ps(farJ, e2));
+      }
     }
   dx = sum8(ax);
   dy = sum8(ay);

@@ -42,6 +42,7 @@ CrowdSimulation::CrowdSimulation(const CrowdSettings& settings, std::vector<Poly
     : settings_(settings),
       obstacles_(std::move(obstacles)),
       goals_(std::move(goals)),
+      anyExitGoal_(std::any_of(goals_.begin(), goals_.end(), [](const Goal& g) { return g.exit; })),
       planner_(std::move(planner)),
       agents_(std::move(agents)),
       inflows_(std::move(inflows)),
@@ -272,7 +273,8 @@ void CrowdSimulation::moveUic(double dt) {
 
 void CrowdSimulation::arriveAndSpawn(double dt) {
   remove_.assign(agents_.size(), 0);
-  const auto exited = static_cast<std::size_t>(parallelSum(agents_.size(), [&](std::size_t i) {
+  // Scenes without exits (the circle: a goal per agent) skip the pass over every agent's goal.
+  const auto exited = !anyExitGoal_ ? std::size_t(0) : static_cast<std::size_t>(parallelSum(agents_.size(), [&](std::size_t i) {
     if (agents_.model[i] == AgentModel::Scripted) return 0.0;
     const Goal& goal = goals_[agents_.goal[i]];
     if (!goal.exit || !goal.reached(agents_.position[i].cast<double>())) return 0.0;

@@ -129,6 +129,7 @@ class CrowdSimulation {
   CrowdSettings settings_;
   std::vector<Polygon> obstacles_;
   std::vector<Goal> goals_;
+  bool anyExitGoal_ = false;
   std::shared_ptr<const GlobalPlanner> planner_;
   Agents agents_;
   std::vector<Inflow> inflows_;

@@ -84,9 +84,10 @@ UicProjection::UicProjection(const GridSpec<2>& grid, const UicSettings& setting
       innerPressure_(Eigen::VectorXd::Zero(rhs_.size())),
       outerPressure_(Eigen::VectorXd::Zero(rhs_.size())) {}
 
-void UicProjection::validate(std::span<const Vec2f> positions, std::span<const Vec2f> preferredVelocities,
-                             std::span<const float> maxSpeeds, const Grid<float, 2>& freeArea, double dt,
-                             std::span<Vec2f> velocities) const {
+UicProjection::SpeedRange UicProjection::validate(std::span<const Vec2f> positions,
+                                                  std::span<const Vec2f> preferredVelocities,
+                                                  std::span<const float> maxSpeeds, const Grid<float, 2>& freeArea,
+                                                  double dt, std::span<Vec2f> velocities) const {
   const std::size_t n = positions.size();
   if (preferredVelocities.size() != n || maxSpeeds.size() != n || velocities.size() != n)
     throw InputError(fmt::format("UIC projection: {} positions but {} preferred velocities, {} speeds and {} outputs",
@@ -95,11 +96,35 @@ void UicProjection::validate(std::span<const Vec2f> positions, std::span<const V
   if (!freeArea.sameLayout(density_))
     throw InputError("UIC projection: the free-area grid does not match the crowd grid's cells");
   const Vec2 lo = grid_.origin, hi = grid_.upper();
-  const std::size_t bad = firstBad(n, [&](std::size_t i) {
-    const Vec2f& x = positions[i];
-    return !x.allFinite() || !preferredVelocities[i].allFinite() || !std::isfinite(maxSpeeds[i]) ||
-           maxSpeeds[i] < 0.0f || x.x() < lo.x() || x.y() < lo.y() || x.x() > hi.x() || x.y() > hi.y();
-  });
+  // One pass: the first bad agent (the minimum index, so deterministic) and the speed range.
+  struct Scan {
+    std::size_t bad;
+    SpeedRange speeds;
+  };
+  const Scan scan = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, n, 4096),
+      Scan{n, SpeedRange{0.0f, std::numeric_limits<float>::infinity()}},
+      [&](const tbb::blocked_range<std::size_t>& r, Scan acc) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+          const Vec2f& x = positions[i];
+          const float v = maxSpeeds[i];
+          if (!x.allFinite() || !preferredVelocities[i].allFinite() || !std::isfinite(v) || v < 0.0f ||
+              x.x() < lo.x() || x.y() < lo.y() || x.x() > hi.x() || x.y() > hi.y()) {
+            acc.bad = std::min(acc.bad, i);
+            break;
+          }
+          acc.speeds.fastest = std::max(acc.speeds.fastest, v);
+          acc.speeds.slowest = std::min(acc.speeds.slowest, v);
+        }
+        return acc;
+      },
+      [](Scan a, const Scan& b) {
+        a.bad = std::min(a.bad, b.bad);
+        a.speeds.fastest = std::max(a.speeds.fastest, b.speeds.fastest);
+        a.speeds.slowest = std::min(a.speeds.slowest, b.speeds.slowest);
+        return a;
+      });
+  const std::size_t bad = scan.bad;
   if (bad < n)
     throw InputError(fmt::format("UIC projection: agent {} at ({}, {}) with preferred velocity ({}, {}) and speed {} "
                                  "is non-finite, has a negative speed or lies outside the grid [{}, {}] x [{}, {}]",
@@ -110,6 +135,7 @@ void UicProjection::validate(std::span<const Vec2f> positions, std::span<const V
   });
   if (badCell < freeArea.count())
     throw InputError(fmt::format("UIC projection: free area {} of cell {} is outside [0, 1]", freeArea[badCell], badCell));
+  return scan.speeds;
 }
 
 namespace {
@@ -151,21 +177,20 @@ void UicProjection::bucketAgents(std::span<const Vec2f> positions) {
 // unit masses onto the cells and both face grids (Sum), and v~ (and the speeds, if they differ)
 // onto the faces, normalised by the face weight sums, which are the face masses.
 void UicProjection::splatAgents(std::span<const Vec2f> positions, std::span<const Vec2f> preferredVelocities,
-                                std::span<const float> maxSpeeds) {
+                                std::span<const float> maxSpeeds, SpeedRange range) {
   const std::size_t n = positions.size();
   const int nx = grid_.res.x(), ny = grid_.res.y();
   const float perArea = static_cast<float>(1.0 / (grid_.dx * grid_.dx));
   // The Normalized splat of a common speed is that speed wherever agents are, and renorm reads
   // v_max only there: skip the speed sums for uniform speeds (the usual case).
-  const double fastest = parallelMax(n, [&](std::size_t i) { return maxSpeeds[i]; });
-  const double spread = parallelMax(n, [&](std::size_t i) { return fastest - maxSpeeds[i]; });
-  const bool speeds = spread != 0.0;
+  const double fastest = range.fastest;
+  const bool speeds = n > 0 && range.slowest != range.fastest;
 
   const std::size_t cells = density_.count(), xFaces = faceDensity_.component(0).count(),
                     yFaces = faceDensity_.component(1).count();
-  auto zeroed = [](std::vector<double>& v, std::size_t size) {
+  auto zeroed = [](std::vector<float>& v, std::size_t size) {
     v.resize(size);
-    parallelFor(0, size, [&](std::size_t i) { v[i] = 0.0; }, 1 << 14);
+    parallelFor(0, size, [&](std::size_t i) { v[i] = 0.0f; }, 1 << 14);
   };
   zeroed(cellMass_, cells);
   for (int a = 0; a < 2; ++a) {
@@ -187,18 +212,18 @@ void UicProjection::splatAgents(std::span<const Vec2f> positions, std::span<cons
         const std::uint32_t p = order[k];
         const double sx = (double(positions[p].x()) - ox) * invDx, sy = (double(positions[p].y()) - oy) * invDx;
         const Taps cx(sx - 0.5, nx), cy(sy - 0.5, ny), fx(sx, nx + 1), fy(sy, ny + 1);
-        const double vx = preferredVelocities[p].x(), vy = preferredVelocities[p].y();
-        const double speed = maxSpeeds[p];
+        const float vx = preferredVelocities[p].x(), vy = preferredVelocities[p].y();
+        const float speed = maxSpeeds[p];
         for (int b = 0; b < 2; ++b)
           for (int c = 0; c < 2; ++c) {
-            const double wc = cy.w[b] * cx.w[c];
+            const auto wc = static_cast<float>(cy.w[b] * cx.w[c]);
             cellMass_[static_cast<std::size_t>(cy.at[b]) * yStride + cx.at[c]] += wc;
             const std::size_t xi = static_cast<std::size_t>(cy.at[b]) * xStride + fx.at[c];
-            const double wx = cy.w[b] * fx.w[c];
+            const auto wx = static_cast<float>(cy.w[b] * fx.w[c]);
             faceMass_[0][xi] += wx;
             faceFlow_[0][xi] += wx * vx;
             const std::size_t yi = static_cast<std::size_t>(fy.at[b]) * yStride + cx.at[c];
-            const double wy = fy.w[b] * cx.w[c];
+            const auto wy = static_cast<float>(fy.w[b] * cx.w[c]);
             faceMass_[1][yi] += wy;
             faceFlow_[1][yi] += wy * vy;
             if (speeds) {
@@ -210,7 +235,7 @@ void UicProjection::splatAgents(std::span<const Vec2f> positions, std::span<cons
     });
   }
 
-  parallelFor(0, cells, [&](std::size_t i) { density_[i] = static_cast<float>(cellMass_[i]) * perArea; }, 1 << 14);
+  parallelFor(0, cells, [&](std::size_t i) { density_[i] = cellMass_[i] * perArea; }, 1 << 14);
   for (int a = 0; a < 2; ++a) {
     auto& rho = faceDensity_.component(a);
     auto& v = preferred_.component(a);
@@ -220,10 +245,10 @@ void UicProjection::splatAgents(std::span<const Vec2f> positions, std::span<cons
     const auto& speedSum = faceSpeed_[a];
     const float common = static_cast<float>(fastest);
     parallelFor(0, rho.count(), [&](std::size_t i) {
-      const double m = mass[i];
-      rho[i] = static_cast<float>(m) * perArea;
-      v[i] = m > 0.0 ? static_cast<float>(flow[i] / m) : 0.0f;
-      vmax[i] = speeds ? (m > 0.0 ? static_cast<float>(speedSum[i] / m) : 0.0f) : common;
+      const float m = mass[i];
+      rho[i] = m * perArea;
+      v[i] = m > 0.0f ? flow[i] / m : 0.0f;
+      vmax[i] = speeds ? (m > 0.0f ? speedSum[i] / m : 0.0f) : common;
     }, 1 << 14);
   }
 }
@@ -397,43 +422,46 @@ void UicProjection::subtractGradient(const MacGrid<2>& u, const Eigen::VectorXd&
 // tangential component is the density-weighted mean of the four neighbouring faces of the other
 // axis, so a uniform field is reproduced exactly and empty faces do not bias it towards zero.
 void UicProjection::renorm(const MacGrid<2>& u, MacGrid<2>& out) const {
-  const int nx = grid_.res.x();
+  const int nx = grid_.res.x(), ny = grid_.res.y();
   const float minFraction = static_cast<float>(settings_.renormMinFraction);
   for (int a = 0; a < 2; ++a) {
-    const int b = 1 - a;
     const auto& in = u.component(a);
     const auto& rho = faceDensity_.component(a);
     const auto& vmax = speed_.component(a);
-    const auto& other = u.component(b);
-    const auto& otherRho = faceDensity_.component(b);
+    const auto& other = u.component(1 - a);
+    const auto& otherRho = faceDensity_.component(1 - a);
     auto& o = out.component(a);
-    parallelForCells<2>(o.size(), [&](const IVec2& f, std::size_t idx) {
-      if (f[a] == 0 || f[a] == grid_.res[a]) {
-        o[idx] = 0.0f;
-        return;
-      }
-      o[idx] = in[idx];
-      if (!(rho[idx] > 0.0f)) return;
-      // The other-axis faces of the two cells sharing this face: cells f - e_a and f, lower and
-      // upper face along b.
-      float wSum = 0.0f, wv = 0.0f;
-      for (int side = 0; side < 2; ++side)
-        for (int up = 0; up < 2; ++up) {
-          IVec2 g = f;
-          g[a] -= 1 - side;
-          g[b] += up;
-          const std::size_t gi = a == 0 ? static_cast<std::size_t>(g.y()) * nx + g.x()
-                                        : static_cast<std::size_t>(g.y()) * (nx + 1) + g.x();
-          wSum += otherRho[gi];
-          wv += otherRho[gi] * other[gi];
+    const int faceNx = a == 0 ? nx + 1 : nx, faceNy = a == 0 ? ny : ny + 1;
+    // The other-axis faces of the two cells sharing face (i, j): for an x face the y faces
+    // (c, r) with c = i - 1, i and r = j, j + 1 (index r nx + c); for a y face the x faces (c, r)
+    // with c = i, i + 1 and r = j - 1, j (index r (nx + 1) + c).
+    const int otherNx = a == 0 ? nx : nx + 1;
+    const int dc = a == 0 ? -1 : 0, dr = a == 0 ? 0 : -1;
+    tbb::parallel_for(tbb::blocked_range<int>(0, faceNy, 8), [&](const tbb::blocked_range<int>& rows) {
+      for (int j = rows.begin(); j != rows.end(); ++j)
+        for (int i = 0; i < faceNx; ++i) {
+          const std::size_t idx = static_cast<std::size_t>(j) * faceNx + i;
+          if ((a == 0 ? i : j) == 0 || (a == 0 ? i == nx : j == ny)) {
+            o[idx] = 0.0f;
+            continue;
+          }
+          o[idx] = in[idx];
+          if (!(rho[idx] > 0.0f)) continue;
+          const std::size_t g = static_cast<std::size_t>(j + dr) * otherNx + (i + dc);
+          const std::size_t gs[4] = {g, g + 1, g + otherNx, g + otherNx + 1};
+          float wSum = 0.0f, wv = 0.0f;
+          for (const std::size_t k : gs) {
+            wSum += otherRho[k];
+            wv += otherRho[k] * other[k];
+          }
+          const float tangential = wSum > 0.0f ? wv / wSum : 0.0f;
+          const float speed = std::sqrt(in[idx] * in[idx] + tangential * tangential);
+          const float target =
+              settings_.weidmannSpeeds
+                  ? static_cast<float>(vmax[idx] * weidmannSpeed(rho[idx], settings_.weidmann) / settings_.weidmann.v0)
+                  : vmax[idx];
+          if (vmax[idx] > 0.0f && speed > minFraction * vmax[idx]) o[idx] = in[idx] * (target / speed);
         }
-      const float tangential = wSum > 0.0f ? wv / wSum : 0.0f;
-      const float speed = std::sqrt(in[idx] * in[idx] + tangential * tangential);
-      const float target =
-          settings_.weidmannSpeeds
-              ? static_cast<float>(vmax[idx] * weidmannSpeed(rho[idx], settings_.weidmann) / settings_.weidmann.v0)
-              : vmax[idx];
-      if (vmax[idx] > 0.0f && speed > minFraction * vmax[idx]) o[idx] = in[idx] * (target / speed);
     });
   }
 }
@@ -491,10 +519,10 @@ const UicStats& UicProjection::project(std::span<const Vec2f> positions, std::sp
                                        std::span<const float> maxSpeeds, const Grid<float, 2>& freeArea, double dt,
                                        std::span<Vec2f> velocities) {
   const auto start = Clock::now();
-  validate(positions, preferredVelocities, maxSpeeds, freeArea, dt, velocities);
+  const SpeedRange speeds = validate(positions, preferredVelocities, maxSpeeds, freeArea, dt, velocities);
   stats_ = UicStats{};
   std::copy(freeArea.data().begin(), freeArea.data().end(), freeArea_.data().begin());
-  splatAgents(positions, preferredVelocities, maxSpeeds);
+  splatAgents(positions, preferredVelocities, maxSpeeds, speeds);
   stats_.splatSeconds = seconds(start);
 
   const auto solveStart = Clock::now();
