@@ -59,33 +59,38 @@ TEST(GranularRenderPoints, FollowTheFlowInsideTheirParticlesThroughSplits) {
   ASSERT_EQ(points.size(), 16 * p.size());
   EXPECT_LE(worstDistance(points, p), 1.0 + kEscapeMargin);
 
-  SplitMerge splitMerge(defaultParticleRadius(kDx));
-  std::size_t splits = 0, resampled = 0;
-  double worstAfterAdvection = 0.0;
+  // First without split/merge: the flow is linear, so the expansion about the particle is the flow
+  // itself and each point takes the forward-Euler step x + dt G (x - centre) of the analytic
+  // field; and a point moves with the same map F = I + dt G as its particle's ellipsoid
+  // (A <- F A F^T), so its Mahalanobis distance does not change and none is resampled.
   const double dt = 0.025;
   std::vector<ParticleMotion> motion;
   double worstEulerError = 0.0;
-  for (int step = 0; step < 30; ++step) {
+  std::size_t resampledWithoutSplits = 0;
+  for (int step = 0; step < 10; ++step) {
     const std::vector<Vecf<3>> before(points.positions().begin(), points.positions().end());
     advectParticles(p, velocity, dt, nullptr, &motion);
-    points.advect(motion, dt, velocity.spec());
-    // The flow is linear, so the expansion about the particle is the flow itself: each point takes
-    // the forward-Euler step x + dt G (x - centre) of the analytic field.
+    resampledWithoutSplits += points.carry(motion, dt, velocity.spec(), p, {});
     for (std::size_t k = 0; k < points.size(); ++k) {
       const Vec3 x = before[k].cast<double>();
       worstEulerError = std::max(worstEulerError, (points.positions()[k].cast<double>() - (x + dt * g * (x - centre))).norm());
     }
-    // In a linear flow a point moves with the same map F = I + dt G as its particle's ellipsoid
-    // (A <- F A F^T), so its Mahalanobis distance does not change.
-    worstAfterAdvection = std::max(worstAfterAdvection, worstDistance(points, p));
+  }
+  const double worstAfterAdvection = worstDistance(points, p);
+  // Then with split/merge every step: points follow a child of their particle.
+  SplitMerge splitMerge(defaultParticleRadius(kDx));
+  std::size_t splits = 0, resampled = 0;
+  for (int step = 0; step < 20; ++step) {
+    advectParticles(p, velocity, dt, nullptr, &motion);
     splits += splitMerge.apply(p).splits;
-    points.reassign(p, splitMerge.successors());
-    resampled += points.resampleEscaped(p);
+    resampled += points.carry(motion, dt, velocity.spec(), p, splitMerge.successors());
     ASSERT_LE(worstDistance(points, p), 1.0 + kEscapeMargin);
   }
-  std::printf("render points: %zu points, worst distance after advection %.6f, %zu splits, %zu resampled\n",
-              points.size(), worstAfterAdvection, splits, resampled);
+  std::printf("render points: %zu points, worst distance after 10 steps %.6f (%zu resampled), then %zu splits, %zu "
+              "resampled\n",
+              points.size(), worstAfterAdvection, resampledWithoutSplits, splits, resampled);
   EXPECT_LE(worstAfterAdvection, 1.0 + kEscapeMargin);
+  EXPECT_EQ(resampledWithoutSplits, 0u);
   EXPECT_LE(worstEulerError, 1e-5);  // float positions of order 1 m
   EXPECT_GT(splits, 0u);
   EXPECT_EQ(points.size(), 16 * std::size_t(8 * 4 * 4 * 4));  // the total is kept
@@ -106,12 +111,16 @@ TEST(GranularRenderPoints, MergedParticleTakesBothSetsOfPoints) {
   RenderPoints points(8, 1);
   points.sample(p);
   SplitMerge splitMerge(r);
+  // A step without motion: only the merge moves the points' parent.
+  std::vector<ParticleMotion> still;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    still.push_back(ParticleMotion{p.position[i].cast<double>(), Vec3::Zero(), Vec3::Zero(), Eigen::Matrix3d::Zero()});
   ASSERT_EQ(splitMerge.apply(p).merges, 1u);
-  points.reassign(p, splitMerge.successors());
-  for (std::uint32_t parent : points.parents()) EXPECT_EQ(parent, 0u);
   // The merged ellipsoid (eq. 5.43) matches the pair's second moment, not their union: the points
   // near the far ends are resampled into it.
-  const std::size_t resampled = points.resampleEscaped(p);
+  const std::size_t resampled = points.carry(still, 0.01, GridSpec<3>(Vec3::Zero(), 0.1, IVec3::Constant(30)), p,
+                                             splitMerge.successors());
+  for (std::uint32_t parent : points.parents()) EXPECT_EQ(parent, 0u);
   EXPECT_LT(resampled, points.size());
   EXPECT_LE(worstDistance(points, p), 1.0 + kEscapeMargin);
 }

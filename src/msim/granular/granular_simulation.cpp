@@ -283,13 +283,11 @@ void GranularSimulation::step(double dt) {
     transfer_.toParticles(fields_.velocity, velocityNew_, particles_, settings_.flipRatio);
     if (corrected) removeVelocityAgainstCorrection();
     advectParticles(particles_, velocityNew_, dt, corrected ? &displacement_ : nullptr, renderPoints_ ? &motion_ : nullptr);
-    if (renderPoints_) renderPoints_->advect(motion_, dt, settings_.grid);
     pushOutOfSolids();
-    if (settings_.splitMerge) {
-      splitMergeStats_ = splitMerge_.apply(particles_);
-      if (renderPoints_) renderPoints_->reassign(particles_, splitMerge_.successors());
-    }
-    if (renderPoints_) renderPoints_->resampleEscaped(particles_);
+    if (settings_.splitMerge) splitMergeStats_ = splitMerge_.apply(particles_);
+    if (renderPoints_)
+      renderPoints_->carry(motion_, dt, settings_.grid, particles_,
+                           settings_.splitMerge ? splitMerge_.successors() : std::span<const SplitMerge::Successors>{});
   }
   time_ += dt;
 }

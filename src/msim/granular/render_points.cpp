@@ -5,6 +5,8 @@
 #include <stdexcept>
 
 #include <Eigen/Cholesky>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
 
 #include "msim/core/parallel.hpp"
 #include "msim/granular/particle_advection.hpp"
@@ -45,55 +47,68 @@ void RenderPoints::sample(const GranularParticles& particles) {
   });
 }
 
-void RenderPoints::advect(std::span<const ParticleMotion> motion, double dt, const GridSpec<3>& domain) {
-  parallelFor(0, size(), [&](std::size_t p) {
-    positions_[p] = carriedPosition(motion[parents_[p]], positions_[p].cast<double>(), dt, domain).cast<float>();
-  }, 4096);
-}
-
-void RenderPoints::reassign(const GranularParticles& particles, std::span<const SplitMerge::Successors> successors) {
-  parallelFor(0, size(), [&](std::size_t p) {
-    const SplitMerge::Successors s = successors[parents_[p]];
-    std::uint32_t best = s.begin;
-    if (s.count > 1) {
-      const Vec3 x = positions_[p].cast<double>();
-      double bestDistance = std::numeric_limits<double>::infinity();
-      for (std::uint32_t k = s.begin; k < s.begin + s.count; ++k) {
-        const double d = mahalanobisDistance(shapeMatrix(particles.shape[k]), x - particles.position[k].cast<double>());
-        if (d < bestDistance) {
-          bestDistance = d;
-          best = k;
-        }
-      }
-    }
-    parents_[p] = best;
-  });
-}
-
-std::size_t RenderPoints::resampleEscaped(const GranularParticles& particles) {
+std::size_t RenderPoints::carry(std::span<const ParticleMotion> motion, double dt, const GridSpec<3>& domain,
+                                const GranularParticles& particles,
+                                std::span<const SplitMerge::Successors> successors) {
+  if (!successors.empty() && successors.size() != motion.size())
+    throw std::invalid_argument("render points: one successor range per particle before the step is needed");
+  if (successors.empty() && particles.size() != motion.size())
+    throw std::invalid_argument("render points: the particles changed but no successors were given");
   ++generation_;
-  escaped_.resize(size());
-  // Each particle's factor once, not once per point (tens of points per particle).
+  // Per particle once, not per point (tens of points per particle): carriedPosition rearranged as
+  // x + (dx_p + dt v_p) + dt J_p (x - x_p), and the inverse factor of the new shape.
+  carried_.resize(motion.size());
+  parallelFor(0, motion.size(), [&](std::size_t i) {
+    const ParticleMotion& m = motion[i];
+    carried_[i] = CarriedMap{(dt * m.jacobian).cast<float>(), m.start.cast<float>(),
+                             (m.displacement + dt * m.velocity).cast<float>()};
+  });
   inverseFactor_.resize(particles.size());
-  // The test in single precision (the positions are floats; its relative error, ~1e-6, is far
-  // below kEscapeMargin).
   parallelFor(0, particles.size(), [&](std::size_t i) {
     inverseFactor_[i] = Eigen::LLT<Eigen::Matrix3d>(shapeMatrix(particles.shape[i]))
                             .matrixL()
                             .solve(Eigen::Matrix3d::Identity())
                             .cast<float>();
   });
+  const double eps = kBoundaryEpsilonCells * domain.dx;  // as clampIntoDomain
+  const Vecf<3> lo = (domain.origin.array() + eps).cast<float>(), hi = (domain.upper().array() - eps).cast<float>();
+  // The escape test in single precision (its relative error, ~1e-6, is far below kEscapeMargin).
   constexpr float kLimit2 = static_cast<float>((1.0 + kEscapeMargin) * (1.0 + kEscapeMargin));
-  parallelFor(0, size(), [&](std::size_t p) {
-    const std::uint32_t i = parents_[p];
-    escaped_[p] = (inverseFactor_[i] * (positions_[p] - particles.position[i])).squaredNorm() > kLimit2;
-    if (escaped_[p]) {
-      Rng rng = streamFor(p);
-      positions_[p] =
-          (particles.position[i].cast<double>() + sampleInEllipsoid(shapeMatrix(particles.shape[i]), rng)).cast<float>();
-    }
-  }, 4096);
-  return static_cast<std::size_t>(parallelSum(size(), [&](std::size_t p) { return escaped_[p]; }));
+  return tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, size(), 4096), std::size_t(0),
+      [&](const tbb::blocked_range<std::size_t>& r, std::size_t escaped) {
+        for (std::size_t p = r.begin(); p != r.end(); ++p) {
+          const std::uint32_t before = parents_[p];
+          const CarriedMap& c = carried_[before];
+          const Vecf<3> x0 = positions_[p];
+          const Vecf<3> x = (x0 + c.shift + c.gradient * (x0 - c.start)).cwiseMax(lo).cwiseMin(hi);
+          std::uint32_t parent = before;
+          if (!successors.empty()) {
+            const SplitMerge::Successors s = successors[before];
+            parent = s.begin;
+            float best = std::numeric_limits<float>::infinity();
+            for (std::uint32_t k = s.begin; s.count > 1 && k < s.begin + s.count; ++k) {
+              const float d = (inverseFactor_[k] * (x - particles.position[k])).squaredNorm();
+              if (d < best) {
+                best = d;
+                parent = k;
+              }
+            }
+          }
+          parents_[p] = parent;
+          if ((inverseFactor_[parent] * (x - particles.position[parent])).squaredNorm() > kLimit2) {
+            Rng rng = streamFor(p);
+            positions_[p] = (particles.position[parent].cast<double>() +
+                             sampleInEllipsoid(shapeMatrix(particles.shape[parent]), rng))
+                                .cast<float>();
+            ++escaped;
+          } else {
+            positions_[p] = x;
+          }
+        }
+        return escaped;
+      },
+      [](std::size_t a, std::size_t b) { return a + b; });
 }
 
 }  // namespace msim::granular

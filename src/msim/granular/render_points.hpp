@@ -40,14 +40,14 @@ class RenderPoints {
 
   // Replaces every point: perParticle of them inside each particle.
   void sample(const GranularParticles& particles);
-  // Moves each point with its particle's motion of the step (carriedPosition of
-  // particle_advection.hpp; `motion` from advectParticles, one per particle).
-  void advect(std::span<const ParticleMotion> motion, double dt, const GridSpec<3>& domain);
-  // After SplitMerge::apply: each point goes to the successor of its particle whose ellipsoid
-  // holds it best (smallest Mahalanobis distance).
-  void reassign(const GranularParticles& particles, std::span<const SplitMerge::Successors> successors);
-  // Resamples inside its particle every point farther than 1 + kEscapeMargin; returns how many.
-  std::size_t resampleEscaped(const GranularParticles& particles);
+  // One particle step for every point, in one pass: moved with its particle's motion of the step
+  // (carriedPosition of particle_advection.hpp; `motion` from advectParticles, one per particle
+  // before split/merge), handed to the successor of its particle whose ellipsoid holds it best
+  // (smallest Mahalanobis distance; `successors` from SplitMerge::apply, empty when the step had
+  // none), and resampled inside that particle if it lies farther than 1 + kEscapeMargin.
+  // `particles` are those after the step. Returns how many were resampled.
+  std::size_t carry(std::span<const ParticleMotion> motion, double dt, const GridSpec<3>& domain,
+                    const GranularParticles& particles, std::span<const SplitMerge::Successors> successors);
 
   std::size_t size() const { return positions_.size(); }
   std::span<const Vecf<3>> positions() const { return positions_; }
@@ -61,8 +61,14 @@ class RenderPoints {
   std::uint64_t generation_ = 0;  // counts sample/resample calls so that each draws fresh numbers
   std::vector<Vecf<3>> positions_;
   std::vector<std::uint32_t> parents_;
-  std::vector<std::uint8_t> escaped_;
-  std::vector<Eigen::Matrix3f> inverseFactor_;  // per particle L^-1 with A = L L^T (resampleEscaped)
+  std::vector<Eigen::Matrix3f> inverseFactor_;  // per particle after the step: L^-1 with A = L L^T
+  // Per particle before the step: carriedPosition as x + shift + gradient (x - start), in single
+  // precision like the points (their rounding, ~1e-7 relative, is far below the step's motion).
+  struct CarriedMap {
+    Eigen::Matrix3f gradient;  // dt J
+    Vecf<3> start, shift;      // x_p before the step; its displacement plus dt v
+  };
+  std::vector<CarriedMap> carried_;
 };
 
 }  // namespace msim::granular
