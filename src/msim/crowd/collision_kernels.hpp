@@ -263,11 +263,19 @@ inline void projectRanges(const SweepSlots& a, std::uint32_t i, const std::uint3
         _mm256_storeu_ps(x + j, _mm256_blendv_ps(xj, nx, m));
         _mm256_storeu_ps(y + j, _mm256_blendv_ps(yj, ny, m));
         _mm256_storeu_ps(far + j, _mm256_blendv_ps(farJ, _mm256_max_ps(farJ, e2), m));
-      } else {  // lanes past the range may belong to rows other tasks move
-        const __m256i store = _mm256_castps_si256(m);
-        _mm256_maskstore_ps(x + j, store, nx);
-        _mm256_maskstore_ps(y + j, store, ny);
-        _mm256_maskstore_ps(far + j, store, _mm256_max_ps(farJ, e2));
+      } else {
+        // Lanes past the range may belong to rows other tasks move: only the moved lanes are
+        // written, one at a time (usually one or two; a masked store is slower on some cores).
+        alignas(32) float lanes[3][8];
+        _mm256_store_ps(lanes[0], nx);
+        _mm256_store_ps(lanes[1], ny);
+        _mm256_store_ps(lanes[2], _mm256_max_ps(farJ, e2));
+        for (unsigned bits = static_cast<unsigned>(_mm256_movemask_ps(m)); bits != 0; bits &= bits - 1) {
+          const unsigned l = static_cast<unsigned>(__builtin_ctz(bits));
+          x[j + l] = lanes[0][l];
+          y[j + l] = lanes[1][l];
+          far[j + l] = lanes[2][l];
+        }
       }
     }
   dx = sum8(ax);
