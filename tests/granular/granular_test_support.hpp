@@ -1,6 +1,8 @@
 #pragma once
 // Shared helpers of the granular particle tests: analytic velocity fields on MAC grids, a
-// reference matrix exponential and conserved totals accumulated in double.
+// reference matrix exponential, the Mahalanobis distance and conserved totals accumulated in
+// double.
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 
 #include "msim/core/mac_grid.hpp"
@@ -8,6 +10,12 @@
 #include "msim/granular/granular_particles.hpp"
 
 namespace msim::granular::test {
+
+// (d^T A^{-1} d)^(1/2) = |L^{-1} d| with A = L L^T: 1 on the surface of the ellipsoid of A
+// centred at the origin.
+inline double mahalanobisDistance(const Eigen::Matrix3d& a, const Vec3& d) {
+  return Eigen::LLT<Eigen::Matrix3d>(a).matrixL().solve(d).norm();
+}
 
 // Face samples of v(x) = G x + b.
 inline void fillLinear(MacGrid<3>& grid, const Eigen::Matrix3d& g, const Vec3& b = Vec3::Zero()) {

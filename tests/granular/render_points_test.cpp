@@ -18,7 +18,7 @@ double worstDistance(const RenderPoints& points, const GranularParticles& p) {
   double worst = 0.0;
   for (std::size_t k = 0; k < points.size(); ++k) {
     const std::uint32_t i = points.parents()[k];
-    worst = std::max(worst, mahalanobisDistance(shapeMatrix(p.shape[i]),
+    worst = std::max(worst, test::mahalanobisDistance(shapeMatrix(p.shape[i]),
                                                 points.positions()[k].cast<double>() - p.position[i].cast<double>()));
   }
   return worst;
@@ -34,7 +34,7 @@ TEST(GranularRenderPoints, SamplesAreUniformInTheEllipsoid) {
   Eigen::Matrix3d moment = Eigen::Matrix3d::Zero();
   for (int k = 0; k < n; ++k) {
     const Vec3 d = sampleInEllipsoid(a, rng);
-    EXPECT_LE(mahalanobisDistance(a, d), 1.0 + 1e-12);
+    EXPECT_LE(test::mahalanobisDistance(a, d), 1.0 + 1e-12);
     mean += d / n;
     moment += d * d.transpose() / n;
   }

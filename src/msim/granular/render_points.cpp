@@ -13,11 +13,6 @@
 
 namespace msim::granular {
 
-double mahalanobisDistance(const Eigen::Matrix3d& a, const Vec3& d) {
-  // |L^{-1} d| with A = L L^T.
-  return Eigen::LLT<Eigen::Matrix3d>(a).matrixL().solve(d).norm();
-}
-
 Vec3 sampleInEllipsoid(const Eigen::Matrix3d& a, Rng& rng) {
   // Uniform in the unit ball: a uniform direction (normalised Gaussian) at radius cbrt(u).
   Vec3 direction(rng.normal(), rng.normal(), rng.normal());

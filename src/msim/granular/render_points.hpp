@@ -23,8 +23,6 @@
 
 namespace msim::granular {
 
-// (d^T A^{-1} d)^(1/2): 1 on the surface of the ellipsoid of A centred at the origin.
-double mahalanobisDistance(const Eigen::Matrix3d& a, const Vec3& d);
 // Uniform in the ellipsoid d^T A^{-1} d <= 1 (A = L L^T maps the unit ball onto it with constant
 // Jacobian). Draws four numbers.
 Vec3 sampleInEllipsoid(const Eigen::Matrix3d& a, Rng& rng);
