@@ -56,32 +56,23 @@ void BM_Mosque25k(benchmark::State& state) { stepScene(state, scenePath("crowd_m
 // Fig. 4.11: the circle with N agents (range 0, thousands), the disc and the domain grown by
 // sqrt(N / 10k) so density and cell size (2.5 m) stay those of the 10k scene; range 1 picks the
 // model (0 UIC, 1 ORCA). Timed from the start: at 1M agents the fronts need minutes to meet.
-void BM_CircleScaling(benchmark::State& state) {
+std::vector<std::string> scaledCircle(const benchmark::State& state) {
   const double n = 1000.0 * static_cast<double>(state.range(0));
   const double scale = std::sqrt(n / 10000.0);
-  const std::vector<std::string> overrides = {
-      fmt::format("domain.max=[{},{}]", 100 * scale, 100 * scale),
-      fmt::format("domain.resolution={}", static_cast<int>(std::lround(40 * scale))),
-      fmt::format("groups[0].count={}", static_cast<long long>(n)),
-      fmt::format("groups[0].region.center=[{},{}]", 50 * scale, 50 * scale),
-      fmt::format("groups[0].region.radius={}", 40 * scale),
-      std::string("groups[0].model=") + (state.range(1) == 0 ? "uic" : "orca")};
-  stepScene(state, scenePath("crowd_circle"), overrides, 2);
+  return {fmt::format("domain.max=[{},{}]", 100 * scale, 100 * scale),
+          fmt::format("domain.resolution={}", static_cast<int>(std::lround(40 * scale))),
+          fmt::format("groups[0].count={}", static_cast<long long>(n)),
+          fmt::format("groups[0].region.center=[{},{}]", 50 * scale, 50 * scale),
+          fmt::format("groups[0].region.radius={}", 40 * scale),
+          std::string("groups[0].model=") + (state.range(1) == 0 ? "uic" : "orca")};
 }
+
+void BM_CircleScaling(benchmark::State& state) { stepScene(state, scenePath("crowd_circle"), scaledCircle(state), 2); }
 
 // The same circle timed over its first 200 steps (20 s: the disc closes in and the crowd packs to
 // rho_max), one run per iteration, the average per step reported; range as above.
 void BM_CircleScalingRun(benchmark::State& state) {
-  const double n = 1000.0 * static_cast<double>(state.range(0));
-  const double scale = std::sqrt(n / 10000.0);
-  const scene::Scene s = scene::loadScene(
-      scenePath("crowd_circle"),
-      {fmt::format("domain.max=[{},{}]", 100 * scale, 100 * scale),
-       fmt::format("domain.resolution={}", static_cast<int>(std::lround(40 * scale))),
-       fmt::format("groups[0].count={}", static_cast<long long>(n)),
-       fmt::format("groups[0].region.center=[{},{}]", 50 * scale, 50 * scale),
-       fmt::format("groups[0].region.radius={}", 40 * scale),
-       std::string("groups[0].model=") + (state.range(1) == 0 ? "uic" : "orca")});
+  const scene::Scene s = scene::loadScene(scenePath("crowd_circle"), scaledCircle(state));
   constexpr int kSteps = 200;
   for (auto _ : state) {
     state.PauseTiming();

@@ -1,4 +1,4 @@
-// Agents' placement order: sortSpatially (a Z-order curve) keeps the same points and puts
+// Agents' placement order: sortSpatially (a Hilbert curve) keeps the same points and puts
 // neighbours next to each other, which is what the per-agent passes of a step rely on for
 // reading memory in order.
 #include "msim/crowd/agents.hpp"
@@ -34,7 +34,7 @@ TEST(CrowdAgents, SpatialSortKeepsThePointsAndBringsNeighboursTogether) {
   const double random = meanStep(points), curve = meanStep(sorted);
   std::printf("mean distance between consecutive points: %.3f m in random order, %.3f m along the curve\n", random,
               curve);
-  // 20000 points on 100 x 50 m: about 0.5 m apart; a Z-order walk steps mostly to a neighbour.
+  // 20000 points on 100 x 50 m: about 0.5 m apart; a Hilbert walk steps mostly to a neighbour.
   EXPECT_LT(curve, random / 20.0);
 }
 

@@ -1,41 +1,17 @@
 #include "msim/crowd/agents.hpp"
 
-#include <algorithm>
-#include <cstdint>
-#include <utility>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/hilbert_sort.h>
 
 namespace msim::crowd {
 
-namespace {
-// The bits of v spread to the even bit positions (16 -> 32 bits).
-std::uint32_t spreadBits(std::uint32_t v) {
-  v = (v | (v << 8)) & 0x00FF00FFu;
-  v = (v | (v << 4)) & 0x0F0F0F0Fu;
-  v = (v | (v << 2)) & 0x33333333u;
-  v = (v | (v << 1)) & 0x55555555u;
-  return v;
-}
-}  // namespace
-
 void sortSpatially(std::vector<Vec2>& points) {
-  if (points.size() < 2) return;
-  Vec2 lo = points[0], hi = points[0];
-  for (const Vec2& p : points) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-  // 2^16 steps per axis over the larger side: cells far below an agent's size.
-  const double scale = 65535.0 / std::max((hi - lo).maxCoeff(), 1e-12);
-  std::vector<std::pair<std::uint32_t, std::size_t>> keyed(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const auto x = static_cast<std::uint32_t>((points[i].x() - lo.x()) * scale);
-    const auto y = static_cast<std::uint32_t>((points[i].y() - lo.y()) * scale);
-    keyed[i] = {spreadBits(x) | (spreadBits(y) << 1), i};
-  }
-  std::sort(keyed.begin(), keyed.end());  // ties by input order: deterministic
-  std::vector<Vec2> sorted(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) sorted[i] = points[keyed[i].second];
-  points.swap(sorted);
+  using Point = CGAL::Exact_predicates_inexact_constructions_kernel::Point_2;
+  std::vector<Point> sorted;
+  sorted.reserve(points.size());
+  for (const Vec2& p : points) sorted.emplace_back(p.x(), p.y());
+  CGAL::hilbert_sort(sorted.begin(), sorted.end());  // median policy: no randomness
+  for (std::size_t i = 0; i < points.size(); ++i) points[i] = Vec2(sorted[i].x(), sorted[i].y());
 }
 
 void Agents::reserve(std::size_t n) {

@@ -29,10 +29,10 @@ struct AgentSpec {
   std::uint32_t group = 0;         // user label (inflow, spawn region), for metrics and colours
 };
 
-// Orders points along a Z-order (Morton) curve over their bounding box, so that agents added in
-// this order are stored next to their neighbours: the per-agent passes of a step (splat, gather,
-// collision buckets) then read memory nearly in order instead of at random. Agents placed at
-// random get their ids in this order; it lasts as long as neighbours stay neighbours.
+// Orders points along a Hilbert curve (CGAL's hilbert_sort), so that agents added in this order
+// are stored next to their neighbours: the per-agent passes of a step (splat, gather, collision
+// buckets) then read memory nearly in order instead of at random. Agents placed at random get
+// their ids in this order; it lasts as long as neighbours stay neighbours.
 void sortSpatially(std::vector<Vec2>& points);
 
 class Agents {

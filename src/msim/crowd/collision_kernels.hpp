@@ -154,13 +154,31 @@ template <typename ForEachPartner>
   return share;
 }
 
-// Gauss-Seidel projections of agent i's pairs with the partners js[q]: each pair closer than target =
-// s (r_i + r_j) is pushed apart to target along its centre line, i taking si = yield_j (0 if i is
-// scripted) of the correction and j taking sj = yield_i (2 - 2 yield_j) (0 if j is scripted):
-// equal and opposite for two movable agents. Each j is moved in place as it comes; i's shares are
-// taken from its position at the start and applied together at the end (coincident partners
-// last).
-inline void projectPairs(const SweepSlots& a, std::uint32_t i, const std::uint32_t* js, std::uint32_t count, float s) {
+// The end of agent i's projections: its coincident partners (rare, out of line), then its own
+// shares (dx, dy) applied together.
+template <typename ForEachPartner>
+inline void applyShares(const SweepSlots& a, std::uint32_t i, float dx, float dy, bool coincident,
+                        const ForEachPartner& forEachPartner, float s) {
+  if (coincident) [[unlikely]] {
+    const Vec2f share = coincidentCorrections(a, i, forEachPartner, s);
+    dx += share.x();
+    dy += share.y();
+  }
+  if (dx == 0.0f && dy == 0.0f) return;
+  a.x[i] += dx;
+  a.y[i] += dy;
+  const float lx = a.x[i] - a.bucketX[i], ly = a.y[i] - a.bucketY[i];
+  a.far[i] = std::max(a.far[i], lx * lx + ly * ly);
+}
+
+// Gauss-Seidel projections of agent i's pairs with the partners forEachPartner(f) enumerates
+// (never i itself): each pair closer than target = s (r_i + r_j) is pushed apart to target along
+// its centre line, i taking si = yield_j (0 if i is scripted) of the correction and j taking
+// sj = yield_i (2 - 2 yield_j) (0 if j is scripted): equal and opposite for two movable agents.
+// Each j is moved in place as it comes; i's shares are taken from its position at the start and
+// applied together at the end (coincident partners last).
+template <typename ForEachPartner>
+inline void projectPartners(const SweepSlots& a, std::uint32_t i, const ForEachPartner& forEachPartner, float s) {
   // The slot arrays do not overlap: without restrict every store would force the loads again.
   float* __restrict x = a.x;
   float* __restrict y = a.y;
@@ -171,39 +189,37 @@ inline void projectPairs(const SweepSlots& a, std::uint32_t i, const std::uint32
   const float* __restrict yield = a.yield;
   const float xi = x[i], yi = y[i], ri = radius[i], yieldI = yield[i];
   const bool movableI = yieldI < 0.75f;  // yield 1/2: movable, 1: scripted
-  auto moved = [&](std::uint32_t k, float xk, float yk) {
-    x[k] = xk;
-    y[k] = yk;
-    const float lx = xk - bucketX[k], ly = yk - bucketY[k];
-    far[k] = std::max(far[k], lx * lx + ly * ly);
-  };
   float dx = 0.0f, dy = 0.0f;
   bool coincident = false;
-  for (std::uint32_t q = 0; q < count; ++q) {
-    const std::uint32_t j = js[q];
+  forEachPartner([&](std::uint32_t j) {
     const float xj = x[j], yj = y[j];
     const float ex = xi - xj, ey = yi - yj;
     const float target = s * (ri + radius[j]);
     const float d2 = ex * ex + ey * ey, t2 = target * target;
-    if (d2 >= t2) continue;
+    if (d2 >= t2) return;
     if (!(d2 > 1e-14f * t2)) [[unlikely]] {
       coincident = true;
-      continue;
+      return;
     }
     const float f = target * inverseSqrt(d2) - 1.0f;  // (target - dist) / dist
     const float si = movableI ? yield[j] : 0.0f;
     const float sj = yieldI * (2.0f - 2.0f * yield[j]);
     dx += si * f * ex;
     dy += si * f * ey;
-    if (sj > 0.0f) moved(j, xj - sj * f * ex, yj - sj * f * ey);
-  }
-  if (coincident) [[unlikely]] {
-    const Vec2f share = coincidentCorrections(
-        a, i, [&](const auto& f) { for (std::uint32_t q = 0; q < count; ++q) f(js[q]); }, s);
-    dx += share.x();
-    dy += share.y();
-  }
-  if (dx != 0.0f || dy != 0.0f) moved(i, xi + dx, yi + dy);
+    if (sj > 0.0f) {
+      x[j] = xj - sj * f * ex;
+      y[j] = yj - sj * f * ey;
+      const float lx = x[j] - bucketX[j], ly = y[j] - bucketY[j];
+      far[j] = std::max(far[j], lx * lx + ly * ly);
+    }
+  });
+  applyShares(a, i, dx, dy, coincident, forEachPartner, s);
+}
+
+// projectPartners over a list of partner slots js[q], q < count (local sweeps).
+inline void projectPairs(const SweepSlots& a, std::uint32_t i, const std::uint32_t* js, std::uint32_t count, float s) {
+  projectPartners(
+      a, i, [&](const auto& f) { for (std::uint32_t q = 0; q < count; ++q) f(js[q]); }, s);
 }
 
 // Gauss-Seidel projections of agent i against every slot of the ranges [lo[q], hi[q]), q < count
@@ -213,11 +229,14 @@ inline void projectPairs(const SweepSlots& a, std::uint32_t i, const std::uint32
 // other and eight are projected at a time (AVX2; reads up to 7 slots past a range, masked off).
 inline void projectRanges(const SweepSlots& a, std::uint32_t i, const std::uint32_t* lo, const std::uint32_t* hi,
                           int count, float s) {
+  auto ranges = [&](const auto& f) {
+    for (int r = 0; r < count; ++r)
+      for (std::uint32_t j = lo[r]; j < hi[r]; ++j) f(j);
+  };
+#if defined(__AVX2__)
   const float xi = a.x[i], yi = a.y[i], ri = a.radius[i], yieldI = a.yield[i];
   const bool movableI = yieldI < 0.75f;
-  float dx = 0.0f, dy = 0.0f;
   bool coincident = false;
-#if defined(__AVX2__)
   float* __restrict x = a.x;
   float* __restrict y = a.y;
   float* __restrict far = a.far;
@@ -278,48 +297,9 @@ inline void projectRanges(const SweepSlots& a, std::uint32_t i, const std::uint3
         }
       }
     }
-  dx = sum8(ax);
-  dy = sum8(ay);
+  applyShares(a, i, sum8(ax), sum8(ay), coincident, ranges, s);
 #else
-  for (int r = 0; r < count; ++r)
-    for (std::uint32_t j = lo[r]; j < hi[r]; ++j) {
-      const float ex = xi - a.x[j], ey = yi - a.y[j];
-      const float target = s * (ri + a.radius[j]);
-      const float d2 = ex * ex + ey * ey, t2 = target * target;
-      if (d2 >= t2) continue;
-      if (!(d2 > 1e-14f * t2)) {
-        coincident = true;
-        continue;
-      }
-      const float f = target * inverseSqrt(d2) - 1.0f;
-      const float si = movableI ? a.yield[j] : 0.0f;
-      const float sj = yieldI * (2.0f - 2.0f * a.yield[j]);
-      dx += si * f * ex;
-      dy += si * f * ey;
-      if (sj > 0.0f) {
-        a.x[j] -= sj * f * ex;
-        a.y[j] -= sj * f * ey;
-        const float lx = a.x[j] - a.bucketX[j], ly = a.y[j] - a.bucketY[j];
-        a.far[j] = std::max(a.far[j], lx * lx + ly * ly);
-      }
-    }
+  projectPartners(a, i, ranges, s);
 #endif
-  if (coincident) [[unlikely]] {
-    const Vec2f share = coincidentCorrections(
-        a, i,
-        [&](const auto& f) {
-          for (int r = 0; r < count; ++r)
-            for (std::uint32_t j = lo[r]; j < hi[r]; ++j) f(j);
-        },
-        s);
-    dx += share.x();
-    dy += share.y();
-  }
-  if (dx != 0.0f || dy != 0.0f) {
-    a.x[i] = xi + dx;
-    a.y[i] = yi + dy;
-    const float lx = a.x[i] - a.bucketX[i], ly = a.y[i] - a.bucketY[i];
-    a.far[i] = std::max(a.far[i], lx * lx + ly * ly);
-  }
 }
 }  // namespace msim::crowd::collision_kernels

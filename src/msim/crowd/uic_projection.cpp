@@ -271,13 +271,8 @@ void UicProjection::buildStencil(double dt) {
     excluded_[k] = sum == 0.0;
     diagonal_[k] = sum + shift;
   });
-  // Cells without faces decouple; their diagonal only has to be positive. It is the largest real
-  // one: MPRGP's expansion steps have the fixed length 1.9 / ||A||, so a placeholder far above
-  // the real diagonals would shorten them as many times.
-  const double largest = parallelMax(diagonal_.size(), [&](std::size_t k) { return excluded_[k] ? 0.0 : diagonal_[k]; });
-  parallelFor(0, diagonal_.size(), [&](std::size_t k) {
-    if (excluded_[k]) diagonal_[k] = largest > 0.0 ? largest : 1.0;
-  });
+  // Cells without faces decouple.
+  numerics::setDecoupledDiagonals(diagonal_, [&](std::size_t k) { return excluded_[k] != 0; });
   // Bounding box of the cells the QP needs (A_ii > 0); every cell outside it is excluded and, since
   // excluded cells have only zero-weight faces, the box problem is exactly the full one restricted.
   struct Box { int lo[2], hi[2]; };

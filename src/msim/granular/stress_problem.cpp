@@ -28,19 +28,10 @@ void StressProblem::build(const GranularGridState& st, const FaceField& weight, 
   const double dt2 = dt * dt;
   for (auto& l : lower)
     for (double& w : l) w *= dt2;
-  // Samples no material reaches decouple; any positive diagonal keeps the operator definite
-  // and their bounds (or right-hand sides) hold them at 0. It is the largest real one: MPRGP's
-  // expansion steps have the fixed length 1.9 / ||A||, and a placeholder of 1, over a hundred
-  // times the real diagonals (dt^2 times the face weights over dx^2), shrank them as many times:
-  // flowing material, with most of its friction at the bounds, took a thousand steps and more
-  // per friction solve instead of about ten (hourglass, 25 x 50 x 25).
-  double largest = 0.0;
-  for (double& d : diagonal) {
-    d *= dt2;
-    largest = std::max(largest, d);
-  }
-  for (double& d : diagonal)
-    if (!(d > 0.0)) d = largest > 0.0 ? largest : 1.0;
+  // Samples no material reaches decouple (hourglass: with a placeholder diagonal of 1 instead,
+  // a thousand MPRGP steps and more per friction solve instead of about ten).
+  for (double& d : diagonal) d *= dt2;
+  numerics::setDecoupledDiagonals(diagonal, [&](std::size_t i) { return !(diagonal[i] > 0.0); });
   op.setBodyWeight(dt2 * st.spec.cellVolume());
   compact.bodyWeight = dt2 * st.spec.cellVolume();
   bodies.resize(coupled.size());

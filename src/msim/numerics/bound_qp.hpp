@@ -14,9 +14,14 @@
 // See docs/bound_qp.md for parameters and validation numbers.
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 namespace msim::numerics {
 
@@ -33,6 +38,15 @@ class QpOperator {
   // length must lie in (0, 2/||A||] for the cost to decrease (Dostál & Schöberl 2005).
   virtual double normUpperBound() const = 0;
 };
+
+// Diagonal entries of samples that couple to nothing (no stencil weight, decoupled(i) true): any
+// positive value keeps A definite, and their bounds or right-hand sides hold them at 0. They take
+// the largest real diagonal (1 if there is none): MPRGP's expansion steps have the fixed length
+// 1.9 / ||A||, so a placeholder far above the real diagonals shortens them as many times (a
+// placeholder of 1, over a hundred times the granular friction diagonals, made flowing sand's
+// friction solves take a thousand steps instead of about ten). Parallel.
+template <typename Decoupled>
+void setDecoupledDiagonals(std::vector<double>& diagonal, const Decoupled& decoupled);
 
 // Adapter for an assembled symmetric matrix. Keeps a reference: the matrix must outlive it.
 class SparseQpOperator final : public QpOperator {
@@ -131,5 +145,21 @@ class BoundQpSolver {
   Eigen::VectorXd g_, z_, d_, Ad_, invDiagonal_;
   std::vector<double> partial_;  // per-block partial sums of the vector loops
 };
+
+template <typename Decoupled>
+void setDecoupledDiagonals(std::vector<double>& diagonal, const Decoupled& decoupled) {
+  const double largest = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, diagonal.size(), 4096), 0.0,
+      [&](const tbb::blocked_range<std::size_t>& r, double m) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i)
+          if (!decoupled(i)) m = std::max(m, diagonal[i]);
+        return m;
+      },
+      [](double a, double b) { return std::max(a, b); });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, diagonal.size(), 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i)
+      if (decoupled(i)) diagonal[i] = largest > 0.0 ? largest : 1.0;
+  });
+}
 
 }  // namespace msim::numerics
