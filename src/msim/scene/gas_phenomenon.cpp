@@ -15,6 +15,7 @@
 #include "msim/scene/phenomenon_support.hpp"
 #include "msim/scene/scene_file.hpp"
 #include "msim/scene/schema/shape_schema.hpp"
+#include "msim/scene/turbulent_wind_keys.hpp"
 
 namespace msim::scene {
 
@@ -48,6 +49,7 @@ void declareGas(Schema& root) {
       .min(0.0)
       .max(1.0);
   root.array("motion_fields", field, "summed to give the velocity u(x) (eq. 6.1)");
+  declareTurbulentWinds(root);
 
   Schema source = Schema::object("a region emitting gas");
   source.field("shape", shapeSchema());
@@ -133,6 +135,8 @@ class GasPhenomenon final : public Phenomenon {
       s.cells = coveredOpenCells<D>(scene, *sceneShape<D>(scene, sources[i].at("shape"), key), solid, key);
       solver_.addSource(std::move(s));
     }
+    // Turbulence on top of the smooth fields (Stam ch. 6.3.2: the plain sum of eq. 6.1).
+    for (auto& wind : turbulentWinds<D>(scene)) solver_.addWind(std::move(wind));
     preview_ = previewSettings(scene);
   }
 
@@ -160,8 +164,10 @@ class GasPhenomenon final : public Phenomenon {
     return render::renderDensityPreview(solver_.density(), preview_, &solver_.solid());
   }
 
-  // The motion fields are steady, so the state is the two grids whatever the time.
-  void restore(const std::filesystem::path& vdbFile, double /*time*/) override {
+  // The motion fields are steady and the winds a function of time, so the state is the two grids
+  // and the clock.
+  void restore(const std::filesystem::path& vdbFile, double time) override {
+    solver_.setTime(time);
     restoreGrid(vdbFile, "density", solver_.density(), source_);
     restoreGrid(vdbFile, "temperature", solver_.temperature(), source_);
   }

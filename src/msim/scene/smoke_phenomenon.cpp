@@ -16,6 +16,7 @@
 #include "msim/scene/scene_file.hpp"
 #include "msim/scene/scene_obstacles.hpp"
 #include "msim/scene/smoke_scene_keys.hpp"
+#include "msim/scene/turbulent_wind_keys.hpp"
 
 namespace msim::scene {
 
@@ -53,6 +54,7 @@ class SmokePhenomenon final : public Phenomenon {
       flame_ = solver_.addScalar("flame");
     }
     addSources(scene);
+    for (auto& wind : turbulentWinds<D>(scene)) solver_.addWind(std::move(wind));
     preview_ = previewSettings(scene);
     preview_.emissionScale = r.at("fire").at("emission").get<double>();
   }
@@ -64,7 +66,7 @@ class SmokePhenomenon final : public Phenomenon {
     const double dx = solver_.spec().dx;
     const double cflDt = solver_.cflTimestep();
     double speed = std::isfinite(cflDt) ? p.cfl * dx / cflDt : 0.0;
-    speed = std::max({speed, boundarySpeed_, obstacles_.maxSpeed(time_)});
+    speed = std::max({speed, boundarySpeed_, obstacles_.maxSpeed(time_), solver_.maxWindSpeed()});
     const double hottest = maxValue(solver_.temperature()) - p.buoyancy.ambientTemperature;
     const double accel = p.buoyancy.beta * std::max(hottest, 0.0) + p.buoyancy.alpha * maxValue(solver_.density());
     speed += std::sqrt(dx * accel);
@@ -128,6 +130,7 @@ class SmokePhenomenon final : public Phenomenon {
 
   void restore(const std::filesystem::path& vdbFile, double time) override {
     time_ = time;
+    solver_.setTime(time);
     if (obstacles_.moving()) placeObstacles(time_);
     restoreGrid(vdbFile, "density", solver_.density(), source_);
     restoreGrid(vdbFile, "temperature", solver_.temperature(), source_);

@@ -8,6 +8,7 @@
 #include "msim/scene/json_vectors.hpp"
 #include "msim/scene/scene_file.hpp"
 #include "msim/scene/schema/shape_schema.hpp"
+#include "msim/scene/turbulent_wind_keys.hpp"
 
 namespace msim::scene {
 
@@ -46,6 +47,9 @@ Schema smokeKeys() {
   buoyancy.number("beta", "m/(s^2 K)", 0.0, "lift per kelvin above ambient").min(0.0);
   smoke.field("buoyancy", buoyancy);
   smoke.number("vorticity_confinement", "", 0.0, "epsilon of the confinement force (ch. 3.2.1); 0 = off").min(0.0);
+  smoke.number("wind_coupling", "1/s", 1.0,
+               "rate at which the air is pulled towards the turbulent winds (winds[]): drag c (u_wind - u)")
+      .min(0.0);
   smoke.number("viscosity", "m^2/s", 0.0, "kinematic viscosity, solved implicitly; 0 = inviscid as in Selle").min(0.0);
   smoke.number("density_dissipation", "1/s", 0.0, "smoke density decays as exp(-rate t)").min(0.0);
   smoke.number("temperature_dissipation", "1/s", 0.0, "T - T_ambient decays as exp(-rate t)").min(0.0);
@@ -107,6 +111,7 @@ void declareSmokeKeys(Schema& root) {
   obstacle.vector("oscillation", "m", {0.0, 0.0, 0.0}, "amplitude A of the motion").lengths({2, 3});
   obstacle.number("frequency", "1/s", 0.0, "f of the motion").min(0.0);
   root.array("obstacles", obstacle, "static or moving solids");
+  declareTurbulentWinds(root);
 }
 
 template <int D>
@@ -140,6 +145,7 @@ fluid::SmokeParams<D> smokeParams(const Scene& scene) {
   if (p.buoyancy.upAxis >= D)
     throw InputError(fmt::format("{}: 'smoke.up_axis' is 'z' but the scene is 2D", file));
   p.vorticityEpsilon = s.at("vorticity_confinement").get<double>();
+  p.windCoupling = s.at("wind_coupling").get<double>();
   p.viscosity = s.at("viscosity").get<double>();
   p.densityDissipation = s.at("density_dissipation").get<double>();
   p.temperatureDissipation = s.at("temperature_dissipation").get<double>();

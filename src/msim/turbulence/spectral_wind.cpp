@@ -144,6 +144,19 @@ std::span<const Vecf<D>> SpectralWind<D>::timeSlice(int l) const {
 }
 
 template <int D>
+void SpectralWind<D>::componentAt(int axis, double t, std::vector<float>& slice) const {
+  const int mt = params_.timeSamples;
+  const double g = t * (mt / params_.period);
+  const double floor = std::floor(g);
+  const float fraction = static_cast<float>(g - floor);
+  const double wrapped = std::fmod(floor, double(mt));
+  const int l = static_cast<int>(wrapped < 0.0 ? wrapped + mt : wrapped) % mt;
+  const auto a = timeSlice(l), b = timeSlice(l + 1);
+  slice.resize(a.size());
+  parallelFor(0, a.size(), [&](std::size_t i) { slice[i] = (1.0f - fraction) * a[i][axis] + fraction * b[i][axis]; }, 1 << 14);
+}
+
+template <int D>
 Vec<D> SpectralWind<D>::velocity(const Vec<D>& x, double t) const {
   const int m = params_.resolution, mt = params_.timeSamples;
   // Lattice coordinates: the lower corner index (wrapped) and the fraction towards the next one.

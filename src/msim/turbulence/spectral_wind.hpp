@@ -54,6 +54,10 @@ class SpectralWind {
   // every axis and T in time.
   Vec<D> velocity(const Vec<D>& x, double t) const;
 
+  // Component `axis` of the lattice blended linearly to time t (M^D values, x fastest): the time
+  // interpolation of velocity() done once for a whole slice.
+  void componentAt(int axis, double t, std::vector<float>& slice) const;
+
   // The lattice: sample (i_0 .. i_{D-1}, l) at index i_0 + M (i_1 + M (... + M l)), each a velocity.
   std::span<const Vecf<D>> samples() const { return samples_; }
   // The samples of time slice l (M^D of them, x fastest).

@@ -25,15 +25,37 @@ GasSolver<D>::GasSolver(const GridSpec<D>& spec, const GasParams& params, const 
       params_(params),
       density_(spec, 0.0f),
       temperature_(spec, static_cast<float>(params.ambientTemperature)),
-      transport_(spec, boundaries) {
+      transport_(spec, boundaries),
+      steadyVelocity_(spec) {
   // The motion field sampled on the cell faces, once: it is steady. 2D scenes live in the z = 0
   // plane of the 3D field.
-  MacGrid<D> velocity(spec);
   for (int a = 0; a < D; ++a) {
-    auto& u = velocity.component(a);
+    auto& u = steadyVelocity_.component(a);
     parallelForCells(u, [&](const IVec<D>& f, std::size_t lin) {
       u[lin] = static_cast<float>(field.velocity(toVec3<D>(u.position(f)))[a]);
     });
+  }
+  transport_.setVelocity(steadyVelocity_);
+}
+
+template <int D>
+void GasSolver<D>::addWind(turbulence::TurbulentWind<D> wind) {
+  winds_.push_back(std::move(wind));
+  refreshVelocity();
+}
+
+template <int D>
+void GasSolver<D>::setTime(double time) {
+  time_ = time;
+  if (!winds_.empty()) refreshVelocity();
+}
+
+template <int D>
+void GasSolver<D>::refreshVelocity() {
+  MacGrid<D> velocity = steadyVelocity_;
+  for (int a = 0; a < D; ++a) {
+    auto& u = velocity.component(a);
+    for (const auto& w : winds_) w.forEachSample(u, a, time_, [&](std::size_t lin, float v) { u[lin] += v; });
   }
   transport_.setVelocity(velocity);
 }
@@ -94,6 +116,9 @@ void GasSolver<D>::step(double dt) {
   transport_.step(temperature_, temperatureSettings, dt);
   // Exact integration of the linear loss terms over the step (no stability limit of their own).
   decay(dt);
+  time_ += dt;
+  // The next step's flow, so that stableTimestep() sees it.
+  if (!winds_.empty()) refreshVelocity();
 }
 
 template <int D>

@@ -15,6 +15,7 @@
 #include "msim/core/mac_grid.hpp"
 #include "msim/fluid/gas/motion_field.hpp"
 #include "msim/numerics/flux_transport.hpp"
+#include "msim/turbulence/turbulent_wind.hpp"
 
 namespace msim::fluid {
 
@@ -52,6 +53,13 @@ class GasSolver {
   // Cells with solid > 0.5 are obstacles: no gas, no flux through their faces.
   void setSolid(const Grid<float, D>& solid);
   void addSource(GasSource source) { sources_.push_back(std::move(source)); }
+  // A turbulent wind added to the motion field (eq. 6.1: the plain sum, which the seed found to
+  // work well): the face velocities become steady field + winds at the current time, resampled
+  // after every step.
+  void addWind(turbulence::TurbulentWind<D> wind);
+  // Sets the clock the winds are sampled at (a resumed run) [s].
+  void setTime(double time);
+  double time() const { return time_; }
 
   // Largest step the explicit transport takes stably, times params.cfl [s].
   double stableTimestep() const;
@@ -71,6 +79,7 @@ class GasSolver {
  private:
   void emit(double dt);
   void decay(double dt);
+  void refreshVelocity();
 
   GridSpec<D> spec_;
   GasParams params_;
@@ -78,6 +87,9 @@ class GasSolver {
   Grid<float, D> temperature_;
   numerics::FluxTransport<D> transport_;
   std::vector<GasSource> sources_;
+  MacGrid<D> steadyVelocity_;  // the motion field on the faces
+  std::vector<turbulence::TurbulentWind<D>> winds_;
+  double time_ = 0.0;
 };
 
 }  // namespace msim::fluid

@@ -193,6 +193,7 @@ void SmokeSolver<D>::step(double dt) {
     if (b.alpha != 0.0 || b.beta != 0.0) addBuoyancy(velocity_, density_, temperature_, b, dt, solid);
     // Confinement re-injects the small-scale rotation (eq. 3.3) numerical dissipation removed.
     if (params_.vorticityEpsilon != 0.0) confinement_.apply(velocity_, params_.vorticityEpsilon, dt, solid);
+    if (!winds_.empty()) applyWinds(dt);
   }
   if (params_.viscosity > 0.0) {
     ScopedStage s(timers_, "viscosity");
@@ -216,6 +217,7 @@ void SmokeSolver<D>::step(double dt) {
     dissipate(dt);
   }
   ++steps_;
+  time_ += dt;
   if (params_.checkFinite) checkFinite();
 }
 
@@ -448,6 +450,38 @@ SmokeStatistics SmokeSolver<D>::statistics() const {
   s.viscosityIterations = viscosityIterations_;
   s.step = steps_;
   return s;
+}
+
+template <int D>
+double SmokeSolver<D>::maxWindSpeed() const {
+  double sum = 0.0;
+  for (const auto& w : winds_) sum += w.maxSpeed();
+  return sum;
+}
+
+// Drag towards the winds, du/dt = c (u_wind - u), solved exactly over the step (stable for any c
+// dt), on the faces between two fluid cells, with the winds at the middle of the step.
+template <int D>
+void SmokeSolver<D>::applyWinds(double dt) {
+  const float pull = static_cast<float>(1.0 - std::exp(-params_.windCoupling * dt));
+  if (pull == 0.0f) return;
+  const double t = time_ + 0.5 * dt;
+  for (int a = 0; a < D; ++a) {
+    auto& u = velocity_.component(a);
+    windScratch_.resize(u.count());
+    std::fill(windScratch_.begin(), windScratch_.end(), 0.0f);
+    for (const auto& w : winds_) w.forEachSample(u, a, t, [&](std::size_t lin, float v) { windScratch_[lin] += v; });
+    parallelForCells(u, [&](const IVec<D>& f, std::size_t lin) {
+      if (hasObstacles_) {
+        IVec<D> below = f;
+        below[a] -= 1;
+        const bool solidBelow = below[a] >= 0 && solid_(below) > 0.5f;
+        const bool solidAbove = f[a] < spec_.res[a] && solid_(f) > 0.5f;
+        if (solidBelow || solidAbove) return;
+      }
+      u[lin] += pull * (windScratch_[lin] - u[lin]);
+    });
+  }
 }
 
 template class SmokeSolver<2>;

@@ -30,6 +30,7 @@
 #include "msim/numerics/advection/advector.hpp"
 #include "msim/numerics/flux_transport.hpp"
 #include "msim/numerics/pressure/projection.hpp"
+#include "msim/turbulence/turbulent_wind.hpp"
 
 namespace msim::fluid {
 
@@ -48,6 +49,9 @@ struct SmokeParams {
   double fluidDensity = 1.0;                 // rho in the pressure equation [kg/m^3]
   BuoyancyParams buoyancy;                   // alpha = beta = 0: no buoyancy
   double vorticityEpsilon = 0.0;             // confinement strength (0: off)
+  // Rate at which the air is pulled towards the turbulent winds (addWind) [1/s]: a drag force
+  // c (u_wind - u) per unit mass, integrated exactly over the step.
+  double windCoupling = 1.0;
   double viscosity = 0.0;                    // kinematic nu [m^2/s] (0: inviscid, as Selle)
   ViscosityMode viscosityMode = ViscosityMode::Implicit;
   ViscositySolveSettings viscositySolve;
@@ -103,6 +107,13 @@ class SmokeSolver {
   // Velocity of the obstacles on each face [m/s] (moving-obstacle boundary condition).
   void setObstacleVelocity(const MacGrid<D>& solidVelocity);
   void addSource(SmokeSource<D> source) { sources_.push_back(std::move(source)); }
+  // A turbulent wind acting on the air as a force (params.windCoupling); several add up.
+  void addWind(turbulence::TurbulentWind<D> wind) { winds_.push_back(std::move(wind)); }
+  // Bound on the winds' summed speed [m/s] (0 without winds), for the time step.
+  double maxWindSpeed() const;
+  // The clock the winds are sampled at [s]; step() advances it, a resumed run sets it.
+  void setTime(double time) { time_ = time; }
+  double time() const { return time_; }
   SmokeSource<D>& source(std::size_t i) { return sources_[i]; }
   std::size_t sourceCount() const { return sources_.size(); }
   // A further advected cell-centred scalar (e.g. fuel), dissipating as rho does; returns its index.
@@ -162,6 +173,7 @@ class SmokeSolver {
   void extrapolateIntoCutFaces();
   void applyInflow();
   void dissipate(double dt);
+  void applyWinds(double dt);
   void checkFinite() const;
   double measureDivergence();
 
@@ -193,6 +205,9 @@ class SmokeSolver {
   double maxDivergence_ = 0.0;
   int pressureIterations_ = 0, viscosityIterations_ = 0;
   long steps_ = 0;
+  std::vector<turbulence::TurbulentWind<D>> winds_;
+  std::vector<float> windScratch_;  // the winds on one face component
+  double time_ = 0.0;
 };
 
 }  // namespace msim::fluid
