@@ -16,6 +16,8 @@
 #include <sstream>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "cli_harness.hpp"
 #include "msim/io/vdb.hpp"
 
@@ -216,6 +218,13 @@ TEST(Cli, TurbulentWindResumesBitExactly) {
   const auto b = msim::io::readFloatGrid(dir / "split" / "vdb" / "tiny_0004.vdb", "density");
   ASSERT_EQ(a.count(), b.count());
   EXPECT_EQ(0, std::memcmp(a.data().data(), b.data().data(), a.count() * sizeof(float)));
+  // The run reports the wind's spectrum against the prescribed one.
+  EXPECT_TRUE(fs::exists(dir / "full" / "winds" / "wind_0_spectrum.png"));
+  EXPECT_TRUE(fs::exists(dir / "full" / "winds" / "wind_0_spectrum.csv"));
+  std::ifstream runJson(dir / "full" / "run.json");
+  const auto report = nlohmann::json::parse(runJson).at("results").at("winds").at(0);
+  EXPECT_LT(report.at("divergence_over_gradient").get<double>(), 1e-5);
+  EXPECT_NEAR(report.at("speed_rms_mps").get<double>() / 0.3, 1.0, 0.25);
   // The wind does move the gas: the same run without it differs.
   ASSERT_EQ(runMsim("run " + scene + " -q --set winds=[] --out " + (dir / "calm").string()).exitCode, 0);
   const auto c = msim::io::readFloatGrid(dir / "calm" / "vdb" / "tiny_0004.vdb", "density");

@@ -16,6 +16,7 @@
 #include "msim/scene/scene_file.hpp"
 #include "msim/scene/schema/shape_schema.hpp"
 #include "msim/scene/turbulent_wind_keys.hpp"
+#include "msim/scene/turbulent_wind_report.hpp"
 
 namespace msim::scene {
 
@@ -170,6 +171,12 @@ class GasPhenomenon final : public Phenomenon {
     solver_.setTime(time);
     restoreGrid(vdbFile, "density", solver_.density(), source_);
     restoreGrid(vdbFile, "temperature", solver_.temperature(), source_);
+  }
+
+  // Each wind's spectrum against the prescribed one (winds/), and its measures in run.json.
+  json finishRun(const std::filesystem::path& runDir, const json& /*frames*/) override {
+    const json winds = writeWindReports<D>(solver_.winds(), runDir);
+    return winds.empty() ? json::object() : json{{"winds", winds}};
   }
 
   json statistics() const override {

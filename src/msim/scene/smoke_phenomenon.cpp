@@ -17,6 +17,7 @@
 #include "msim/scene/scene_obstacles.hpp"
 #include "msim/scene/smoke_scene_keys.hpp"
 #include "msim/scene/turbulent_wind_keys.hpp"
+#include "msim/scene/turbulent_wind_report.hpp"
 
 namespace msim::scene {
 
@@ -138,6 +139,12 @@ class SmokePhenomenon final : public Phenomenon {
       restoreGrid(vdbFile, solver_.scalarName(i), solver_.scalar(i), source_);
     for (int a = 0; a < D; ++a) restoreGrid(vdbFile, faceGridName(a), solver_.velocity().component(a), source_);
     restoreGrid(vdbFile, "pressure", solver_.pressure(), source_);
+  }
+
+  // Each wind's spectrum against the prescribed one (winds/), and its measures in run.json.
+  json finishRun(const std::filesystem::path& runDir, const json& /*frames*/) override {
+    const json winds = writeWindReports<D>(solver_.winds(), runDir);
+    return winds.empty() ? json::object() : json{{"winds", winds}};
   }
 
   json statistics() const override {

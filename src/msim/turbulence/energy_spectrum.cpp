@@ -60,18 +60,30 @@ ShellSpectrum shellSpectrum(std::span<const Vecf<D>> field, int resolution, doub
   const double dk = 2.0 * std::numbers::pi / size;
   ShellSpectrum out;
   out.energy.assign(shells, 0.0);
+  out.wavenumber.assign(shells, 0.0);
   out.modes.assign(shells, 0);
-  for (int k = 1; k <= shells; ++k) out.wavenumber.push_back(k * dk);
+  const double sphere = D == 2 ? 2.0 * std::numbers::pi : 4.0 * std::numbers::pi;  // unit sphere's surface
   for (std::size_t a = 0; a < c[0].size(); ++a) {
     const auto s = frequencies<D>(a, resolution);
     double q = 0.0;
     for (int d = 0; d < D; ++d) q += double(s[d]) * s[d];
-    const long shell = std::lround(std::sqrt(q));
+    const double radius = std::sqrt(q);
+    const long shell = std::lround(radius);
     if (shell < 1 || shell > shells) continue;
     double e = 0.0;
     for (int d = 0; d < D; ++d) e += 0.5 * std::norm(std::complex<double>(c[d][a]));
-    out.energy[shell - 1] += e / dk;
+    out.energy[shell - 1] += sphere * std::pow(radius, D - 1) * e / dk;
+    out.wavenumber[shell - 1] += radius * dk;
     ++out.modes[shell - 1];
+  }
+  for (int k = 1; k <= shells; ++k) {
+    const std::size_t count = out.modes[k - 1];
+    if (count == 0) {
+      out.wavenumber[k - 1] = k * dk;
+      continue;
+    }
+    out.energy[k - 1] /= double(count);
+    out.wavenumber[k - 1] /= double(count);
   }
   return out;
 }

@@ -11,13 +11,18 @@
 namespace msim::turbulence {
 
 struct ShellSpectrum {
-  std::vector<double> wavenumber;   // shell n: k_n = 2 pi n / P [rad/m], n = 1 .. M / 2
-  std::vector<double> energy;       // E(k_n) [m^3/s^2]: 1/2 sum |u^|^2 over the modes with round(|n|) = n, / dk
+  std::vector<double> wavenumber;   // shell n: the mean |k| of its modes [rad/m] (k = 2 pi |n| / P), n = 1 .. M / 2
+  std::vector<double> energy;       // E at that wavenumber [m^3/s^2] (0 for a shell without modes)
   std::vector<std::size_t> modes;   // lattice modes in the shell
 };
 
-// E(k) of the periodic field `field` (resolution^D samples, x fastest, tile side `size` [m]):
-// u^ = FFT(u) / N, so that sum_shells E dk = 1/2 <|u|^2> over the modes up to |n| = M / 2 + 1/2.
+// E(k) of the periodic field `field` (resolution^D samples, x fastest, tile side `size` [m]),
+// u^ = FFT(u) / N, shell n holding the modes with round(|n|) = n. Each mode estimates E at its own
+// |k| as its energy 1/2 |u^|^2 times the area of the sphere of radius |n| in mode space (4 pi n^2
+// in 3D, 2 pi n in 2D) over dk; a shell reports the mean estimate at its modes' mean |k|. (The
+// plain sum over a shell carries the lattice's uneven mode counts and radii: on a 32^3 lattice
+// it puts exact Kolmogorov modes 6% low in shell 6; this estimator is within 0.5% from shell 5 up.)
+// So sum_shells E dk approximates 1/2 <|u|^2> rather than equalling it.
 template <int D>
 ShellSpectrum shellSpectrum(std::span<const Vecf<D>> field, int resolution, double size);
 

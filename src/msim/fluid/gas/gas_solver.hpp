@@ -60,6 +60,7 @@ class GasSolver {
   // Sets the clock the winds are sampled at (a resumed run) [s].
   void setTime(double time);
   double time() const { return time_; }
+  const std::vector<turbulence::TurbulentWind<D>>& winds() const { return winds_; }
 
   // Largest step the explicit transport takes stably, times params.cfl [s].
   double stableTimestep() const;

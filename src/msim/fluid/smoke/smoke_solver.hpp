@@ -114,6 +114,7 @@ class SmokeSolver {
   // The clock the winds are sampled at [s]; step() advances it, a resumed run sets it.
   void setTime(double time) { time_ = time; }
   double time() const { return time_; }
+  const std::vector<turbulence::TurbulentWind<D>>& winds() const { return winds_; }
   SmokeSource<D>& source(std::size_t i) { return sources_[i]; }
   std::size_t sourceCount() const { return sources_.size(); }
   // A further advected cell-centred scalar (e.g. fuel), dissipating as rho does; returns its index.

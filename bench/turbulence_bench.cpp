@@ -1,0 +1,68 @@
+// Turbulent wind (Stam ch. 3.4): synthesis of the periodic 4D lattice (3 inverse FFTs of
+// M^3 x M_t complex samples), and sampling it on a grid's faces every step (gas and smoke winds)
+// and at scattered points.
+#include <benchmark/benchmark.h>
+
+#include "msim/core/mac_grid.hpp"
+#include "msim/core/rng.hpp"
+#include "msim/turbulence/turbulent_wind.hpp"
+
+using namespace msim;
+
+namespace {
+
+turbulence::SpectralWindParams lattice(int m, int mt) {
+  turbulence::SpectralWindParams p;
+  p.resolution = m;
+  p.timeSamples = mt;
+  p.spectrum.largestEddy = 0.25;
+  p.spectrum.smallestEddy = 2.0 / m;
+  return p;
+}
+
+void BM_WindSynthesis(benchmark::State& state) {
+  const auto p = lattice(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  for (auto _ : state) benchmark::DoNotOptimize(turbulence::SpectralWind<3>(p).samples().data());
+  state.counters["samples"] = static_cast<double>(std::pow(p.resolution, 3) * p.timeSamples);
+}
+BENCHMARK(BM_WindSynthesis)->Args({16, 16})->Args({32, 16})->Args({64, 16})->Unit(benchmark::kMillisecond);
+
+// All three face components of an n^3 MAC grid, as GasSolver::addWind resamples every step.
+void BM_WindOnFaces(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const turbulence::TurbulentWind<3> wind(turbulence::SpectralWind<3>(lattice(32, 16)), Vec3::Zero(), Vec3(0.3, 0, 0));
+  const GridSpec<3> spec(Vec3::Zero(), 1.0 / n, IVec3(n, n, n));
+  MacGrid<3> u(spec);
+  double t = 0.0;
+  for (auto _ : state) {
+    for (int a = 0; a < 3; ++a) {
+      auto& g = u.component(a);
+      wind.forEachSample(g, a, t, [&](std::size_t lin, float v) { g[lin] = v; });
+    }
+    t += 0.01;
+  }
+  const double faces = 3.0 * std::pow(n, 3);
+  state.counters["time/face"] =
+      benchmark::Counter(faces, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_WindOnFaces)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond);
+
+// velocity(x, t) at scattered points (quadrilinear, 16 samples).
+void BM_WindAtPoints(benchmark::State& state) {
+  const turbulence::TurbulentWind<3> wind(turbulence::SpectralWind<3>(lattice(32, 16)), Vec3::Zero(), Vec3::Zero());
+  Rng rng(1);
+  std::vector<Vec3> points(1 << 16);
+  for (auto& x : points) x = Vec3(rng.uniform(), rng.uniform(), rng.uniform());
+  double t = 0.0;
+  for (auto _ : state) {
+    Vec3 sum = Vec3::Zero();
+    for (const Vec3& x : points) sum += wind.velocity(x, t);
+    benchmark::DoNotOptimize(sum);
+    t += 0.01;
+  }
+  state.counters["time/point"] = benchmark::Counter(static_cast<double>(points.size()),
+                                                  benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_WindAtPoints)->Unit(benchmark::kMillisecond);
+
+}  // namespace
