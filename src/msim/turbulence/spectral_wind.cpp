@@ -76,30 +76,26 @@ SpectralWind<D>::SpectralWind(const SpectralWindParams& params, const std::strin
   std::array<std::vector<std::complex<float>>, D> modes;
   for (auto& c : modes) c.assign(n, std::complex<float>(0.0f, 0.0f));
   const Rng noise(params.seed);
-  // Each pair of mirror modes is drawn and written by its lower index, so threads never share one.
-  latticeVariance_ = parallelSum(n, [&](std::size_t a) {
-    std::size_t rest = a, mirror = 0, stride = 1;
-    std::array<int, D> s{};
+  std::vector<int> dims(D, m);
+  dims.push_back(mt);
+  // The variance a mode carries (0 for the empty ones): tr S w dk^m = (m - 1) Phi^2 w dk^m.
+  auto modeVariance = [&](const auto& s) {
     int q = 0;
-    bool empty = false;
     for (int d = 0; d < D; ++d) {
-      const int i = static_cast<int>(rest % m);
-      rest /= m;
-      empty |= isNyquist(i, m);
-      s[d] = signedFrequency(i, m);
+      if (2 * std::abs(s[d]) == m) return 0.0;  // Nyquist plane
       q += s[d] * s[d];
-      mirror += static_cast<std::size_t>((m - i) % m) * stride;
-      stride *= static_cast<std::size_t>(m);
     }
-    const int l = static_cast<int>(rest);
-    mirror += static_cast<std::size_t>((mt - l) % mt) * stride;
-    if (empty || q == 0 || isNyquist(l, mt) || mirror < a) return 0.0;
+    if (q == 0 || (mt > 1 && 2 * std::abs(s[D]) == mt)) return 0.0;
     const double k = dk * std::sqrt(double(q));
-    const double e = params.spectrum.energy(k);
-    const double w = weight[static_cast<std::size_t>(q) * mt + l];
-    if (e == 0.0 || w == 0.0) return 0.0;
-    const double phi2 = e * gammaOverPi / ((D - 1) * std::pow(k, D - 1));
-    const double amplitude = std::sqrt(phi2 * cellVolume * w);
+    const int l = s[D] < 0 ? s[D] + mt : s[D];
+    return (D - 1) * params.spectrum.energy(k) * gammaOverPi / ((D - 1) * std::pow(k, D - 1)) * cellVolume *
+           weight[static_cast<std::size_t>(q) * mt + l];
+  };
+  // Each pair of mirror modes is drawn from the lower index's stream and written by it alone.
+  numerics::forEachMirrorPair(dims, [&](std::size_t a, std::size_t mirror, const auto& s) {
+    const double variance = modeVariance(s);
+    if (variance == 0.0) return;
+    const double amplitude = std::sqrt(variance / (D - 1));  // sqrt(Phi^2 w dk^m)
     Rng r = noise.split(a);
     std::array<std::complex<double>, D> v;
     for (auto& c : v) {
@@ -107,20 +103,31 @@ SpectralWind<D>::SpectralWind(const SpectralWindParams& params, const std::strin
       c = std::polar(size, 2.0 * std::numbers::pi * r.uniform());
     }
     // P(k) v: the part of v normal to k.
+    double q = 0.0;
     std::complex<double> along = 0.0;
-    for (int d = 0; d < D; ++d) along += double(s[d]) * v[d];
-    along /= double(q);
+    for (int d = 0; d < D; ++d) {
+      along += double(s[d]) * v[d];
+      q += double(s[d]) * s[d];
+    }
+    along /= q;
     for (int d = 0; d < D; ++d) {
       const std::complex<double> u = amplitude * (v[d] - along * double(s[d]));
       modes[d][a] = std::complex<float>(u);
       modes[d][mirror] = std::conj(std::complex<float>(u));
     }
-    // The mode and its mirror each carry tr S w dk^m = (m - 1) Phi^2 w dk^m on average.
-    return 2.0 * (D - 1) * phi2 * w * cellVolume;
+  });
+  // Every mode but the empty ones, mirrors included.
+  latticeVariance_ = parallelSum(n, [&](std::size_t a) {
+    std::array<int, D + 1> s;
+    std::size_t rest = a;
+    for (int d = 0; d <= D; ++d) {
+      const int count = d < D ? m : mt;
+      s[d] = signedFrequency(static_cast<int>(rest % count), count);
+      rest /= count;
+    }
+    return modeVariance(s);
   });
 
-  std::vector<int> dims(D, m);
-  dims.push_back(mt);
   const numerics::FftNd fft(dims);
   samples_.assign(n, Vecf<D>::Zero());
   double largestReal = 0.0, largestImaginary = 0.0;
