@@ -1,6 +1,7 @@
 #include "msim/turbulence/curl_noise.hpp"
 
 #include <array>
+#include <cstdint>
 #include <cmath>
 #include <complex>
 #include <numbers>
@@ -71,6 +72,8 @@ NoiseTile<D>::NoiseTile(std::uint64_t seed) {
 
 template <int D>
 float NoiseTile<D>::value(const Vec<D>& y, double t) const {
+  // Power-of-two sample counts: the wrap is a mask on the (two's complement) lattice index.
+  static_assert((kSamples & (kSamples - 1)) == 0 && (kTimeSamples & (kTimeSamples - 1)) == 0);
   std::array<std::size_t, D + 1> lower, upper;
   std::array<float, D + 1> fraction;
   std::size_t stride = 1;
@@ -79,10 +82,9 @@ float NoiseTile<D>::value(const Vec<D>& y, double t) const {
     const double g = d < D ? y[d] * (kSamples / kSide) : t * (kTimeSamples / kPeriod);
     const double floor = std::floor(g);
     fraction[d] = static_cast<float>(g - floor);
-    const double wrapped = std::fmod(floor, double(count));
-    const int i = static_cast<int>(wrapped < 0.0 ? wrapped + count : wrapped) % count;
+    const std::int64_t i = static_cast<std::int64_t>(floor) & (count - 1);
     lower[d] = static_cast<std::size_t>(i) * stride;
-    upper[d] = static_cast<std::size_t>((i + 1) % count) * stride;
+    upper[d] = static_cast<std::size_t>((i + 1) & (count - 1)) * stride;
     stride *= static_cast<std::size_t>(count);
   }
   float sum = 0.0f;

@@ -1,0 +1,79 @@
+#pragma once
+// Noise particles (Narain 2011 ch. 3.5.1): the turbulent velocity u' as the curl of a potential
+// carried by particles that move with the mean flow, so the eddies travel with the fluid without
+// being distorted by it. Each particle j carries an offset o_j into the animated noise tile and a
+// noise time t_ij per octave i; octave i of the potential is the blend
+//   psi_i(x) = sum_j rho(|x - p_j|) A_i(p_j) N(o_j + (x - p_j) / l_i, t_ij) / sqrt(sum_j rho^2)
+// with rho(r) = 1 - 3 (r/l_0)^2 + 2 (r/l_0)^3 (r < l_0), l_i = l_0 / 2^i and A_i = sqrt(E_i) l_i,
+// E_i the octave's energy from the energy model (eq. 3.4, 3.10). The noise time advances by
+// 1 / tau_i per second, tau_i = l_i / sqrt(E_i) the eddy turnover time. u' = curl sum_i psi_i on the
+// faces of a finer grid, divergence-free to round-off (curl_noise.hpp).
+//
+// Departures from the seed, each for a reason:
+// - The seed divides by sum_j rho (eq. 3.12), a partition of unity; blending independent noises
+//   that way lowers their variance (to about a third where four particles overlap). Dividing by
+//   sqrt(sum_j rho^2) keeps the variance, so u' carries the energy the model prescribes.
+// - The seed samples a Poisson disk of spacing l_0 once and notes that dynamic resampling was not
+//   needed; with open boundaries particles leave, so here cells of side l_0 without a particle get
+//   one each step (and particles beyond three per cell are dropped where the flow converges).
+// - The seed's Perlin noise is replaced by the band-limited NoiseTile.
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "msim/core/grid.hpp"
+#include "msim/core/mac_grid.hpp"
+#include "msim/turbulence/curl_noise.hpp"
+#include "msim/turbulence/turbulent_energy.hpp"
+
+namespace msim::turbulence {
+
+struct NoiseParticleParams {
+  int octaves = 0;  // 0: every octave whose shortest wavelength l_i / 2 spans two fine cells
+  std::uint64_t seed = 0;
+};
+
+template <int D>
+class NoiseParticles {
+ public:
+  static constexpr int kMaxOctaves = 8;
+
+  // Particles over the fluid cells of `coarse` (solid > 0.5 excluded), one per cell of side l_0
+  // (energy.largestEddy()), jittered. fineDx: the cell size u' is synthesised at.
+  NoiseParticles(const GridSpec<D>& coarse, const TurbulentEnergy<D>& energy, double fineDx,
+                 const NoiseParticleParams& params, const Grid<float, D>* solid = nullptr);
+
+  // Moves the particles with U (midpoint rule), advances their noise times by dt / tau_i, removes
+  // those that left the domain or entered a solid, and refills empty cells.
+  void advance(const MacGrid<D>& velocity, const TurbulentEnergy<D>& energy, double dt);
+
+  // u' on the faces of `turbulent` (a MAC grid over the fine spec). Nodes with nodeMask[n] == 0
+  // (res + 1 per axis, x fastest) get no potential; null: every node.
+  void synthesize(const TurbulentEnergy<D>& energy, MacGrid<D>& turbulent,
+                  const std::vector<std::uint8_t>* nodeMask = nullptr) const;
+
+  std::size_t size() const { return position_.size(); }
+  int octaves() const { return octaves_; }
+  const std::vector<Vec<D>>& positions() const { return position_; }
+
+ private:
+  void refill(std::uint64_t step);
+  bool inFluid(const Vec<D>& x) const;
+
+  GridSpec<D> coarse_;
+  double l0_;
+  int octaves_;
+  NoiseParticleParams params_;
+  std::optional<Grid<float, D>> solid_;
+  NoiseTile<D> tile_;
+  IVec<D> cells_;  // coverage cells of side l_0
+  std::vector<Vec<D>> position_, offset_;
+  std::vector<std::array<double, kMaxOctaves>> time_;
+  std::uint64_t steps_ = 0;
+};
+
+extern template class NoiseParticles<2>;
+extern template class NoiseParticles<3>;
+
+}  // namespace msim::turbulence
