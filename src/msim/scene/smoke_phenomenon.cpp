@@ -54,6 +54,7 @@ class SmokePhenomenon final : public Phenomenon {
       fuel_ = solver_.addScalar("fuel", r.at("fire").at("fuel_dissipation").get<double>());
       flame_ = solver_.addScalar("flame");
     }
+    if (r.at("smoke").at("turbulence").at("enabled").get<bool>()) enableTurbulence(scene);
     addSources(scene);
     for (auto& wind : turbulentWinds<D>(scene)) solver_.addWind(std::move(wind));
     preview_ = previewSettings(scene);
@@ -75,8 +76,16 @@ class SmokePhenomenon final : public Phenomenon {
   }
 
   void step(double dt) override {
-    for (std::size_t i = 0; i < windows_.size(); ++i)
-      solver_.source(i).active = time_ >= windows_[i].first && (windows_[i].second <= 0.0 || time_ < windows_[i].second);
+    for (std::size_t i = 0; i < windows_.size(); ++i) {
+      const bool active = time_ >= windows_[i].first && (windows_[i].second <= 0.0 || time_ < windows_[i].second);
+      solver_.source(i).active = active;
+      if (turbulence_) turbulence_->source(i).active = active;
+    }
+    if (turbulence_) {
+      // Sub-grid turbulence and the fine scalars, before the simulated flow moves on (ch. 3).
+      ScopedStage stage(timers_, "smoke: turbulence");
+      turbulence_->step(solver_.velocity(), dt, solver_.density(), solver_.temperature());
+    }
     if (obstacles_.moving()) {
       ScopedStage stage(timers_, "smoke: move obstacles");
       placeObstacles(time_ + 0.5 * dt);
@@ -103,6 +112,10 @@ class SmokePhenomenon final : public Phenomenon {
     for (int a = 0; a < D; ++a) requireFinite(solver_.velocity().component(a), axes[a], stepIndex, time);
     requireFinite(solver_.density(), "density", stepIndex, time);
     requireFinite(solver_.temperature(), "temperature", stepIndex, time);
+    if (turbulence_) {
+      requireFinite(turbulence_->density(), "fine density", stepIndex, time);
+      requireFinite(turbulence_->energy().energy(), "turbulent energy", stepIndex, time);
+    }
     for (std::size_t i = 0; i < solver_.scalarCount(); ++i)
       requireFinite(solver_.scalar(i), solver_.scalarName(i), stepIndex, time);
   }
@@ -112,8 +125,10 @@ class SmokePhenomenon final : public Phenomenon {
   // "obstacle_distance" (signed, at cell centres) lets renderers draw the obstacles.
   void writeVolume(const std::filesystem::path& vdbFile) const override {
     io::VdbWriter writer;
-    writer.addFloatGrid("density", solver_.density());
-    writer.addFloatGrid("temperature", solver_.temperature());
+    // With turbulence the smoke lives on the fine grid; the coarse scalars are its averages.
+    writer.addFloatGrid("density", turbulence_ ? turbulence_->density() : solver_.density());
+    writer.addFloatGrid("temperature", turbulence_ ? turbulence_->temperature() : solver_.temperature());
+    if (turbulence_) writer.addFloatGrid("turbulent_energy", turbulence_->energy().energy());
     for (std::size_t i = 0; i < solver_.scalarCount(); ++i) writer.addFloatGrid(solver_.scalarName(i), solver_.scalar(i));
     if constexpr (D == 3) writer.addVectorGrid("vel", solver_.velocity());
     for (int a = 0; a < D; ++a) writer.addFloatGrid(faceGridName(a), faceAsCells(solver_.velocity().component(a)));
@@ -123,6 +138,9 @@ class SmokePhenomenon final : public Phenomenon {
   }
 
   io::Image preview() const override {
+    if (turbulence_)
+      return render::renderDensityPreview(turbulence_->density(), preview_,
+                                          obstacles_.empty() ? nullptr : &turbulence_->fineSolid());
     const Grid<float, D>* solid = obstacles_.empty() ? nullptr : &solver_.solid();
     render::PreviewEmission<D> emission;
     if (combustion_) emission = {&solver_.scalar(flame_), &solver_.temperature()};
@@ -133,8 +151,17 @@ class SmokePhenomenon final : public Phenomenon {
     time_ = time;
     solver_.setTime(time);
     if (obstacles_.moving()) placeObstacles(time_);
-    restoreGrid(vdbFile, "density", solver_.density(), source_);
-    restoreGrid(vdbFile, "temperature", solver_.temperature(), source_);
+    if (turbulence_) {
+      // The noise particles are not saved: they start afresh (the resumed run is not bit-exact).
+      restoreGrid(vdbFile, "density", turbulence_->density(), source_);
+      restoreGrid(vdbFile, "temperature", turbulence_->temperature(), source_);
+      restoreGrid(vdbFile, "turbulent_energy", turbulence_->energy().energy(), source_);
+      turbulence_->downsample(solver_.density(), solver_.temperature());
+      turbulence_->reseedParticles();
+    } else {
+      restoreGrid(vdbFile, "density", solver_.density(), source_);
+      restoreGrid(vdbFile, "temperature", solver_.temperature(), source_);
+    }
     for (std::size_t i = 0; i < solver_.scalarCount(); ++i)
       restoreGrid(vdbFile, solver_.scalarName(i), solver_.scalar(i), source_);
     for (int a = 0; a < D; ++a) restoreGrid(vdbFile, faceGridName(a), solver_.velocity().component(a), source_);
@@ -155,6 +182,13 @@ class SmokePhenomenon final : public Phenomenon {
               {"max_divergence_1_s", s.maxDivergence},
               {"pressure_iterations", s.pressureIterations},
               {"max_temperature_K", maxValue(solver_.temperature())}};
+    if (turbulence_) {
+      j["turbulent_energy_integral"] = turbulence_->energy().integral();
+      j["turbulent_kinetic_energy"] = turbulence_->turbulentKineticEnergy();
+      j["noise_particles"] = turbulence_->particles().size();
+      j["turbulence_band_fraction"] = turbulence_->bandFraction();
+      j["fine_smoke_mass_kg"] = turbulence_->fineSpec().cellVolume() * total(turbulence_->density());
+    }
     if (combustion_) {
       const double dV = solver_.spec().cellVolume();
       j["fuel_kg"] = dV * total(solver_.scalar(fuel_));
@@ -187,6 +221,20 @@ class SmokePhenomenon final : public Phenomenon {
     if (obstacles_.moving()) solver_.setObstacleVelocity(obstacles_.faceVelocity(time));
   }
 
+  void enableTurbulence(const Scene& scene) {
+    const json& r = scene.resolved;
+    if (combustion_)
+      throw InputError(fmt::format("{}: 'smoke.turbulence.enabled' with 'fire.enabled' is not supported yet (the fuel "
+                                   "and flame stay on the simulation grid)",
+                                   source_));
+    if (obstacles_.moving())
+      throw InputError(fmt::format("{}: 'smoke.turbulence.enabled' with moving obstacles is not supported yet", source_));
+    turbulence_ = std::make_unique<fluid::SmokeTurbulence<D>>(
+        solver_.spec(), smokeTurbulenceParams(r), solver_.params().advection,
+        obstacles_.empty() ? nullptr : &solver_.solid(), solver_.params().buoyancy.ambientTemperature);
+    if (turbulence_->params().coupling) solver_.setAdvectionOffset(&turbulence_->coarseTurbulentVelocity());
+  }
+
   void addSources(const Scene& scene) {
     const json& list = scene.resolved.at("sources");
     for (std::size_t i = 0; i < list.size(); ++i) {
@@ -214,6 +262,16 @@ class SmokePhenomenon final : public Phenomenon {
         throw InputError(fmt::format("{}: '{}.stop' ({} s) must come after '{}.start' ({} s), or be 0 for 'to the end'",
                                      source_, key, stop, key, start));
       windows_.emplace_back(start, stop);
+      if (turbulence_) {
+        // The smoke and heat go into the fine grid; the simulated flow keeps only the inflow.
+        fluid::SmokeSource<D> fine = src;
+        fine.cells = coveredOpenCells<D>(scene, *shape, turbulence_->fineSolid(), key + ".shape");
+        fine.velocity.reset();
+        turbulence_->addSource(std::move(fine));
+        src.mode = fluid::SmokeSource<D>::Mode::Add;
+        src.density = 0.0;
+        src.temperature = 0.0;
+      }
       solver_.addSource(std::move(src));
     }
   }
@@ -228,6 +286,7 @@ class SmokePhenomenon final : public Phenomenon {
   std::vector<std::pair<double, double>> windows_;  // (start, stop) of each source [s]
   std::optional<fluid::CombustionParams> combustion_;
   std::size_t fuel_ = 0, flame_ = 0;
+  std::unique_ptr<fluid::SmokeTurbulence<D>> turbulence_;
   render::PreviewSettings preview_;
 };
 

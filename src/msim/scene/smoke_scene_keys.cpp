@@ -59,6 +59,21 @@ Schema smokeKeys() {
   pressure.number("tolerance", "", 1e-5, "relative max-norm residual of the pressure solve").min(0.0, Bound::Exclusive).max(1.0);
   pressure.integer("max_iterations", 500, "PCG iteration cap").min(1);
   smoke.field("pressure", pressure);
+  Schema turbulence = Schema::object(
+      "procedural sub-grid turbulence (Narain ch. 3): an energy model on the grid, noise particles synthesising "
+      "curl-noise eddies on a finer grid that carries the smoke");
+  turbulence.boolean("enabled", false, "simulate sub-grid turbulence; density and temperature then live on the fine grid");
+  turbulence.integer("refinement", 4, "fine cells per simulation cell and axis (the seed: 4)").min(1).max(8);
+  turbulence.number("largest_eddy", "m", 0.0, "l_0, size of the largest modelled eddies; 0 = four grid cells").min(0.0);
+  turbulence.number("viscosity", "m^2/s", 1.5e-5, "nu: sets the viscous cutoff that turns turbulence off in calm flow")
+      .min(0.0);
+  turbulence.number("initial_energy", "m^2/s^2", 1e-4, "E_0 at the start (production needs E_0 > 0)").min(0.0);
+  turbulence.integer("octaves", 0, "noise octaves; 0 = down to two fine cells").min(0).max(8);
+  turbulence.boolean("coupling", true, "the simulated flow is advected by itself plus the turbulence (ch. 3.5.2)");
+  turbulence.number("smoke_threshold", "kg/m^3", 1e-4, "cells with less smoke (and not near smoke) get no eddies")
+      .min(0.0);
+  turbulence.integer("seed", 1, "random seed of the noise").min(0);
+  smoke.field("turbulence", turbulence);
   smoke.vector("initial_velocity", "m/s", {0.0, 0.0, 0.0}, "velocity of the air at t = 0").lengths({2, 3});
   Schema walls = Schema::object("velocity of each closed side of the domain");
   for (const auto& axis : kSides)
@@ -204,5 +219,19 @@ fluid::CombustionParams combustionParams(const json& r) {
 
 template fluid::SmokeParams<2> smokeParams<2>(const Scene&);
 template fluid::SmokeParams<3> smokeParams<3>(const Scene&);
+
+fluid::SmokeTurbulenceParams smokeTurbulenceParams(const json& resolved) {
+  const json& t = resolved.at("smoke").at("turbulence");
+  fluid::SmokeTurbulenceParams p;
+  p.refinement = t.at("refinement").get<int>();
+  p.energy.largestEddy = t.at("largest_eddy").get<double>();
+  p.energy.viscosity = t.at("viscosity").get<double>();
+  p.energy.initialEnergy = t.at("initial_energy").get<double>();
+  p.particles.octaves = t.at("octaves").get<int>();
+  p.particles.seed = t.at("seed").get<std::uint64_t>();
+  p.coupling = t.at("coupling").get<bool>();
+  p.smokeThreshold = t.at("smoke_threshold").get<double>();
+  return p;
+}
 
 }  // namespace msim::scene

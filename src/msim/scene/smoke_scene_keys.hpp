@@ -6,6 +6,7 @@
 
 #include "msim/fluid/smoke/combustion.hpp"
 #include "msim/fluid/smoke/smoke_solver.hpp"
+#include "msim/fluid/smoke/smoke_turbulence.hpp"
 #include "msim/scene/schema/schema.hpp"
 
 namespace msim::scene {
@@ -21,5 +22,8 @@ template <int D>
 fluid::SmokeParams<D> smokeParams(const Scene& scene);
 
 fluid::CombustionParams combustionParams(const nlohmann::json& resolved);
+
+// smoke.turbulence.* (enabled or not).
+fluid::SmokeTurbulenceParams smokeTurbulenceParams(const nlohmann::json& resolved);
 
 }  // namespace msim::scene

@@ -181,7 +181,18 @@ void SmokeSolver<D>::step(double dt) {
   {
     // Self-advection of the momentum, the (u.grad) u term of eq. 3.1.
     ScopedStage s(timers_, "advect velocity");
-    advector_.advect(velocity_, velocity_, dt);
+    if (advectionOffset_) {
+      if (!advecting_) advecting_.emplace(spec_);
+      for (int a = 0; a < D; ++a) {
+        auto& w = advecting_->component(a);
+        const auto& u = velocity_.component(a);
+        const auto& o = advectionOffset_->component(a);
+        parallelFor(0, w.count(), [&](std::size_t i) { w[i] = u[i] + o[i]; }, 1 << 14);
+      }
+      advector_.advect(velocity_, *advecting_, dt);
+    } else {
+      advector_.advect(velocity_, velocity_, dt);
+    }
     // Faces the projection treats as (partly) fluid but the advector as solid keep their old value
     // there; refresh them from the fluid beside them, or the pressure correction would pile up on
     // them step after step and the velocity would grow without bound.
@@ -342,25 +353,8 @@ void SmokeSolver<D>::resetInflowCells() {
 
 template <int D>
 void SmokeSolver<D>::applyScalarSources(double dt) {
-  for (const auto& src : sources_) {
-    if (!src.active) continue;
-    const bool set = src.mode == SmokeSource<D>::Mode::Set;
-    parallelFor(0, src.cells.size(), [&](std::size_t k) {
-      const auto [cell, w] = src.cells[k];
-      if (set) {
-        density_[cell] += static_cast<float>(w * (src.density - density_[cell]));
-        if (src.temperature > 0.0) temperature_[cell] += static_cast<float>(w * (src.temperature - temperature_[cell]));
-        for (const auto& [index, value] : src.scalars) {
-          float& v = scalars_[index].field[cell];
-          v += static_cast<float>(w * (value - v));
-        }
-      } else {
-        density_[cell] += static_cast<float>(w * src.density * dt);
-        temperature_[cell] += static_cast<float>(w * src.temperature * dt);
-        for (const auto& [index, rate] : src.scalars) scalars_[index].field[cell] += static_cast<float>(w * rate * dt);
-      }
-    }, 256);
-  }
+  for (const auto& src : sources_)
+    applySourceScalars<D>(src, dt, density_, temperature_, [&](std::size_t i) -> Grid<float, D>& { return scalars_[i].field; });
 }
 
 template <int D>

@@ -81,6 +81,30 @@ struct SmokeSource {
   bool active = true;  // an inactive source does nothing (emitters switched on and off in time)
 };
 
+// A source's scalars over dt: Set blends density (and temperature, if > 0, and each extra scalar)
+// towards its value by the coverage, Add adds coverage x rate x dt. scalar(i) returns the field of
+// extra scalar i. Inactive sources do nothing.
+template <int D, typename ScalarField>
+void applySourceScalars(const SmokeSource<D>& src, double dt, Grid<float, D>& density, Grid<float, D>& temperature,
+                        ScalarField&& scalar) {
+  if (!src.active) return;
+  const bool set = src.mode == SmokeSource<D>::Mode::Set;
+  for (const auto& [cell, w] : src.cells) {
+    if (set) {
+      density[cell] += static_cast<float>(w * (src.density - density[cell]));
+      if (src.temperature > 0.0) temperature[cell] += static_cast<float>(w * (src.temperature - temperature[cell]));
+      for (const auto& [index, value] : src.scalars) {
+        float& v = scalar(index)[cell];
+        v += static_cast<float>(w * (value - v));
+      }
+    } else {
+      density[cell] += static_cast<float>(w * src.density * dt);
+      temperature[cell] += static_cast<float>(w * src.temperature * dt);
+      for (const auto& [index, rate] : src.scalars) scalar(index)[cell] += static_cast<float>(w * rate * dt);
+    }
+  }
+}
+
 struct SmokeStatistics {
   double kineticEnergy = 0.0;   // 1/2 rho sum_faces w_f u_f^2 dV [J per unit depth in 2D]
   double maxDivergence = 0.0;   // max |div u| after the last projection [1/s]
@@ -111,6 +135,9 @@ class SmokeSolver {
   void addWind(turbulence::TurbulentWind<D> wind) { winds_.push_back(std::move(wind)); }
   // Bound on the winds' summed speed [m/s] (0 without winds), for the time step.
   double maxWindSpeed() const;
+  // Velocity added to U when U advects itself (procedural turbulence's coupling, Narain ch. 3.5.2:
+  // U moves with U + u'); null: U alone. The grid must outlive its use.
+  void setAdvectionOffset(const MacGrid<D>* offset) { advectionOffset_ = offset; }
   // The clock the winds are sampled at [s]; step() advances it, a resumed run sets it.
   void setTime(double time) { time_ = time; }
   double time() const { return time_; }
@@ -208,6 +235,8 @@ class SmokeSolver {
   long steps_ = 0;
   std::vector<turbulence::TurbulentWind<D>> winds_;
   std::vector<float> windScratch_;  // the winds on one face component
+  const MacGrid<D>* advectionOffset_ = nullptr;
+  std::optional<MacGrid<D>> advecting_;  // U + offset
   double time_ = 0.0;
 };
 

@@ -1,0 +1,97 @@
+#pragma once
+// Procedural turbulence for smoke (Narain 2011, ch. 3): the coarse smoke solver keeps the large
+// scales U; the energy model tracks the sub-grid turbulent energy on the coarse grid; noise
+// particles synthesise the turbulent velocity u' on a grid `refinement` times finer; density and
+// temperature live on that fine grid and are carried by U + u' (ch. 3.5.2), so the smoke shows
+// eddies the coarse grid cannot hold. The coarse solver sees the scalars downsampled (for its
+// buoyancy) and, with coupling on, advects U by U + u' averaged onto its faces (ch. 3.5.2).
+//
+// One step (SmokeTurbulence::step, before the coarse solver's step):
+//   1. energy model (eq. 3.5) in U; 2. noise particles move with U, noise times advance;
+//   3. u' on the fine faces where there is smoke (the coarse cells whose smoke exceeds the
+//      threshold, grown by one cell and by the distance the flow carries it in a step);
+//   4. fine sources, then the fine scalars advected by U (interpolated) + u';
+//   5. the scalars averaged onto the coarse cells, u' onto the coarse faces (flux averages, so the
+//      coarse u' stays divergence-free).
+#include <memory>
+#include <vector>
+
+#include "msim/core/grid.hpp"
+#include "msim/core/mac_grid.hpp"
+#include "msim/fluid/smoke/smoke_solver.hpp"
+#include "msim/numerics/advection/advector.hpp"
+#include "msim/turbulence/noise_particles.hpp"
+#include "msim/turbulence/turbulent_energy.hpp"
+
+namespace msim::fluid {
+
+struct SmokeTurbulenceParams {
+  int refinement = 4;  // fine cells per coarse cell and axis (the seed: 4)
+  turbulence::TurbulentEnergyParams energy;      // l_0 <= 0: four coarse cells
+  turbulence::NoiseParticleParams particles;
+  bool coupling = true;            // U advected by U + u' (ch. 3.5.2)
+  double smokeThreshold = 1e-4;    // [kg/m^3] coarse cells with less smoke get no u'
+};
+
+template <int D>
+class SmokeTurbulence {
+ public:
+  // coarseSolid: the solver's solid mask (or null); the fine grid takes each fine cell from the
+  // coarse cell it lies in. std::invalid_argument for refinement < 1.
+  SmokeTurbulence(const GridSpec<D>& coarse, const SmokeTurbulenceParams& params,
+                  const numerics::AdvectionSettings& advection, const Grid<float, D>* coarseSolid,
+                  double ambientTemperature);
+
+  // A source on the fine grid (cells of fineSpec()); only its scalars are used (inflow velocities
+  // act on the coarse solver).
+  void addSource(SmokeSource<D> source) { sources_.push_back(std::move(source)); }
+  SmokeSource<D>& source(std::size_t i) { return sources_[i]; }
+
+  // Steps 1-5 above; coarseDensity and coarseTemperature receive the averaged fine scalars.
+  void step(const MacGrid<D>& velocity, double dt, Grid<float, D>& coarseDensity, Grid<float, D>& coarseTemperature);
+
+  const GridSpec<D>& fineSpec() const { return fine_; }
+  const Grid<float, D>& fineSolid() const { return fineSolid_; }
+  Grid<float, D>& density() { return density_; }
+  const Grid<float, D>& density() const { return density_; }
+  Grid<float, D>& temperature() { return temperature_; }
+  const Grid<float, D>& temperature() const { return temperature_; }
+  const MacGrid<D>& turbulentVelocity() const { return turbulent_; }       // u' on the fine faces
+  const MacGrid<D>& coarseTurbulentVelocity() const { return coarseTurbulent_; }  // u' on the coarse faces
+  turbulence::TurbulentEnergy<D>& energy() { return energy_; }
+  const turbulence::TurbulentEnergy<D>& energy() const { return energy_; }
+  const turbulence::NoiseParticles<D>& particles() const { return *particles_; }
+  const SmokeTurbulenceParams& params() const { return params_; }
+  // Restarts the noise particles (a resumed run: they are not saved).
+  void reseedParticles();
+  // Fills the coarse grids with the fine scalars averaged (after a restore).
+  void downsample(Grid<float, D>& coarseDensity, Grid<float, D>& coarseTemperature) const;
+  // 1/2 int |u'|^2 dV over the fine grid [m^5/s^2] (per unit depth in 2D), from the face values.
+  double turbulentKineticEnergy() const;
+  // Fraction of the fine nodes that got a potential in the last step.
+  double bandFraction() const { return bandFraction_; }
+
+ private:
+  void markBand(const MacGrid<D>& velocity, double dt, const Grid<float, D>& coarseDensity);
+  void fineVelocity(const MacGrid<D>& velocity);
+  void applySources(double dt);
+  void averageTurbulenceToCoarse();
+
+  GridSpec<D> coarse_, fine_;
+  SmokeTurbulenceParams params_;
+  Grid<float, D> coarseSolid_, fineSolid_;
+  bool hasSolid_ = false;
+  Grid<float, D> density_, temperature_;
+  MacGrid<D> turbulent_, advecting_, coarseTurbulent_;
+  std::vector<std::uint8_t> nodeMask_, coarseBand_;
+  turbulence::TurbulentEnergy<D> energy_;
+  std::unique_ptr<turbulence::NoiseParticles<D>> particles_;
+  numerics::Advector<float, D> advector_;
+  std::vector<SmokeSource<D>> sources_;
+  double bandFraction_ = 0.0;
+};
+
+extern template class SmokeTurbulence<2>;
+extern template class SmokeTurbulence<3>;
+
+}  // namespace msim::fluid
