@@ -25,7 +25,7 @@ TEST(NoiseParticles, SynthesisedVelocityIsIncompressibleAndCarriesTheOctavesEner
   const GridSpec<3> fine(Vec3::Zero(), 1.0 / 64, IVec3(64, 64, 64));
   TurbulentEnergy<3> energy(coarse, inviscid());
   energy.energy().fill(0.01f);
-  const NoiseParticles<3> particles(coarse, energy, fine.dx, NoiseParticleParams{.seed = 2});
+  NoiseParticles<3> particles(coarse, energy, fine.dx, NoiseParticleParams{.seed = 2});
   EXPECT_EQ(particles.octaves(), 3);  // l_i = 0.25, 0.125, 0.0625 m: l_i / 2 spans >= 2 fine cells
   EXPECT_EQ(particles.size(), 64u);   // one per cell of side l_0
   MacGrid<3> u(fine);

@@ -113,38 +113,38 @@ float NoiseTile<D>::component(int c, const Vec<D>& y, double t) const {
 template <int D>
 void curlOfNodalPotential(const GridSpec<D>& spec, const std::vector<Vecf<3>>& psi, MacGrid<D>& u) {
   const IVec<D> nodes = spec.res + IVec<D>::Ones();
-  auto at = [&](const IVec<D>& n) -> const Vecf<3>& {
-    std::size_t index = static_cast<std::size_t>(n[D - 1]);
-    for (int d = D - 2; d >= 0; --d) index = index * nodes[d] + n[d];
-    return psi[index];
-  };
-  const float h = static_cast<float>(spec.dx);
+  const float inv = static_cast<float>(1.0 / spec.dx);
   if constexpr (D == 2) {
     // u_x on the x-face (i, j + 1/2) = d psi / dy; u_y on (i + 1/2, j) = -d psi / dx.
+    const std::size_t sy = static_cast<std::size_t>(nodes[0]);
     auto& ux = u.component(0);
     parallelForCells<2>(ux.size(), [&](const IVec2& f, std::size_t lin) {
-      ux[lin] = (at(IVec2(f.x(), f.y() + 1))[0] - at(f)[0]) / h;
+      const std::size_t n = static_cast<std::size_t>(f.y()) * sy + f.x();
+      ux[lin] = (psi[n + sy][0] - psi[n][0]) * inv;
     });
     auto& uy = u.component(1);
     parallelForCells<2>(uy.size(), [&](const IVec2& f, std::size_t lin) {
-      uy[lin] = -(at(IVec2(f.x() + 1, f.y()))[0] - at(f)[0]) / h;
+      const std::size_t n = static_cast<std::size_t>(f.y()) * sy + f.x();
+      uy[lin] = -(psi[n + 1][0] - psi[n][0]) * inv;
     });
   } else {
-    // psi_c on the c-edges (the mean of the edge's two nodes); each face's flux is the
-    // circulation of psi round its four edges.
-    auto edge = [&](int c, const IVec3& n) {  // edge along axis c starting at node n
-      IVec3 m = n;
-      m[c] += 1;
-      return 0.5f * (at(n)[c] + at(m)[c]);
-    };
+    // psi_c on the c-edges is the mean of the edge's two nodes; each face's flux is the
+    // circulation of psi round its four edges: u_a = d psi_c / d x_b - d psi_b / d x_c, with
+    // (a, b, c) cyclic. Written out with the node strides s_b, s_c from the face's lower node n:
+    // u_a = [psi_c(n+s_b) + psi_c(n+s_b+s_c) - psi_c(n) - psi_c(n+s_c)
+    //        - psi_b(n+s_c) - psi_b(n+s_c+s_b) + psi_b(n) + psi_b(n+s_b)] / (2 h).
+    const std::size_t stride[3] = {1, static_cast<std::size_t>(nodes[0]),
+                                   static_cast<std::size_t>(nodes[0]) * static_cast<std::size_t>(nodes[1])};
+    const float half = 0.5f * inv;
     for (int a = 0; a < 3; ++a) {
-      const int b = (a + 1) % 3, c = (a + 2) % 3;  // u_a = d psi_c / d x_b - d psi_b / d x_c
+      const int b = (a + 1) % 3, c = (a + 2) % 3;
+      const std::size_t sb = stride[b], sc = stride[c];
       auto& ua = u.component(a);
       parallelForCells<3>(ua.size(), [&](const IVec3& f, std::size_t lin) {
-        IVec3 nb = f, nc = f;
-        nb[b] += 1;
-        nc[c] += 1;
-        ua[lin] = ((edge(c, nb) - edge(c, f)) - (edge(b, nc) - edge(b, f))) / h;
+        const std::size_t n = static_cast<std::size_t>(f.z()) * stride[2] + static_cast<std::size_t>(f.y()) * stride[1] + f.x();
+        const float dc = psi[n + sb][c] + psi[n + sb + sc][c] - psi[n][c] - psi[n + sc][c];
+        const float db = psi[n + sc][b] + psi[n + sc + sb][b] - psi[n][b] - psi[n + sb][b];
+        ua[lin] = (dc - db) * half;
       });
     }
   }

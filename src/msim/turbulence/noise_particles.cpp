@@ -126,7 +126,7 @@ void NoiseParticles<D>::advance(const MacGrid<D>& velocity, const TurbulentEnerg
 
 template <int D>
 void NoiseParticles<D>::synthesize(const TurbulentEnergy<D>& energy, MacGrid<D>& turbulent,
-                                   const std::vector<std::uint8_t>* nodeMask) const {
+                                   const std::vector<std::uint8_t>* nodeMask) {
   const GridSpec<D>& fine = turbulent.component(0).spec();
   // Per particle and octave: amplitude A_i = sqrt(E_i) l_i.
   const std::size_t n = position_.size();
@@ -163,10 +163,12 @@ void NoiseParticles<D>::synthesize(const TurbulentEnergy<D>& energy, MacGrid<D>&
   const IVec<D> nodes = fine.res + IVec<D>::Ones();
   std::size_t nodeCount = 1;
   for (int d = 0; d < D; ++d) nodeCount *= static_cast<std::size_t>(nodes[d]);
-  std::vector<Vecf<3>> psi(nodeCount, Vecf<3>::Zero());
+  psi_.resize(nodeCount);
+  std::vector<Vecf<3>>& psi = psi_;
   constexpr int kComponents = D == 3 ? 3 : 1;
   const double invL0 = 1.0 / l0_;
   parallelFor(0, nodeCount, [&](std::size_t a) {
+    psi[a].setZero();
     if (nodeMask && !(*nodeMask)[a]) return;
     Vec<D> x;
     std::size_t rest = a;

@@ -51,7 +51,7 @@ class NoiseParticles {
   // u' on the faces of `turbulent` (a MAC grid over the fine spec). Nodes with nodeMask[n] == 0
   // (res + 1 per axis, x fastest) get no potential; null: every node.
   void synthesize(const TurbulentEnergy<D>& energy, MacGrid<D>& turbulent,
-                  const std::vector<std::uint8_t>* nodeMask = nullptr) const;
+                  const std::vector<std::uint8_t>* nodeMask = nullptr);
 
   std::size_t size() const { return position_.size(); }
   int octaves() const { return octaves_; }
@@ -71,6 +71,7 @@ class NoiseParticles {
   std::vector<Vec<D>> position_, offset_;
   std::vector<std::array<double, kMaxOctaves>> time_;
   std::uint64_t steps_ = 0;
+  std::vector<Vecf<3>> psi_;  // synthesis scratch: the potential at the fine nodes
 };
 
 extern template class NoiseParticles<2>;

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "msim/core/interpolation.hpp"
+#include "msim/core/resample.hpp"
 #include "msim/core/parallel.hpp"
 
 namespace msim::fluid {
@@ -106,9 +106,8 @@ void SmokeTurbulence<D>::fineVelocity(const MacGrid<D>& velocity) {
   for (int a = 0; a < D; ++a) {
     auto& w = advecting_.component(a);
     const auto& t = turbulent_.component(a);
-    parallelForCells<D>(w.size(), [&](const IVec<D>& f, std::size_t lin) {
-      w[lin] = sampleLinear<D>(velocity.component(a), w.position(f)) + t[lin];
-    });
+    resampleLinear<D>(velocity.component(a), w);
+    parallelFor(0, w.count(), [&](std::size_t i) { w[i] += t[i]; }, 1 << 14);
   }
 }
 
