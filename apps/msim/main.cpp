@@ -20,6 +20,7 @@
 #include "msim/scene/saved_frames.hpp"
 #include "msim/scene/scene_file.hpp"
 #include "msim/scene/schema/describe.hpp"
+#include "msim/scene/velocity_spectrum.hpp"
 #include "msim/version.hpp"
 
 namespace {
@@ -82,6 +83,12 @@ int main(int argc, char** argv) {
   render->add_option("--out", renderOutput, "output folder (run; default <run>/render) or file (.vdb; default <file>.png)");
   render->add_option("--set", overrides, "override a render key: render.key.path=value (repeatable)");
 
+  scene::SpectrumJob spectrumJob;
+  auto* spectrum = app.add_subcommand("spectrum", "kinetic energy spectrum of saved 3D velocity fields (.vdb), as CSV and PNG");
+  spectrum->add_option("inputs", spectrumJob.inputs, "one or more .vdb files, compared in one chart")->required();
+  spectrum->add_option("--grid", spectrumJob.grid, "the vector grid (default vel)");
+  spectrum->add_option("--out", spectrumJob.output, "prefix of the CSV files and the chart (default <first file>_spectrum)");
+
   std::string phenomenonName;
   auto* schema = app.add_subcommand("schema", "print the Markdown reference of every scene key of a phenomenon");
   schema->add_option("phenomenon", phenomenonName, "phenomenon name, e.g. gas")->required();
@@ -103,6 +110,19 @@ int main(int argc, char** argv) {
       const scene::PhenomenonType* type = scene::findPhenomenonType(phenomenonName);
       if (!type) throw InputError(fmt::format("unknown phenomenon '{}'", phenomenonName));
       std::printf("%s", scene::markdownReference(scene::sceneSchema(*type)).c_str());
+      return 0;
+    }
+    if (*spectrum) {
+      const auto result = scene::velocitySpectrum(spectrumJob);
+      for (const auto& r : result.at("spectra")) {
+        const std::string fit = r.at("exponent").is_null()
+                                    ? "no fit (too few shells)"
+                                    : fmt::format("E ~ k^{:.3f} over {} shells", r.at("exponent").get<double>(),
+                                                  r.at("shells_fitted").get<int>());
+        fmt::print("{}: cube of {} voxels, {} -> {}\n", r.at("file").get<std::string>(), r.at("cube_voxels").get<int>(),
+                   fit, r.at("csv").get<std::string>());
+      }
+      fmt::print("chart: {}\n", result.at("png").get<std::string>());
       return 0;
     }
     if (*render) {

@@ -78,3 +78,27 @@ TEST(SmokeTurbulenceCli, SmokeLivesOnTheFineGridAndUnsupportedCombinationsAreRef
   EXPECT_NE(fire.output.find("smoke.turbulence.enabled"), std::string::npos) << fire.output;
   EXPECT_FALSE(fs::exists(dir / "fire_out"));
 }
+
+TEST(SmokeTurbulenceCli, SpectrumOfSavedVelocities) {
+  // A 3D plume with turbulence writing its fine velocity, and `msim spectrum` on the last frame.
+  const fs::path dir = scratch("turbulence_spectrum");
+  writeText(dir / "s.json", R"({"name": "p", "phenomenon": "smoke",
+ "domain": {"min": [0, 0, 0], "max": [1, 1, 1], "resolution": 12},
+ "time": {"duration": 0.4, "fps": 5},
+ "smoke": {"buoyancy": {"alpha": 0.0, "beta": 0.05}, "turbulence": {"enabled": true, "write_velocity": true}},
+ "sources": [{"shape": {"type": "sphere", "center": [0.5, 0.2, 0.5], "radius": 0.15}, "mode": "set", "density": 1.0,
+              "temperature": 500.0}],
+ "outputs": {"mp4": false, "png": false}})");
+  ASSERT_EQ(runMsim("run " + (dir / "s.json").string() + " -q --out " + (dir / "out").string()).exitCode, 0);
+  const fs::path frame = dir / "out" / "vdb" / "p_0002.vdb";
+  EXPECT_EQ(msim::io::readVectorGrid(frame, "vel").size(), msim::IVec3(48, 48, 48));  // the fine grid
+  const Result r = runMsim("spectrum " + frame.string() + " --out " + (dir / "spec").string());
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("cube of 48 voxels"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(dir / "spec.png"));
+  EXPECT_TRUE(fs::exists(dir / "spec_0.csv"));
+  // A missing grid names itself.
+  const Result bad = runMsim("spectrum " + frame.string() + " --grid nothing");
+  EXPECT_EQ(bad.exitCode, 2) << bad.output;
+  EXPECT_NE(bad.output.find("nothing"), std::string::npos) << bad.output;
+}

@@ -130,7 +130,12 @@ class SmokePhenomenon final : public Phenomenon {
     writer.addFloatGrid("temperature", turbulence_ ? turbulence_->temperature() : solver_.temperature());
     if (turbulence_) writer.addFloatGrid("turbulent_energy", turbulence_->energy().energy());
     for (std::size_t i = 0; i < solver_.scalarCount(); ++i) writer.addFloatGrid(solver_.scalarName(i), solver_.scalar(i));
-    if constexpr (D == 3) writer.addVectorGrid("vel", solver_.velocity());
+    if constexpr (D == 3) {
+      if (turbulence_ && turbulence_->params().writeVelocity)
+        writer.addVectorGrid("vel", turbulence_->fineVelocity());
+      else
+        writer.addVectorGrid("vel", solver_.velocity());
+    }
     for (int a = 0; a < D; ++a) writer.addFloatGrid(faceGridName(a), faceAsCells(solver_.velocity().component(a)));
     writer.addFloatGrid("pressure", solver_.pressure());
     if (!obstacles_.empty()) writer.addFloatGrid("obstacle_distance", obstacles_.cellDistance(time_));

@@ -73,6 +73,8 @@ Schema smokeKeys() {
   turbulence.number("smoke_threshold", "kg/m^3", 1e-4, "cells with less smoke (and not near smoke) get no eddies")
       .min(0.0);
   turbulence.integer("seed", 1, "random seed of the noise").min(0);
+  turbulence.boolean("write_velocity", false,
+                     "write the fine velocity U + u' as 'vel' in the VDB frames (large: 12 bytes per fine cell)");
   smoke.field("turbulence", turbulence);
   smoke.vector("initial_velocity", "m/s", {0.0, 0.0, 0.0}, "velocity of the air at t = 0").lengths({2, 3});
   Schema walls = Schema::object("velocity of each closed side of the domain");
@@ -231,6 +233,7 @@ fluid::SmokeTurbulenceParams smokeTurbulenceParams(const json& resolved) {
   p.particles.seed = t.at("seed").get<std::uint64_t>();
   p.coupling = t.at("coupling").get<bool>();
   p.smokeThreshold = t.at("smoke_threshold").get<double>();
+  p.writeVelocity = t.at("write_velocity").get<bool>();
   return p;
 }
 

@@ -10,6 +10,7 @@
 #include "msim/io/atomic_file.hpp"
 #include "msim/io/png.hpp"
 #include "msim/render/plot.hpp"
+#include "msim/scene/spectrum_plot.hpp"
 #include "msim/turbulence/energy_spectrum.hpp"
 
 namespace msim::scene {
@@ -41,34 +42,12 @@ json writeWindReports(std::span<const turbulence::TurbulentWind<D>> winds, const
       if (!csv) throw std::runtime_error("writing " + stem + ".csv failed");
     });
 
-    render::Plot plot;
-    plot.title = fmt::format("wind {}: energy spectrum", i);
-    plot.xLabel = "log10 k (rad/m)";
-    plot.yLabel = "log10 E (m^3/s^2)";
-    render::PlotSeries lattice_, kolmogorov;
-    lattice_.name = "lattice (time slice 0)";
-    lattice_.line = false;
-    lattice_.markers = true;
-    lattice_.colour = render::plotColour(0);
-    kolmogorov.name = "C_K eps^(2/3) k^(-5/3)";
-    kolmogorov.colour = render::plotColour(1);
-    kolmogorov.lineWidth = 2;
-    // Shells outside the inertial range hold only round-off (1e-9 of the peak and below).
-    double peak = 0.0;
-    for (const double e : measured.energy) peak = std::max(peak, e);
-    for (std::size_t s = 0; s < measured.wavenumber.size(); ++s) {
-      const double k = measured.wavenumber[s], e = p.spectrum.energy(k);
-      if (measured.energy[s] > 1e-9 * peak) {
-        lattice_.x.push_back(std::log10(k));
-        lattice_.y.push_back(std::log10(measured.energy[s]));
-      }
-      if (e > 0.0) {
-        kolmogorov.x.push_back(std::log10(k));
-        kolmogorov.y.push_back(std::log10(e));
-      }
-    }
-    plot.series = {lattice_, kolmogorov};
-    if (!lattice_.x.empty() && !kolmogorov.x.empty()) io::writePng(runDir / "winds" / (stem + ".png"), render::renderPlot(plot));
+    std::vector<double> prescribed;
+    for (const double k : measured.wavenumber) prescribed.push_back(p.spectrum.energy(k));
+    const render::Plot plot = spectrumPlot(fmt::format("wind {}: energy spectrum", i),
+                                           {{"lattice (time slice 0)", measured.wavenumber, measured.energy, true},
+                                            {"C_K eps^(2/3) k^(-5/3)", measured.wavenumber, prescribed, false}});
+    if (plot.series.size() == 2) io::writePng(runDir / "winds" / (stem + ".png"), render::renderPlot(plot));
 
     json r = {{"speed_rms_mps", std::sqrt(meanSquare)},
               {"speed_rms_prescribed_mps", p.spectrum.speedRms()},

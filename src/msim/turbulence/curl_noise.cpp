@@ -19,14 +19,17 @@ NoiseTile<D>::NoiseTile(std::uint64_t seed) {
   std::size_t n = 1;
   for (const int d : dims) n *= static_cast<std::size_t>(d);
   std::vector<std::complex<float>> modes(n, std::complex<float>(0.0f, 0.0f));
-  // Flat energy over the spatial octave |n| in [4, 8) (wavelengths [1/2, 1) units on a 4-unit
-  // tile); a Gaussian of 0.25 cycles per time unit over the temporal frequencies.
+  // The spatial octave |n| in [4, 8) (wavelengths [1/2, 1) units on a 4-unit tile), shaped so the
+  // velocity it makes follows k^(-5/3) within the octave too: a shell of radius k holds ~k^(D-1)
+  // modes and the curl multiplies each mode's energy by k^2, so the potential's modes get
+  // |n|^-(D + 8/3). Octaves scaled by 2^i with energies E_0 2^(-2i/3) then join into one power law
+  // instead of a staircase. A Gaussian of 0.25 cycles per time unit over the temporal frequencies.
   auto weight = [&](const auto& s) {
     double q = 0.0;
     for (int d = 0; d < D; ++d) q += double(s[d]) * s[d];
     if (q < 16.0 || q >= 64.0 || 2 * std::abs(s[D]) == kTimeSamples) return 0.0;
     const double f = s[D] / kPeriod;
-    return std::exp(-0.5 * f * f / (0.25 * 0.25));
+    return std::pow(q, -0.5 * (D + 8.0 / 3.0)) * std::exp(-0.5 * f * f / (0.25 * 0.25));
   };
   const Rng noise(seed);
   numerics::forEachMirrorPair(dims, [&](std::size_t a, std::size_t mirror, const auto& s) {

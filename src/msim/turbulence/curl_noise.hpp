@@ -5,9 +5,9 @@
 // NoiseTile is the animated band-limited noise every octave and particle reads: a scalar field,
 // periodic in space and time, whose energy lies in one octave of wavelengths, [1/2, 1) noise units.
 // The seed precomputes animated 3D Perlin noise; this tile is synthesised spectrally instead
-// (flat energy over the octave band, Gaussian in temporal frequency), which band-limits it exactly
-// where Perlin noise leaks into neighbouring octaves (the seed notes that wavelet noise would
-// band-limit better). It is scaled so the curl of the vector of its three offset copies (2D: the
+// (its curl's energy falling as k^(-5/3) across the octave band, Gaussian in temporal frequency),
+// which band-limits it exactly where Perlin noise leaks into neighbouring octaves (the seed notes
+// that wavelet noise would band-limit better). It is scaled so the curl of the vector of its three offset copies (2D: the
 // rotated gradient of one), interpolated as it is read, has <|curl N|^2> = 2 (measured at random
 // points): a potential A N(x / l) then gives velocities of rms sqrt(2) A / l, so A = sqrt(E) l
 // (Narain: A_i = u_i l_i, u_i = sqrt(E_i)) gives the kinetic energy 1/2 <|u|^2> = E.

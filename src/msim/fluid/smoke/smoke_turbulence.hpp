@@ -31,6 +31,7 @@ struct SmokeTurbulenceParams {
   turbulence::NoiseParticleParams particles;
   bool coupling = true;            // U advected by U + u' (ch. 3.5.2)
   double smokeThreshold = 1e-4;    // [kg/m^3] coarse cells with less smoke get no u'
+  bool writeVelocity = false;      // the scene writes U + u' on the fine grid as its "vel" (outputs only)
 };
 
 template <int D>
@@ -57,6 +58,7 @@ class SmokeTurbulence {
   Grid<float, D>& temperature() { return temperature_; }
   const Grid<float, D>& temperature() const { return temperature_; }
   const MacGrid<D>& turbulentVelocity() const { return turbulent_; }       // u' on the fine faces
+  const MacGrid<D>& fineVelocity() const { return advecting_; }  // U (interpolated) + u' of the last step
   const MacGrid<D>& coarseTurbulentVelocity() const { return coarseTurbulent_; }  // u' on the coarse faces
   turbulence::TurbulentEnergy<D>& energy() { return energy_; }
   const turbulence::TurbulentEnergy<D>& energy() const { return energy_; }
