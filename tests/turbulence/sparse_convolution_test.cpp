@@ -11,6 +11,8 @@
 #include "msim/turbulence/energy_spectrum.hpp"
 #include "msim/turbulence/sparse_convolution_wind.hpp"
 
+#include "input_error_message.hpp"
+
 using namespace msim;
 using namespace msim::turbulence;
 
@@ -128,12 +130,7 @@ TEST(SparseConvolutionWind, TilesRepeatAndOpenFieldsDoNot) {
 
 TEST(SparseConvolutionWind, BadParametersAreClearErrors) {
   auto message = [](const SparseConvolutionParams& p) {
-    try {
-      SparseConvolutionWind<3> w(p, "wind");
-    } catch (const InputError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
+    return inputErrorMessage([&] { SparseConvolutionWind<3> w(p, "wind"); });
   };
   SparseConvolutionParams p = tiled(32);
   p.tile = 0.9;  // three reaches of 0.32 m do not fit

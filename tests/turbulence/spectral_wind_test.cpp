@@ -15,6 +15,8 @@
 #include "msim/turbulence/energy_spectrum.hpp"
 #include "msim/turbulence/spectral_wind.hpp"
 
+#include "input_error_message.hpp"
+
 using namespace msim;
 using namespace msim::turbulence;
 
@@ -69,14 +71,7 @@ TEST(KolmogorovSpectrum, EnergyIntegratesToTheClosedForm) {
 }
 
 TEST(KolmogorovSpectrum, InconsistentParametersAreClearErrors) {
-  auto message = [](const KolmogorovSpectrum& s) {
-    try {
-      s.validate("wind.spectrum");
-    } catch (const InputError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
+  auto message = [](const KolmogorovSpectrum& s) { return inputErrorMessage([&] { s.validate("wind.spectrum"); }); };
   KolmogorovSpectrum s;
   s.dissipation = -1.0;
   EXPECT_NE(message(s).find("wind.spectrum"), std::string::npos);
@@ -256,14 +251,7 @@ TEST(SpectralWind, SameSeedSameFieldOnAnyThreadCount) {
 }
 
 TEST(SpectralWind, LatticeThatCannotHoldTheSpectrumIsAClearError) {
-  auto message = [](const SpectralWindParams& p) {
-    try {
-      SpectralWind<3> w(p, "wind");
-    } catch (const InputError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
+  auto message = [](const SpectralWindParams& p) { return inputErrorMessage([&] { SpectralWind<3> w(p, "wind"); }); };
   SpectralWindParams p = tile(16, 4);
   p.spectrum.smallestEddy = 0.05;  // below two cells of 1/16 m
   EXPECT_NE(message(p).find("finer than the lattice"), std::string::npos);

@@ -405,7 +405,7 @@ class CrowdPhenomenon final : public Phenomenon {
 void declare(Schema& root) { declareCrowdKeys(root); }
 
 // Grids of the continuum (density, velocity, pressure, free area, scratch of the projection).
-double bytesPerCell(int) { return 400.0; }
+double bytesPerCell(int, const json&) { return 400.0; }
 
 std::unique_ptr<Phenomenon> create(const Scene& scene, StageTimers& timers) {
   return std::make_unique<CrowdPhenomenon>(scene, timers);

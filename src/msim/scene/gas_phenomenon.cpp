@@ -63,7 +63,7 @@ void declareGas(Schema& root) {
   root.array("obstacles", obstacle, "static solids");
 }
 
-double gasBytesPerCell(int dimensions) {
+double gasBytesPerCell(int dimensions, const json& /*resolved*/) {
   // density, temperature, solid, RK stage, rate, net outflow (6 floats) + velocity, flux and
   // open-face velocity (3 x D floats) + the preview's light buffer and the VDB copies of two
   // fields (~3 floats).

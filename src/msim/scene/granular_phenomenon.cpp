@@ -169,7 +169,7 @@ void declare(Schema& root) { declareGranularKeys(root); }
 
 // Grid fields of the transfer and the stress solver (cells, faces, six stress lattices, QP
 // scratch) plus about 8 particles per filled cell at ~80 bytes each.
-double bytesPerCell(int) { return 2000.0; }
+double bytesPerCell(int, const json&) { return 2000.0; }
 
 std::unique_ptr<Phenomenon> create(const Scene& scene, StageTimers& timers) {
   return std::make_unique<GranularPhenomenon>(scene, timers);

@@ -51,7 +51,7 @@ struct PhenomenonType {
   // Adds the phenomenon's own keys to the root scene schema.
   void (*declare)(Schema& root);
   // Bytes of memory per grid cell while running (state, scratch, output buffers).
-  double (*bytesPerCell)(int dimensions);
+  double (*bytesPerCell)(int dimensions, const nlohmann::json& resolved);
   std::unique_ptr<Phenomenon> (*create)(const Scene& scene, StageTimers& timers);
 };
 

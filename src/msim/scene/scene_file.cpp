@@ -124,7 +124,7 @@ Scene loadScene(const std::filesystem::path& file, const std::vector<std::string
   scene.frameCount = std::max(1, static_cast<int>(std::lround(time.at("duration").get<double>() * scene.fps)));
 
   // Refuse before anything is allocated: a run that swaps or is killed by the OOM killer helps no one.
-  scene.memoryEstimate = static_cast<double>(scene.cellCount()) * scene.type->bytesPerCell(scene.dimensions);
+  scene.memoryEstimate = static_cast<double>(scene.cellCount()) * scene.type->bytesPerCell(scene.dimensions, scene.resolved);
   const double available = static_cast<double>(availableMemoryBytes());
   if (available > 0.0 && scene.memoryEstimate > available)
     throw InputError(fmt::format(

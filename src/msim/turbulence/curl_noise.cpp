@@ -6,6 +6,7 @@
 #include <complex>
 #include <numbers>
 
+#include "msim/core/linear_taps.hpp"
 #include "msim/core/parallel.hpp"
 #include "msim/core/rng.hpp"
 #include "msim/numerics/fft.hpp"
@@ -75,33 +76,14 @@ NoiseTile<D>::NoiseTile(std::uint64_t seed) {
 
 template <int D>
 float NoiseTile<D>::value(const Vec<D>& y, double t) const {
-  // Power-of-two sample counts: the wrap is a mask on the (two's complement) lattice index.
-  static_assert((kSamples & (kSamples - 1)) == 0 && (kTimeSamples & (kTimeSamples - 1)) == 0);
-  std::array<std::size_t, D + 1> lower, upper;
-  std::array<float, D + 1> fraction;
+  std::array<LinearTap, D + 1> taps;
   std::size_t stride = 1;
-  for (int d = 0; d <= D; ++d) {
-    const int count = d < D ? kSamples : kTimeSamples;
-    const double g = d < D ? y[d] * (kSamples / kSide) : t * (kTimeSamples / kPeriod);
-    const double floor = std::floor(g);
-    fraction[d] = static_cast<float>(g - floor);
-    const std::int64_t i = static_cast<std::int64_t>(floor) & (count - 1);
-    lower[d] = static_cast<std::size_t>(i) * stride;
-    upper[d] = static_cast<std::size_t>((i + 1) & (count - 1)) * stride;
-    stride *= static_cast<std::size_t>(count);
+  for (int d = 0; d < D; ++d) {
+    taps[d] = periodicTap(y[d] * (kSamples / kSide), kSamples, stride);
+    stride *= static_cast<std::size_t>(kSamples);
   }
-  float sum = 0.0f;
-  for (int corner = 0; corner < (1 << (D + 1)); ++corner) {
-    std::size_t index = 0;
-    float w = 1.0f;
-    for (int d = 0; d <= D; ++d) {
-      const bool up = (corner >> d) & 1;
-      index += up ? upper[d] : lower[d];
-      w *= up ? fraction[d] : 1.0f - fraction[d];
-    }
-    sum += w * samples_[index];
-  }
-  return sum;
+  taps[D] = periodicTap(t * (kTimeSamples / kPeriod), kTimeSamples, stride);
+  return blendCorners<D + 1>(taps, samples_.data());
 }
 
 template <int D>

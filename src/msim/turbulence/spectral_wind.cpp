@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "msim/core/error.hpp"
+#include "msim/core/linear_taps.hpp"
 #include "msim/core/parallel.hpp"
 #include "msim/core/rng.hpp"
 #include "msim/numerics/fft.hpp"
@@ -153,47 +154,23 @@ std::span<const Vecf<D>> SpectralWind<D>::timeSlice(int l) const {
 template <int D>
 void SpectralWind<D>::componentAt(int axis, double t, std::vector<float>& slice) const {
   const int mt = params_.timeSamples;
-  const double g = t * (mt / params_.period);
-  const double floor = std::floor(g);
-  const float fraction = static_cast<float>(g - floor);
-  const double wrapped = std::fmod(floor, double(mt));
-  const int l = static_cast<int>(wrapped < 0.0 ? wrapped + mt : wrapped) % mt;
-  const auto a = timeSlice(l), b = timeSlice(l + 1);
+  const LinearTap time = periodicTap(t * (mt / params_.period), mt, 1);
+  const auto a = timeSlice(static_cast<int>(time.lower)), b = timeSlice(static_cast<int>(time.upper));
   slice.resize(a.size());
-  parallelFor(0, a.size(), [&](std::size_t i) { slice[i] = (1.0f - fraction) * a[i][axis] + fraction * b[i][axis]; }, 1 << 14);
+  parallelFor(0, a.size(), [&](std::size_t i) { slice[i] = (1.0f - time.fraction) * a[i][axis] + time.fraction * b[i][axis]; }, 1 << 14);
 }
 
 template <int D>
 Vec<D> SpectralWind<D>::velocity(const Vec<D>& x, double t) const {
   const int m = params_.resolution, mt = params_.timeSamples;
-  // Lattice coordinates: the lower corner index (wrapped) and the fraction towards the next one.
-  std::array<std::size_t, D + 1> lower, upper;
-  std::array<float, D + 1> fraction;
+  std::array<LinearTap, D + 1> taps;
   std::size_t stride = 1;
-  for (int d = 0; d <= D; ++d) {
-    const int count = d < D ? m : mt;
-    const double g = d < D ? x[d] * (m / params_.size) : t * (mt / params_.period);
-    const double floor = std::floor(g);
-    fraction[d] = static_cast<float>(g - floor);
-    // fmod keeps huge coordinates in range before the integer conversion.
-    const double wrapped = std::fmod(floor, double(count));
-    const int i = static_cast<int>(wrapped < 0.0 ? wrapped + count : wrapped) % count;
-    lower[d] = static_cast<std::size_t>(i) * stride;
-    upper[d] = static_cast<std::size_t>((i + 1) % count) * stride;
-    stride *= static_cast<std::size_t>(count);
+  for (int d = 0; d < D; ++d) {
+    taps[d] = periodicTap(x[d] * (m / params_.size), m, stride);
+    stride *= static_cast<std::size_t>(m);
   }
-  Vecf<D> sum = Vecf<D>::Zero();
-  for (int corner = 0; corner < (1 << (D + 1)); ++corner) {
-    std::size_t index = 0;
-    float weight = 1.0f;
-    for (int d = 0; d <= D; ++d) {
-      const bool up = (corner >> d) & 1;
-      index += up ? upper[d] : lower[d];
-      weight *= up ? fraction[d] : 1.0f - fraction[d];
-    }
-    sum += weight * samples_[index];
-  }
-  return sum.template cast<double>();
+  taps[D] = periodicTap(t * (mt / params_.period), mt, stride);
+  return blendCorners<D + 1>(taps, samples_.data()).template cast<double>();
 }
 
 template class SpectralWind<2>;

@@ -6,6 +6,9 @@
 #include <stdexcept>
 #include <vector>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "msim/core/parallel.hpp"
 
 namespace msim::turbulence {
@@ -160,35 +163,44 @@ void TurbulentEnergy<D>::diffuse(double dt) {
     // The lines along axis a: every cell with coordinate 0 along a.
     IVec<D> lineCount = spec_.res;
     lineCount[a] = 1;
-    parallelForCells<D>(lineCount, [&](const IVec<D>& start, std::size_t) {
-      std::vector<double> lower(n), diag(n), upper(n), rhs(n);
-      IVec<D> c = start;
-      auto kappaFace = [&](int k) {  // between cells k - 1 and k along the line
-        IVec<D> lo = start, hi = start;
-        lo[a] = k - 1;
-        hi[a] = k;
-        if (solidAt(lo) || solidAt(hi)) return 0.0;
-        return 0.5 * (double(filtered_(lo)) + double(filtered_(hi)));
-      };
-      for (int k = 0; k < n; ++k) {
-        c[a] = k;
-        const double left = r * kappaFace(k), right = r * kappaFace(k + 1);
-        lower[k] = -left;
-        upper[k] = -right;
-        diag[k] = 1.0 + left + right;
-        rhs[k] = energy_(c);
-      }
-      // Thomas algorithm.
-      for (int k = 1; k < n; ++k) {
-        const double m = lower[k] / diag[k - 1];
-        diag[k] -= m * upper[k - 1];
-        rhs[k] -= m * rhs[k - 1];
-      }
-      rhs[n - 1] /= diag[n - 1];
-      for (int k = n - 2; k >= 0; --k) rhs[k] = (rhs[k] - upper[k] * rhs[k + 1]) / diag[k];
-      for (int k = 0; k < n; ++k) {
-        c[a] = k;
-        energy_(c) = static_cast<float>(rhs[k]);
+    const std::size_t lines = static_cast<std::size_t>(lineCount.prod());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, lines, 16), [&](const tbb::blocked_range<std::size_t>& range) {
+      std::vector<double> lower(n), diag(n), upper(n), rhs(n);  // once per task, not per line
+      for (std::size_t line = range.begin(); line != range.end(); ++line) {
+        IVec<D> start;
+        std::size_t rest = line;
+        for (int d = 0; d < D; ++d) {
+          start[d] = static_cast<int>(rest % lineCount[d]);
+          rest /= lineCount[d];
+        }
+        IVec<D> c = start;
+        auto kappaFace = [&](int k) {  // between cells k - 1 and k along the line
+          IVec<D> lo = start, hi = start;
+          lo[a] = k - 1;
+          hi[a] = k;
+          if (solidAt(lo) || solidAt(hi)) return 0.0;
+          return 0.5 * (double(filtered_(lo)) + double(filtered_(hi)));
+        };
+        for (int k = 0; k < n; ++k) {
+          c[a] = k;
+          const double left = r * kappaFace(k), right = r * kappaFace(k + 1);
+          lower[k] = -left;
+          upper[k] = -right;
+          diag[k] = 1.0 + left + right;
+          rhs[k] = energy_(c);
+        }
+        // Thomas algorithm.
+        for (int k = 1; k < n; ++k) {
+          const double m = lower[k] / diag[k - 1];
+          diag[k] -= m * upper[k - 1];
+          rhs[k] -= m * rhs[k - 1];
+        }
+        rhs[n - 1] /= diag[n - 1];
+        for (int k = n - 2; k >= 0; --k) rhs[k] = (rhs[k] - upper[k] * rhs[k + 1]) / diag[k];
+        for (int k = 0; k < n; ++k) {
+          c[a] = k;
+          energy_(c) = static_cast<float>(rhs[k]);
+        }
       }
     });
   }

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "msim/core/grid.hpp"
+#include "msim/core/linear_taps.hpp"
 #include "msim/core/parallel.hpp"
 #include "msim/core/vec.hpp"
 #include "msim/turbulence/spectral_wind.hpp"
@@ -52,44 +53,21 @@ void TurbulentWind<D>::forEachSample(const Grid<T, D>& grid, int axis, double t,
   const int m = lattice_.params().resolution;
   std::vector<float> slice;
   lattice_.componentAt(axis, t, slice);
-  // Per axis d and grid index i: the lattice offsets of the two neighbours and the weight of the
-  // upper one, for the position shifted by the mean wind.
-  struct Tap {
-    std::size_t lower, upper;
-    float fraction;
-  };
-  std::array<std::vector<Tap>, D> taps;
+  // Per axis d and grid index i: the wrapped lattice tap, for the position shifted by the mean wind.
+  std::array<std::vector<LinearTap>, D> taps;
   const Vec<D> first = grid.position(IVec<D>::Zero()) - origin_ - mean_ * t;
   const double h = lattice_.cellSize();
   std::size_t stride = 1;
   for (int d = 0; d < D; ++d) {
-    const int count = grid.size()[d];
-    taps[d].resize(static_cast<std::size_t>(count));
-    for (int i = 0; i < count; ++i) {
-      const double g = (first[d] + i * grid.spec().dx) / h;
-      const double floor = std::floor(g);
-      const double wrapped = std::fmod(floor, double(m));
-      const int lo = static_cast<int>(wrapped < 0.0 ? wrapped + m : wrapped) % m;
-      taps[d][i] = Tap{static_cast<std::size_t>(lo) * stride, static_cast<std::size_t>((lo + 1) % m) * stride,
-                       static_cast<float>(g - floor)};
-    }
+    taps[d].resize(static_cast<std::size_t>(grid.size()[d]));
+    for (int i = 0; i < grid.size()[d]; ++i) taps[d][i] = periodicTap((first[d] + i * grid.spec().dx) / h, m, stride);
     stride *= static_cast<std::size_t>(m);
   }
   const float mean = static_cast<float>(mean_[axis]);
   parallelForCells<D>(grid.size(), [&](const IVec<D>& c, std::size_t lin) {
-    float sum = 0.0f;
-    for (int corner = 0; corner < (1 << D); ++corner) {
-      std::size_t index = 0;
-      float weight = 1.0f;
-      for (int d = 0; d < D; ++d) {
-        const Tap& tap = taps[d][static_cast<std::size_t>(c[d])];
-        const bool up = (corner >> d) & 1;
-        index += up ? tap.upper : tap.lower;
-        weight *= up ? tap.fraction : 1.0f - tap.fraction;
-      }
-      sum += weight * slice[index];
-    }
-    f(lin, mean + sum);
+    std::array<LinearTap, D> at;
+    for (int d = 0; d < D; ++d) at[d] = taps[d][static_cast<std::size_t>(c[d])];
+    f(lin, mean + blendCorners<D>(at, slice.data()));
   });
 }
 
