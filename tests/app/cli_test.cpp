@@ -245,3 +245,18 @@ TEST(Cli, WindTheLatticeCannotHoldNamesTheKey) {
   EXPECT_EQ(r2.exitCode, 2) << r2.output;
   EXPECT_NE(r2.output.find("below the largest scale"), std::string::npos) << r2.output;
 }
+
+TEST(Cli, SpatiallySynthesisedWindMovesTheGas) {
+  const fs::path dir = scratch("spatial_wind");
+  writeText(dir / "s.json",
+            tinyScene(R"(, "winds": [{"synthesis": "spatial", "speed_rms": 0.3, "points_per_cell": 2}])"));
+  const std::string scene = (dir / "s.json").string();
+  ASSERT_EQ(runMsim("run " + scene + " -q --frames 2 --out " + (dir / "windy").string()).exitCode, 0);
+  ASSERT_EQ(runMsim("run " + scene + " -q --frames 2 --set winds=[] --out " + (dir / "calm").string()).exitCode, 0);
+  const auto a = msim::io::readFloatGrid(dir / "windy" / "vdb" / "tiny_0002.vdb", "density");
+  const auto b = msim::io::readFloatGrid(dir / "calm" / "vdb" / "tiny_0002.vdb", "density");
+  EXPECT_NE(0, std::memcmp(a.data().data(), b.data().data(), a.count() * sizeof(float)));
+  std::ifstream runJson(dir / "windy" / "run.json");
+  EXPECT_EQ(nlohmann::json::parse(runJson).at("results").at("winds").at(0).at("synthesis"), "spatial");
+  EXPECT_FALSE(fs::exists(dir / "windy" / "winds"));  // no lattice to report on
+}

@@ -6,10 +6,12 @@
 #include <cmath>
 
 #include "msim/core/error.hpp"
+#include "msim/core/mac_grid.hpp"
 #include "msim/core/parallel.hpp"
 #include "msim/core/rng.hpp"
 #include "msim/turbulence/energy_spectrum.hpp"
 #include "msim/turbulence/sparse_convolution_wind.hpp"
+#include "msim/turbulence/turbulent_wind.hpp"
 
 #include "input_error_message.hpp"
 
@@ -141,4 +143,26 @@ TEST(SparseConvolutionWind, BadParametersAreClearErrors) {
   p = tiled(32);
   p.spectrum.smallestEddy = 0.5;
   EXPECT_NE(message(p).find("below the largest scale"), std::string::npos);
+}
+
+TEST(SparseConvolutionWind, PlacedAsAWindItIsCarriedByTheMeanAndSampledOnGrids) {
+  SparseConvolutionParams p = tiled(32);
+  p.tile = 0.0;
+  const double rms = p.spectrum.speedRms();
+  const TurbulentWind<3> wind(SparseConvolutionWind<3>(p), rms, Vec3(0.1, 0.0, 0.0), Vec3(0.5, 0.0, 0.0));
+  EXPECT_NEAR(wind.maxSpeed(), 0.5 + 5.0 * rms, 1e-12);
+  EXPECT_EQ(wind.lattice(), nullptr);
+  // Frozen pattern carried by U: u(x + U t, t) = u(x, 0).
+  const Vec3 x(0.3, 0.6, 0.2);
+  EXPECT_LT((wind.velocity(x + 0.7 * Vec3(0.5, 0.0, 0.0), 0.7) - wind.velocity(x, 0.0)).norm(), 1e-12);
+  // The grid sampler gives velocity() at every sample.
+  const GridSpec<3> spec(Vec3::Zero(), 0.125, IVec3(8, 8, 8));
+  const MacGrid<3> faces(spec);
+  const auto& uy = faces.component(1);
+  int checked = 0;
+  wind.forEachSample(uy, 1, 0.4, [&](std::size_t lin, float v) {
+    EXPECT_NEAR(v, wind.velocity(uy.position(uy.coord(lin)), 0.4).y(), 1e-6);
+    ++checked;
+  });
+  EXPECT_EQ(checked, static_cast<int>(uy.count()));
 }

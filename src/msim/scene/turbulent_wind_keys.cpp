@@ -13,6 +13,10 @@ void declareTurbulentWinds(Schema& root) {
   Schema wind = Schema::object(
       "a turbulent wind: an isotropic, incompressible random field with the Kolmogorov spectrum, synthesised on a "
       "lattice periodic in space and time (Stam ch. 3.4) and carried by its mean velocity");
+  wind.string("synthesis", "spectral",
+              "'spectral': FFT on a lattice periodic in space and time (ch. 3.3.2); 'spatial': sparse convolution "
+              "(ch. 3.3.3), evaluated anywhere without a lattice, never repeating, frozen in time")
+      .choices({"spectral", "spatial"});
   wind.number("speed_rms", "m/s", 0.1, "sqrt(<|u'|^2>) of the turbulent part; sets the dissipation rate epsilon")
       .min(0.0, Bound::Exclusive);
   wind.number("dissipation", "m^2/s^3", 0.0, "epsilon of E(k) = C_K epsilon^(2/3) k^(-5/3); 0 = from speed_rms").min(0.0);
@@ -28,6 +32,8 @@ void declareTurbulentWinds(Schema& root) {
               "swept by the large ones)")
       .min(-1.0);
   wind.integer("seed", 1, "random seed of the realisation").min(0);
+  wind.number("reach", "", 2.0, "spatial: kernel reach in largest eddies").min(1.0);
+  wind.integer("points_per_cell", 8, "spatial: random impulses per cell of the kernel's reach").min(1).max(64);
   wind.vector("origin", "m", {0.0, 0.0, 0.0}, "where the lattice's first sample sits").lengths({2, 3});
   wind.vector("mean_velocity", "m/s", {0.0, 0.0, 0.0}, "U: u = U + u'(x - origin - U t, t) (frozen turbulence carried by the mean wind)")
       .lengths({2, 3});
@@ -61,8 +67,17 @@ std::vector<turbulence::TurbulentWind<D>> turbulentWinds(const Scene& scene) {
     p.spectrum.dissipation = 1.0;
     p.spectrum.validate(where);
     p.spectrum.dissipation = epsilon > 0.0 ? epsilon : p.spectrum.dissipationForSpeedRms(w.at("speed_rms").get<double>());
-    out.emplace_back(turbulence::SpectralWind<D>(p, where), sceneVector<D>(w.at("origin")),
-                     sceneVector<D>(w.at("mean_velocity")));
+    const Vec<D> origin = sceneVector<D>(w.at("origin")), mean = sceneVector<D>(w.at("mean_velocity"));
+    if (w.at("synthesis").get<std::string>() == "spatial") {
+      turbulence::SparseConvolutionParams sp;
+      sp.spectrum = p.spectrum;
+      sp.reach = w.at("reach").get<double>();
+      sp.pointsPerCell = w.at("points_per_cell").get<int>();
+      sp.seed = p.seed;
+      out.emplace_back(turbulence::SparseConvolutionWind<D>(sp, where), p.spectrum.speedRms(), origin, mean);
+    } else {
+      out.emplace_back(turbulence::SpectralWind<D>(p, where), origin, mean);
+    }
   }
   return out;
 }

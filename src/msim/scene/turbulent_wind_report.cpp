@@ -22,9 +22,13 @@ template <int D>
 json writeWindReports(std::span<const turbulence::TurbulentWind<D>> winds, const fs::path& runDir) {
   json out = json::array();
   if (winds.empty()) return out;
-  fs::create_directories(runDir / "winds");
   for (std::size_t i = 0; i < winds.size(); ++i) {
-    const auto& lattice = winds[i].lattice();
+    if (!winds[i].lattice()) {
+      out.push_back({{"synthesis", "spatial"}});  // no lattice to measure
+      continue;
+    }
+    fs::create_directories(runDir / "winds");
+    const auto& lattice = *winds[i].lattice();
     const auto& p = lattice.params();
     const turbulence::ShellSpectrum measured = turbulence::shellSpectrum<D>(lattice.timeSlice(0), p.resolution, p.size);
     const turbulence::DivergenceMeasure div = turbulence::spectralDivergence<D>(lattice.timeSlice(0), p.resolution, p.size);
