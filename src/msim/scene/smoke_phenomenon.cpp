@@ -232,6 +232,7 @@ class SmokePhenomenon final : public Phenomenon {
   void placeObstacles(double time) {
     solver_.setObstacles(obstacles_.nodalDistance(time));
     if (obstacles_.moving()) solver_.setObstacleVelocity(obstacles_.faceVelocity(time));
+    if (turbulence_) turbulence_->setSolid(solver_.solid());
   }
 
   void enableTurbulence(const Scene& scene) {
@@ -240,8 +241,6 @@ class SmokePhenomenon final : public Phenomenon {
       throw InputError(fmt::format("{}: 'smoke.turbulence.enabled' with 'fire.enabled' is not supported yet (the fuel "
                                    "and flame stay on the simulation grid)",
                                    source_));
-    if (obstacles_.moving())
-      throw InputError(fmt::format("{}: 'smoke.turbulence.enabled' with moving obstacles is not supported yet", source_));
     turbulence_ = std::make_unique<fluid::SmokeTurbulence<D>>(
         solver_.spec(), smokeTurbulenceParams(r), solver_.params().advection,
         obstacles_.empty() ? nullptr : &solver_.solid(), solver_.params().buoyancy.ambientTemperature);

@@ -53,6 +53,10 @@ class NoiseParticles {
   void synthesize(const TurbulentEnergy<D>& energy, MacGrid<D>& turbulent,
                   const std::vector<std::uint8_t>* nodeMask = nullptr);
 
+  // Moving obstacles: the new solid mask (> 0.5); particles inside it are dropped at the next
+  // advance() and empty cells refilled around it.
+  void setSolid(const Grid<float, D>& solid) { solid_ = solid; }
+
   std::size_t size() const { return position_.size(); }
   int octaves() const { return octaves_; }
   const std::vector<Vec<D>>& positions() const { return position_; }

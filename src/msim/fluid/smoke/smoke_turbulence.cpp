@@ -35,17 +35,28 @@ SmokeTurbulence<D>::SmokeTurbulence(const GridSpec<D>& coarse, const SmokeTurbul
       coarseTurbulent_(coarse),
       energy_(coarse, params.energy),
       advector_(fine_, advection) {
-  if (coarseSolid) {
-    coarseSolid_ = *coarseSolid;
-    hasSolid_ = true;
-    const int r = params.refinement;
-    parallelForCells<D>(fine_.res, [&](const IVec<D>& c, std::size_t lin) {
-      fineSolid_[lin] = coarseSolid_(IVec<D>(c / r));
-    });
-    energy_.setSolid(coarseSolid_);
-    advector_.setSolid(fineSolid_);
-  }
+  if (coarseSolid) applySolid(*coarseSolid);
   reseedParticles();
+}
+
+template <int D>
+void SmokeTurbulence<D>::applySolid(const Grid<float, D>& coarseSolid) {
+  coarseSolid_ = coarseSolid;
+  hasSolid_ = true;
+  const int r = params_.refinement;
+  parallelForCells<D>(fine_.res, [&](const IVec<D>& c, std::size_t lin) { fineSolid_[lin] = coarseSolid_(IVec<D>(c / r)); });
+  energy_.setSolid(coarseSolid_);
+  advector_.setSolid(fineSolid_);
+  // Smoke does not live inside solids.
+  parallelFor(0, density_.count(), [&](std::size_t i) {
+    if (fineSolid_[i] > 0.5f) density_[i] = 0.0f;
+  }, 1 << 14);
+}
+
+template <int D>
+void SmokeTurbulence<D>::setSolid(const Grid<float, D>& coarseSolid) {
+  applySolid(coarseSolid);
+  if (particles_) particles_->setSolid(coarseSolid_);
 }
 
 template <int D>

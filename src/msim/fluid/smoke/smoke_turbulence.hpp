@@ -64,6 +64,9 @@ class SmokeTurbulence {
   const turbulence::TurbulentEnergy<D>& energy() const { return energy_; }
   const turbulence::NoiseParticles<D>& particles() const { return *particles_; }
   const SmokeTurbulenceParams& params() const { return params_; }
+  // Moving obstacles: the simulation grid's new solid mask; the fine grid, the energy model, the
+  // fine advector and the noise particles follow it.
+  void setSolid(const Grid<float, D>& coarseSolid);
   // Restarts the noise particles (a resumed run: they are not saved).
   void reseedParticles();
   // Fills the coarse grids with the fine scalars averaged (after a restore).
@@ -74,6 +77,7 @@ class SmokeTurbulence {
   double bandFraction() const { return bandFraction_; }
 
  private:
+  void applySolid(const Grid<float, D>& coarseSolid);
   void markBand(const MacGrid<D>& velocity, double dt, const Grid<float, D>& coarseDensity);
   void fineVelocity(const MacGrid<D>& velocity);
   void applySources(double dt);
