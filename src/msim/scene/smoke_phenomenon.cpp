@@ -279,6 +279,7 @@ class SmokePhenomenon final : public Phenomenon {
         fluid::SmokeSource<D> fine = src;
         fine.cells = coveredOpenCells<D>(scene, *shape, turbulence_->fineSolid(), key + ".shape");
         fine.velocity.reset();
+        fine.scalars.clear();  // fuel cannot be set here: fire with turbulence is refused
         turbulence_->addSource(std::move(fine));
         src.mode = fluid::SmokeSource<D>::Mode::Add;
         src.density = 0.0;

@@ -41,34 +41,52 @@ bool NoiseParticles<D>::inFluid(const Vec<D>& x) const {
 }
 
 template <int D>
+IVec<D> NoiseParticles<D>::coverageCoord(const Vec<D>& x) const {
+  IVec<D> c;
+  for (int d = 0; d < D; ++d)
+    c[d] = std::clamp(static_cast<int>(std::floor((x[d] - coarse_.origin[d]) / l0_)), 0, cells_[d] - 1);
+  return c;
+}
+
+template <int D>
+std::size_t NoiseParticles<D>::coverageIndex(const IVec<D>& c) const {
+  std::size_t index = 0;
+  for (int d = D - 1; d >= 0; --d) index = index * cells_[d] + static_cast<std::size_t>(c[d]);
+  return index;
+}
+
+template <int D>
 void NoiseParticles<D>::refill(std::uint64_t step) {
-  // Bucket by coverage cell, keep at most kMostPerCell per cell (in index order), add one where a
-  // fluid cell has none; the arrays end up in cell order.
+  // Bucket by coverage cell (stable counting sort), keep at most kMostPerCell per cell (in index
+  // order), add one where a fluid cell has none; the arrays end up in cell order.
   std::size_t cellCount = 1;
   for (int d = 0; d < D; ++d) cellCount *= static_cast<std::size_t>(cells_[d]);
-  auto cellOf = [&](const Vec<D>& x) {
-    std::size_t index = 0;
-    for (int d = D - 1; d >= 0; --d) {
-      const int c = std::clamp(static_cast<int>((x[d] - coarse_.origin[d]) / l0_), 0, cells_[d] - 1);
-      index = index * cells_[d] + static_cast<std::size_t>(c);
-    }
-    return index;
-  };
-  std::vector<std::vector<std::uint32_t>> members(cellCount);
-  for (std::size_t j = 0; j < position_.size(); ++j) {
-    auto& m = members[cellOf(position_[j])];
-    if (m.size() < kMostPerCell) m.push_back(static_cast<std::uint32_t>(j));
+  const std::size_t n = position_.size();
+  oldCell_.resize(n);
+  oldStart_.assign(cellCount + 1, 0);
+  for (std::size_t j = 0; j < n; ++j) {
+    oldCell_[j] = static_cast<std::uint32_t>(coverageIndex(coverageCoord(position_[j])));
+    ++oldStart_[oldCell_[j] + 1];
   }
-  std::vector<Vec<D>> position, offset;
-  std::vector<std::array<double, kMaxOctaves>> time;
+  for (std::size_t c = 0; c < cellCount; ++c) oldStart_[c + 1] += oldStart_[c];
+  oldOrder_.resize(n);
+  cellStart_.assign(oldStart_.begin(), oldStart_.end());  // fill cursors, rebuilt below
+  for (std::size_t j = 0; j < n; ++j) oldOrder_[cellStart_[oldCell_[j]]++] = static_cast<std::uint32_t>(j);
+
+  nextPosition_.clear();
+  nextOffset_.clear();
+  nextTime_.clear();
   const Rng base(params_.seed ^ 0x2545f4914f6cdd1dull);
   for (std::size_t cell = 0; cell < cellCount; ++cell) {
-    for (const std::uint32_t j : members[cell]) {
-      position.push_back(position_[j]);
-      offset.push_back(offset_[j]);
-      time.push_back(time_[j]);
+    cellStart_[cell] = static_cast<std::uint32_t>(nextPosition_.size());
+    const std::uint32_t first = oldStart_[cell], last = std::min<std::uint32_t>(oldStart_[cell + 1], first + kMostPerCell);
+    for (std::uint32_t q = first; q < last; ++q) {
+      const std::uint32_t j = oldOrder_[q];
+      nextPosition_.push_back(position_[j]);
+      nextOffset_.push_back(offset_[j]);
+      nextTime_.push_back(time_[j]);
     }
-    if (!members[cell].empty()) continue;
+    if (first != last) continue;
     Rng r = base.split(step * 0x9E3779B97F4A7C15ull + cell);
     Vec<D> x;
     std::size_t rest = cell;
@@ -83,13 +101,14 @@ void NoiseParticles<D>::refill(std::uint64_t step) {
     for (int d = 0; d < D; ++d) o[d] = r.uniform(0.0, NoiseTile<D>::kSide);
     std::array<double, kMaxOctaves> t{};
     for (double& v : t) v = r.uniform(0.0, NoiseTile<D>::kPeriod);
-    position.push_back(x);
-    offset.push_back(o);
-    time.push_back(t);
+    nextPosition_.push_back(x);
+    nextOffset_.push_back(o);
+    nextTime_.push_back(t);
   }
-  position_.swap(position);
-  offset_.swap(offset);
-  time_.swap(time);
+  cellStart_[cellCount] = static_cast<std::uint32_t>(nextPosition_.size());
+  position_.swap(nextPosition_);
+  offset_.swap(nextOffset_);
+  time_.swap(nextTime_);
 }
 
 template <int D>
@@ -138,28 +157,6 @@ void NoiseParticles<D>::synthesize(const TurbulentEnergy<D>& energy, MacGrid<D>&
       amplitude[j][i] = static_cast<float>(std::sqrt(energy.octaveEnergy(e0, i)) * l);
     }
   }, 1024);
-  // Particles by coverage cell (counting sort) for the neighbour search.
-  std::size_t cellCount = 1;
-  for (int d = 0; d < D; ++d) cellCount *= static_cast<std::size_t>(cells_[d]);
-  auto cellCoord = [&](const Vec<D>& x) {
-    IVec<D> c;
-    for (int d = 0; d < D; ++d)
-      c[d] = std::clamp(static_cast<int>(std::floor((x[d] - coarse_.origin[d]) / l0_)), 0, cells_[d] - 1);
-    return c;
-  };
-  auto linear = [&](const IVec<D>& c) {
-    std::size_t index = 0;
-    for (int d = D - 1; d >= 0; --d) index = index * cells_[d] + static_cast<std::size_t>(c[d]);
-    return index;
-  };
-  std::vector<std::uint32_t> start(cellCount + 1, 0), order(n);
-  for (std::size_t j = 0; j < n; ++j) ++start[linear(cellCoord(position_[j])) + 1];
-  for (std::size_t c = 0; c < cellCount; ++c) start[c + 1] += start[c];
-  {
-    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
-    for (std::size_t j = 0; j < n; ++j) order[fill[linear(cellCoord(position_[j]))]++] = static_cast<std::uint32_t>(j);
-  }
-
   const IVec<D> nodes = fine.res + IVec<D>::Ones();
   std::size_t nodeCount = 1;
   for (int d = 0; d < D; ++d) nodeCount *= static_cast<std::size_t>(nodes[d]);
@@ -176,7 +173,7 @@ void NoiseParticles<D>::synthesize(const TurbulentEnergy<D>& energy, MacGrid<D>&
       x[d] = fine.origin[d] + static_cast<double>(rest % nodes[d]) * fine.dx;
       rest /= nodes[d];
     }
-    const IVec<D> home = cellCoord(x);
+    const IVec<D> home = coverageCoord(x);
     double acc[3] = {0.0, 0.0, 0.0}, weights = 0.0;
     for (int k = 0; k < (D == 3 ? 27 : 9); ++k) {
       IVec<D> c = home;
@@ -188,9 +185,8 @@ void NoiseParticles<D>::synthesize(const TurbulentEnergy<D>& energy, MacGrid<D>&
         inside &= c[d] >= 0 && c[d] < cells_[d];
       }
       if (!inside) continue;
-      const std::size_t cell = linear(c);
-      for (std::uint32_t q = start[cell]; q < start[cell + 1]; ++q) {
-        const std::uint32_t j = order[q];
+      const std::size_t cell = coverageIndex(c);
+      for (std::uint32_t j = cellStart_[cell]; j < cellStart_[cell + 1]; ++j) {  // particles are in cell order
         const Vec<D> rel = x - position_[j];
         const double dist = rel.norm() * invL0;
         if (dist >= 1.0) continue;

@@ -64,6 +64,8 @@ class NoiseParticles {
  private:
   void refill(std::uint64_t step);
   bool inFluid(const Vec<D>& x) const;
+  IVec<D> coverageCoord(const Vec<D>& x) const;      // the coverage cell holding x (clamped)
+  std::size_t coverageIndex(const IVec<D>& c) const;  // x fastest
 
   GridSpec<D> coarse_;
   double l0_;
@@ -76,6 +78,14 @@ class NoiseParticles {
   std::vector<std::array<double, kMaxOctaves>> time_;
   std::uint64_t steps_ = 0;
   std::vector<Vecf<3>> psi_;  // synthesis scratch: the potential at the fine nodes
+  // The particles are kept in coverage-cell order (refill sorts them): cell c holds
+  // [cellStart_[c], cellStart_[c + 1]), which the synthesis's neighbour search reads.
+  std::vector<std::uint32_t> cellStart_;
+  // refill's scratch, reused from step to step: the old particles by cell (stable counting sort)
+  // and the arrays being built.
+  std::vector<std::uint32_t> oldCell_, oldStart_, oldOrder_;
+  std::vector<Vec<D>> nextPosition_, nextOffset_;
+  std::vector<std::array<double, kMaxOctaves>> nextTime_;
 };
 
 extern template class NoiseParticles<2>;

@@ -26,7 +26,8 @@ GasSolver<D>::GasSolver(const GridSpec<D>& spec, const GasParams& params, const 
       density_(spec, 0.0f),
       temperature_(spec, static_cast<float>(params.ambientTemperature)),
       transport_(spec, boundaries),
-      steadyVelocity_(spec) {
+      steadyVelocity_(spec),
+      windyVelocity_(spec) {
   // The motion field sampled on the cell faces, once: it is steady. 2D scenes live in the z = 0
   // plane of the 3D field.
   for (int a = 0; a < D; ++a) {
@@ -52,12 +53,12 @@ void GasSolver<D>::setTime(double time) {
 
 template <int D>
 void GasSolver<D>::refreshVelocity() {
-  MacGrid<D> velocity = steadyVelocity_;
+  windyVelocity_ = steadyVelocity_;  // copied into the same storage every step
   for (int a = 0; a < D; ++a) {
-    auto& u = velocity.component(a);
+    auto& u = windyVelocity_.component(a);
     for (const auto& w : winds_) w.forEachSample(u, a, time_, [&](std::size_t lin, float v) { u[lin] += v; });
   }
-  transport_.setVelocity(velocity);
+  transport_.setVelocity(windyVelocity_);
 }
 
 template <int D>

@@ -89,6 +89,7 @@ class GasSolver {
   numerics::FluxTransport<D> transport_;
   std::vector<GasSource> sources_;
   MacGrid<D> steadyVelocity_;  // the motion field on the faces
+  MacGrid<D> windyVelocity_;   // steady field + winds at the current time (scratch)
   std::vector<turbulence::TurbulentWind<D>> winds_;
   double time_ = 0.0;
 };

@@ -113,7 +113,7 @@ void SmokeTurbulence<D>::markBand(const MacGrid<D>& velocity, double dt, const G
 }
 
 template <int D>
-void SmokeTurbulence<D>::fineVelocity(const MacGrid<D>& velocity) {
+void SmokeTurbulence<D>::updateAdvectingVelocity(const MacGrid<D>& velocity) {
   for (int a = 0; a < D; ++a) {
     auto& w = advecting_.component(a);
     const auto& t = turbulent_.component(a);
@@ -123,9 +123,17 @@ void SmokeTurbulence<D>::fineVelocity(const MacGrid<D>& velocity) {
 }
 
 template <int D>
+void SmokeTurbulence<D>::addSource(SmokeSource<D> source) {
+  if (!source.scalars.empty())
+    throw std::invalid_argument("SmokeTurbulence: fine-grid sources carry density and temperature only");
+  sources_.push_back(std::move(source));
+}
+
+template <int D>
 void SmokeTurbulence<D>::applySources(double dt) {
-  for (const auto& src : sources_)
-    applySourceScalars<D>(src, dt, density_, temperature_, [&](std::size_t) -> Grid<float, D>& { return density_; });
+  // addSource refused extra scalars, so the accessor is never called.
+  auto noScalars = [&](std::size_t) -> Grid<float, D>& { throw std::logic_error("SmokeTurbulence: no extra scalars"); };
+  for (const auto& src : sources_) applySourceScalars<D>(src, dt, density_, temperature_, noScalars);
 }
 
 template <int D>
@@ -185,7 +193,7 @@ void SmokeTurbulence<D>::step(const MacGrid<D>& velocity, double dt, Grid<float,
   markBand(velocity, dt, coarseDensity);
   particles_->synthesize(energy_, turbulent_, &nodeMask_);
   applySources(dt);
-  fineVelocity(velocity);
+  updateAdvectingVelocity(velocity);
   advector_.advect(density_, advecting_, dt);
   advector_.advect(temperature_, advecting_, dt);
   downsample(coarseDensity, coarseTemperature);

@@ -43,9 +43,10 @@ class SmokeTurbulence {
                   const numerics::AdvectionSettings& advection, const Grid<float, D>* coarseSolid,
                   double ambientTemperature);
 
-  // A source on the fine grid (cells of fineSpec()); only its scalars are used (inflow velocities
-  // act on the coarse solver).
-  void addSource(SmokeSource<D> source) { sources_.push_back(std::move(source)); }
+  // A source on the fine grid (cells of fineSpec()): its density and temperature (inflow velocities
+  // act on the coarse solver). std::invalid_argument if it carries extra scalars (fuel): they live
+  // on the simulation grid.
+  void addSource(SmokeSource<D> source);
   SmokeSource<D>& source(std::size_t i) { return sources_[i]; }
 
   // Steps 1-5 above; coarseDensity and coarseTemperature receive the averaged fine scalars.
@@ -79,7 +80,7 @@ class SmokeTurbulence {
  private:
   void applySolid(const Grid<float, D>& coarseSolid);
   void markBand(const MacGrid<D>& velocity, double dt, const Grid<float, D>& coarseDensity);
-  void fineVelocity(const MacGrid<D>& velocity);
+  void updateAdvectingVelocity(const MacGrid<D>& velocity);
   void applySources(double dt);
   void averageTurbulenceToCoarse();
 
