@@ -35,8 +35,7 @@ std::vector<Vecf<D>> octaves(const NoiseTile<D>& tile, int m, int count, MacGrid
     for (int i = 0; i < count; ++i) {
       const double l = 0.25 / std::ldexp(1.0, i);
       const double amplitude = std::sqrt(std::pow(2.0, -2.0 * i / 3.0)) * l;  // E_0 = 1
-      for (int c = 0; c < (D == 3 ? 3 : 1); ++c)
-        psi[a][c] += static_cast<float>(amplitude * tile.component(c, x / l, 0.3));
+      psi[a] += static_cast<float>(amplitude) * tile.vector(x / l, 0.3);
     }
   }, 1024);
   u = MacGrid<D>(spec);

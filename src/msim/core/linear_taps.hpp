@@ -37,21 +37,26 @@ inline LinearTap clampedTap(double s, int n, std::size_t stride) {
                    static_cast<float>(c - lo)};
 }
 
-// sum over the corners of prod_axes (fraction or 1 - fraction) * data[sum of offsets].
-template <int N, typename T>
-T blendCorners(const std::array<LinearTap, N>& taps, const T* data) {
-  T sum = data[0] * 0.0f;
-  for (int corner = 0; corner < (1 << N); ++corner) {
-    std::size_t index = 0;
-    float w = 1.0f;
-    for (int d = 0; d < N; ++d) {
-      const bool up = (corner >> d) & 1;
-      index += up ? taps[d].upper : taps[d].lower;
-      w *= up ? taps[d].fraction : 1.0f - taps[d].fraction;
-    }
-    sum += w * data[index];
+namespace detail {
+// Axes 0 .. A blended below the sample at offset `base`: a tree of lerps (the 2^N corners read
+// once each, independent chains instead of one running sum).
+template <int A, int N, typename T>
+[[gnu::always_inline]] inline T blendBelow(const std::array<LinearTap, N>& taps, const T* data, std::size_t base) {
+  if constexpr (A < 0) {
+    return data[base];
+  } else {
+    const T lower = blendBelow<A - 1, N>(taps, data, base + taps[A].lower);
+    const T upper = blendBelow<A - 1, N>(taps, data, base + taps[A].upper);
+    return lower + taps[A].fraction * (upper - lower);
   }
-  return sum;
+}
+}  // namespace detail
+
+// sum over the corners of prod_axes (fraction or 1 - fraction) * data[sum of offsets], evaluated as
+// nested lerps, axis 0 innermost.
+template <int N, typename T>
+[[gnu::always_inline]] inline T blendCorners(const std::array<LinearTap, N>& taps, const T* data) {
+  return detail::blendBelow<N - 1, N>(taps, data, 0);
 }
 
 }  // namespace msim

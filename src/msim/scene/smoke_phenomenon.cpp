@@ -140,7 +140,7 @@ class SmokePhenomenon final : public Phenomenon {
     for (std::size_t i = 0; i < solver_.scalarCount(); ++i) writer.addFloatGrid(solver_.scalarName(i), solver_.scalar(i));
     if constexpr (D == 3) {
       if (turbulence_ && turbulence_->params().writeVelocity)
-        writer.addVectorGrid("vel", turbulence_->fineVelocity());
+        writer.addVectorGrid("vel", turbulence_->fineVelocity(solver_.velocity()));
       else
         writer.addVectorGrid("vel", solver_.velocity());
     }

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <cmath>
 #include <complex>
+#include <algorithm>
 #include <numbers>
 
 #include "msim/core/linear_taps.hpp"
@@ -32,21 +33,37 @@ NoiseTile<D>::NoiseTile(std::uint64_t seed) {
     const double f = s[D] / kPeriod;
     return std::pow(q, -0.5 * (D + 8.0 / 3.0)) * std::exp(-0.5 * f * f / (0.25 * 0.25));
   };
+  // The components are independent realisations, two per transform: a + i b with a and b real
+  // (their modes Hermitian) transforms to a real pair.
   const Rng noise(seed);
-  numerics::forEachMirrorPair(dims, [&](std::size_t a, std::size_t mirror, const auto& s) {
-    const double w = weight(s);
-    if (w == 0.0) return;
-    Rng r = noise.split(a);
-    const double size = r.normal();
-    const std::complex<float> c(std::polar(std::sqrt(w) * size, 2.0 * std::numbers::pi * r.uniform()));
-    modes[a] = c;
-    modes[mirror] = std::conj(c);
-  });
-  numerics::FftNd(dims).inverse(modes);
-  samples_.resize(n);
-  parallelFor(0, n, [&](std::size_t a) { samples_[a] = modes[a].real(); }, 1 << 14);
-  // Scale so that <|curl N|^2> = 2 for the noise as it is read: interpolated, its components at
-  // their offsets. Measured by central differences at 4096 random points and times.
+  if constexpr (D == 3) samples_.assign(n, Eigen::Array4f::Zero());
+  else samples_.assign(n, 0.0f);
+  for (int first = 0; first < kComponents; first += 2) {
+    std::fill(modes.begin(), modes.end(), std::complex<float>(0.0f, 0.0f));
+    for (int c = first; c < std::min(first + 2, kComponents); ++c) {
+      const std::complex<float> unit = c == first ? std::complex<float>(1.0f, 0.0f) : std::complex<float>(0.0f, 1.0f);
+      const Rng stream = noise.split(static_cast<std::uint64_t>(c));
+      numerics::forEachMirrorPair(dims, [&](std::size_t a, std::size_t mirror, const auto& s) {
+        const double w = weight(s);
+        if (w == 0.0) return;  // zero on every self-mirrored mode (the mean, the Nyquist planes)
+        Rng r = stream.split(a);
+        const double size = r.normal();
+        const std::complex<float> mode(std::polar(std::sqrt(w) * size, 2.0 * std::numbers::pi * r.uniform()));
+        modes[a] += unit * mode;
+        modes[mirror] += unit * std::conj(mode);
+      });
+    }
+    numerics::FftNd(dims).inverse(modes);
+    parallelFor(0, n, [&](std::size_t a) {
+      if constexpr (D == 3) {
+        samples_[a][first] = modes[a].real();
+        if (first + 1 < kComponents) samples_[a][first + 1] = modes[a].imag();
+      } else {
+        samples_[a] = modes[a].real();
+      }
+    }, 1 << 14);
+  }
+  // Scale so that <|curl N|^2> = 2 for the noise as it is read (interpolated). Measured by central differences at 4096 random points and times.
   Rng sampler(seed ^ 0x5bd1e995ull);
   const double h = 1e-3;
   double sum = 0.0;
@@ -57,12 +74,12 @@ NoiseTile<D>::NoiseTile(std::uint64_t seed) {
     const double t = sampler.uniform(0.0, kPeriod);
     // grad[c][d] = d N_c / d y_d
     double grad[3][3] = {};
-    for (int c = 0; c < (D == 3 ? 3 : 1); ++c)
-      for (int d = 0; d < D; ++d) {
-        Vec<D> e = Vec<D>::Zero();
-        e[d] = h;
-        grad[c][d] = (double(component(c, y + e, t)) - double(component(c, y - e, t))) / (2.0 * h);
-      }
+    for (int d = 0; d < D; ++d) {
+      Vec<D> e = Vec<D>::Zero();
+      e[d] = h;
+      const Vecf<3> difference = vector(y + e, t) - vector(y - e, t);
+      for (int c = 0; c < kComponents; ++c) grad[c][d] = double(difference[c]) / (2.0 * h);
+    }
     if constexpr (D == 3) {
       const double cx = grad[2][1] - grad[1][2], cy = grad[0][2] - grad[2][0], cz = grad[1][0] - grad[0][1];
       sum += cx * cx + cy * cy + cz * cz;
@@ -71,28 +88,38 @@ NoiseTile<D>::NoiseTile(std::uint64_t seed) {
     }
   }
   const float scale = static_cast<float>(std::sqrt(2.0 / (sum / points)));
-  for (float& v : samples_) v *= scale;
+  for (Sample& v : samples_) v *= scale;
 }
 
 template <int D>
-float NoiseTile<D>::value(const Vec<D>& y, double t) const {
-  std::array<LinearTap, D + 1> taps;
-  std::size_t stride = 1;
-  for (int d = 0; d < D; ++d) {
-    taps[d] = periodicTap(y[d] * (kSamples / kSide), kSamples, stride);
+LinearTap NoiseTile<D>::timeTap(double t) const {
+  std::size_t slice = 1;
+  for (int d = 0; d < D; ++d) slice *= static_cast<std::size_t>(kSamples);
+  return periodicTap(t * (kTimeSamples / kPeriod), kTimeSamples, slice);
+}
+
+template <int D>
+typename NoiseTile<D>::Row NoiseTile<D>::row(const Vec<D>& y, const LinearTap& time) const {
+  std::array<LinearTap, D> taps;  // axes 1 .. D - 1, then time
+  std::size_t stride = kSamples;
+  for (int d = 1; d < D; ++d) {
+    taps[d - 1] = periodicTap(y[d] * (kSamples / kSide), kSamples, stride);
     stride *= static_cast<std::size_t>(kSamples);
   }
-  taps[D] = periodicTap(t * (kTimeSamples / kPeriod), kTimeSamples, stride);
-  return blendCorners<D + 1>(taps, samples_.data());
-}
-
-template <int D>
-float NoiseTile<D>::component(int c, const Vec<D>& y, double t) const {
-  // Offsets far apart compared with the noise's correlation length (about half a unit).
-  static constexpr double kOffset[3][3] = {{0.0, 0.0, 0.0}, {1.37, 2.19, 0.83}, {2.61, 0.71, 1.93}};
-  Vec<D> shifted = y;
-  for (int d = 0; d < D; ++d) shifted[d] += kOffset[c][d];
-  return value(shifted, t + 2.7 * c);
+  taps[D - 1] = time;
+  Row r;
+  for (int corner = 0; corner < kRowCorners; ++corner) {
+    std::size_t offset = 0;
+    float w = 1.0f;
+    for (int a = 0; a < D; ++a) {
+      const bool up = (corner >> a) & 1;
+      offset += up ? taps[a].upper : taps[a].lower;
+      w *= up ? taps[a].fraction : 1.0f - taps[a].fraction;
+    }
+    r.offset[corner] = offset;
+    r.weight[corner] = w;
+  }
+  return r;
 }
 
 template <int D>

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "msim/core/interpolation.hpp"
 #include "msim/core/parallel.hpp"
 #include "msim/core/rng.hpp"
@@ -147,66 +150,102 @@ template <int D>
 void NoiseParticles<D>::synthesize(const TurbulentEnergy<D>& energy, MacGrid<D>& turbulent,
                                    const std::vector<std::uint8_t>* nodeMask) {
   const GridSpec<D>& fine = turbulent.component(0).spec();
-  // Per particle and octave: amplitude A_i = sqrt(E_i) l_i.
+  // Per particle and octave: amplitude A_i = sqrt(E_i) l_i and the noise's time tap.
   const std::size_t n = position_.size();
-  std::vector<std::array<float, kMaxOctaves>> amplitude(n);
+  amplitude_.resize(n);
+  timeTap_.resize(n);
   parallelFor(0, n, [&](std::size_t j) {
     const double e0 = std::max(0.0f, sampleLinear<D>(energy.energy(), position_[j]));
     for (int i = 0; i < octaves_; ++i) {
       const double l = l0_ / std::ldexp(1.0, i);
-      amplitude[j][i] = static_cast<float>(std::sqrt(energy.octaveEnergy(e0, i)) * l);
+      amplitude_[j][i] = static_cast<float>(std::sqrt(energy.octaveEnergy(e0, i)) * l);
+      timeTap_[j][i] = tile_.timeTap(time_[j][i]);
     }
   }, 1024);
   const IVec<D> nodes = fine.res + IVec<D>::Ones();
-  std::size_t nodeCount = 1;
+  std::size_t nodeCount = 1, rows = 1;
   for (int d = 0; d < D; ++d) nodeCount *= static_cast<std::size_t>(nodes[d]);
+  for (int d = 1; d < D; ++d) rows *= static_cast<std::size_t>(nodes[d]);
   psi_.resize(nodeCount);
-  std::vector<Vecf<3>>& psi = psi_;
-  constexpr int kComponents = D == 3 ? 3 : 1;
-  const double invL0 = 1.0 / l0_;
-  parallelFor(0, nodeCount, [&](std::size_t a) {
-    psi[a].setZero();
-    if (nodeMask && !(*nodeMask)[a]) return;
-    Vec<D> x;
-    std::size_t rest = a;
-    for (int d = 0; d < D; ++d) {
-      x[d] = fine.origin[d] + static_cast<double>(rest % nodes[d]) * fine.dx;
-      rest /= nodes[d];
-    }
-    const IVec<D> home = coverageCoord(x);
-    double acc[3] = {0.0, 0.0, 0.0}, weights = 0.0;
-    for (int k = 0; k < (D == 3 ? 27 : 9); ++k) {
-      IVec<D> c = home;
-      int r = k;
-      bool inside = true;
-      for (int d = 0; d < D; ++d) {
-        c[d] += r % 3 - 1;
-        r /= 3;
-        inside &= c[d] >= 0 && c[d] < cells_[d];
+  const int rowLength = nodes[0];
+  const double invL0 = 1.0 / l0_, h = fine.dx;
+  // Row by row of nodes along x: a particle within l_0 of the row covers a run of its nodes, over
+  // which the noise's rows (the other axes and time) stay fixed, so only the x tap varies.
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows, 8), [&](const tbb::blocked_range<std::size_t>& range) {
+    std::vector<Vecf<3>> acc(static_cast<std::size_t>(rowLength));
+    std::vector<float> weights(static_cast<std::size_t>(rowLength)), rho(static_cast<std::size_t>(rowLength));
+    for (std::size_t rowIndex = range.begin(); rowIndex != range.end(); ++rowIndex) {
+      Vecf<3>* psiRow = psi_.data() + rowIndex * static_cast<std::size_t>(rowLength);
+      const std::uint8_t* maskRow = nodeMask ? nodeMask->data() + rowIndex * static_cast<std::size_t>(rowLength) : nullptr;
+      std::fill(psiRow, psiRow + rowLength, Vecf<3>::Zero());
+      // The marked nodes' extent along the row (every node without a mask).
+      int markedFirst = 0, markedEnd = rowLength;
+      if (maskRow) {
+        while (markedFirst < rowLength && !maskRow[markedFirst]) ++markedFirst;
+        while (markedEnd > markedFirst && !maskRow[markedEnd - 1]) --markedEnd;
       }
-      if (!inside) continue;
-      const std::size_t cell = coverageIndex(c);
-      for (std::uint32_t j = cellStart_[cell]; j < cellStart_[cell + 1]; ++j) {  // particles are in cell order
-        const Vec<D> rel = x - position_[j];
-        const double dist = rel.norm() * invL0;
-        if (dist >= 1.0) continue;
-        const double rho = 1.0 - dist * dist * (3.0 - 2.0 * dist);
-        weights += rho * rho;
-        for (int i = 0; i < octaves_; ++i) {
-          if (amplitude[j][i] == 0.0f) continue;
-          const double scale = std::ldexp(invL0, i);  // 1 / l_i
-          const Vec<D> y = offset_[j] + rel * scale;
-          const double w = rho * amplitude[j][i];
-          for (int comp = 0; comp < kComponents; ++comp) acc[comp] += w * tile_.component(comp, y, time_[j][i]);
+      if (markedFirst == markedEnd) continue;
+      // The row's position across x, and the coverage cells within l_0 of it.
+      Vec<D> across = Vec<D>::Zero();
+      IVec<D> lowCell = IVec<D>::Zero(), highCell = IVec<D>::Zero();
+      std::size_t rest = rowIndex;
+      for (int d = 1; d < D; ++d) {
+        across[d] = fine.origin[d] + static_cast<double>(rest % nodes[d]) * h;
+        rest /= nodes[d];
+        const int home = coverageCoord(across)[d];
+        lowCell[d] = std::max(0, home - 1);
+        highCell[d] = std::min(cells_[d] - 1, home + 1);
+      }
+      highCell[0] = cells_[0] - 1;
+      std::fill(acc.begin(), acc.end(), Vecf<3>::Zero());
+      std::fill(weights.begin(), weights.end(), 0.0f);
+      // Particles are in coverage-cell order with x fastest: each line of cells along x is one run.
+      IVec<D> line = lowCell;
+      while (true) {
+        IVec<D> last = line;
+        last[0] = highCell[0];
+        for (std::uint32_t j = cellStart_[coverageIndex(line)]; j < cellStart_[coverageIndex(last) + 1]; ++j) {
+          const Vec<D>& p = position_[j];
+          double crossSquared = 0.0;
+          for (int d = 1; d < D; ++d) crossSquared += (across[d] - p[d]) * (across[d] - p[d]);
+          crossSquared *= invL0 * invL0;
+          if (crossSquared >= 1.0) continue;
+          const double halfWidth = l0_ * std::sqrt(1.0 - crossSquared);
+          const int first = std::max(markedFirst, static_cast<int>(std::ceil((p[0] - halfWidth - fine.origin[0]) / h)));
+          const int end = std::min(markedEnd, static_cast<int>(std::floor((p[0] + halfWidth - fine.origin[0]) / h)) + 1);
+          if (first >= end) continue;
+          for (int i = first; i < end; ++i) {
+            const double dx = (fine.origin[0] + i * h - p[0]) * invL0;
+            const double dist = std::sqrt(std::min(1.0, dx * dx + crossSquared));
+            const float r = static_cast<float>(1.0 - dist * dist * (3.0 - 2.0 * dist));
+            rho[static_cast<std::size_t>(i)] = r;
+            weights[static_cast<std::size_t>(i)] += r * r;
+          }
+          for (int o = 0; o < octaves_; ++o) {
+            if (amplitude_[j][o] == 0.0f) continue;
+            const double scale = std::ldexp(invL0, o);  // 1 / l_o
+            const Vec<D> y = offset_[j] + (across - p) * scale;  // x handled per node below
+            const typename NoiseTile<D>::Row noiseRow = tile_.row(y, timeTap_[j][o]);
+            const double x0 = offset_[j][0] + (fine.origin[0] - p[0]) * scale, step = h * scale;
+            const float amplitude = amplitude_[j][o];
+            for (int i = first; i < end; ++i)
+              acc[static_cast<std::size_t>(i)] += (rho[static_cast<std::size_t>(i)] * amplitude) * tile_.onRow(noiseRow, x0 + i * step);
+          }
         }
+        int d = 1;
+        for (; d < D; ++d) {
+          if (++line[d] <= highCell[d]) break;
+          line[d] = lowCell[d];
+        }
+        if (d == D) break;
+      }
+      for (int i = 0; i < rowLength; ++i) {
+        if (weights[static_cast<std::size_t>(i)] > 0.0f && (!maskRow || maskRow[i]))
+          psiRow[i] = acc[static_cast<std::size_t>(i)] / std::sqrt(weights[static_cast<std::size_t>(i)]);
       }
     }
-    if (weights > 0.0) {
-      const double norm = 1.0 / std::sqrt(weights);
-      for (int comp = 0; comp < kComponents; ++comp) psi[a][comp] = static_cast<float>(acc[comp] * norm);
-    }
-  }, 256);
-  curlOfNodalPotential<D>(fine, psi, turbulent);
+  });
+  curlOfNodalPotential<D>(fine, psi_, turbulent);
 }
 
 template class NoiseParticles<2>;

@@ -77,7 +77,11 @@ class NoiseParticles {
   std::vector<Vec<D>> position_, offset_;
   std::vector<std::array<double, kMaxOctaves>> time_;
   std::uint64_t steps_ = 0;
-  std::vector<Vecf<3>> psi_;  // synthesis scratch: the potential at the fine nodes
+  // synthesis scratch: per particle and octave the amplitude and the noise's time tap; the
+  // potential at the fine nodes
+  std::vector<std::array<float, kMaxOctaves>> amplitude_;
+  std::vector<std::array<LinearTap, kMaxOctaves>> timeTap_;
+  std::vector<Vecf<3>> psi_;
   // The particles are kept in coverage-cell order (refill sorts them): cell c holds
   // [cellStart_[c], cellStart_[c + 1]), which the synthesis's neighbour search reads.
   std::vector<std::uint32_t> cellStart_;

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
+#include "msim/core/grid_window.hpp"
 #include "msim/core/resample.hpp"
 #include "msim/core/parallel.hpp"
 
@@ -26,15 +28,15 @@ SmokeTurbulence<D>::SmokeTurbulence(const GridSpec<D>& coarse, const SmokeTurbul
     : coarse_(coarse),
       fine_(refined(coarse, params.refinement)),
       params_(params),
+      advection_(advection),
+      ambientTemperature_(ambientTemperature),
       coarseSolid_(coarse, 0.0f),
       fineSolid_(fine_, 0.0f),
       density_(fine_, 0.0f),
       temperature_(fine_, static_cast<float>(ambientTemperature)),
       turbulent_(fine_),
-      advecting_(fine_),
       coarseTurbulent_(coarse),
-      energy_(coarse, params.energy),
-      advector_(fine_, advection) {
+      energy_(coarse, params.energy) {
   if (coarseSolid) applySolid(*coarseSolid);
   reseedParticles();
 }
@@ -46,7 +48,7 @@ void SmokeTurbulence<D>::applySolid(const Grid<float, D>& coarseSolid) {
   const int r = params_.refinement;
   parallelForCells<D>(fine_.res, [&](const IVec<D>& c, std::size_t lin) { fineSolid_[lin] = coarseSolid_(IVec<D>(c / r)); });
   energy_.setSolid(coarseSolid_);
-  advector_.setSolid(fineSolid_);
+  windowSolidStale_ = true;
   // Smoke does not live inside solids.
   parallelFor(0, density_.count(), [&](std::size_t i) {
     if (fineSolid_[i] > 0.5f) density_[i] = 0.0f;
@@ -66,8 +68,10 @@ void SmokeTurbulence<D>::reseedParticles() {
 }
 
 template <int D>
-void SmokeTurbulence<D>::markBand(const MacGrid<D>& velocity, double dt, const Grid<float, D>& coarseDensity) {
-  // Coarse cells with smoke, grown by one cell and by the cells the fastest face crosses in a step.
+void SmokeTurbulence<D>::markBand(const MacGrid<D>& velocity, double dt, const Grid<float, D>& coarseDensity,
+                                  const Grid<float, D>& coarseTemperature) {
+  // Coarse cells with smoke or heat, grown by one cell and by the cells the fastest face crosses in
+  // a step.
   double fastest = 0.0;
   for (int a = 0; a < D; ++a) {
     const auto& u = velocity.component(a);
@@ -76,8 +80,13 @@ void SmokeTurbulence<D>::markBand(const MacGrid<D>& velocity, double dt, const G
   const int grow = 1 + static_cast<int>(std::ceil(fastest * dt / coarse_.dx));
   const std::size_t cells = coarseDensity.count();
   coarseBand_.assign(cells, 0);
-  parallelFor(0, cells, [&](std::size_t i) { coarseBand_[i] = coarseDensity[i] > params_.smokeThreshold ? 1 : 0; }, 4096);
-  std::vector<std::uint8_t> next(cells);
+  constexpr double kHeatTolerance = 0.01;  // [K] warmer or cooler than ambient: heat the flow carries
+  parallelFor(0, cells, [&](std::size_t i) {
+    coarseBand_[i] = coarseDensity[i] > params_.smokeThreshold ||
+                     std::abs(coarseTemperature[i] - ambientTemperature_) > kHeatTolerance;
+  }, 4096);
+  std::vector<std::uint8_t>& next = bandScratch_;
+  next.resize(cells);
   for (int a = 0; a < D; ++a) {
     parallelForCells<D>(coarse_.res, [&](const IVec<D>& c, std::size_t lin) {
       std::uint8_t any = 0;
@@ -91,35 +100,103 @@ void SmokeTurbulence<D>::markBand(const MacGrid<D>& velocity, double dt, const G
     });
     coarseBand_.swap(next);
   }
+  // Their bounding box, rounded out to whole blocks of kBoxBlock cells so the advection window
+  // changes only every few steps as the smoke spreads.
+  constexpr int kBoxBlock = 4;
+  IVec<D> lo = coarse_.res, hi = IVec<D>::Zero();
+  for (std::size_t i = 0; i < cells; ++i) {
+    if (!coarseBand_[i]) continue;
+    const IVec<D> c = coarseDensity.coord(i);
+    lo = lo.cwiseMin(c);
+    hi = hi.cwiseMax(c + IVec<D>::Ones());
+  }
+  bandLo_ = bandHi_ = IVec<D>::Zero();
+  if ((hi.array() > lo.array()).all()) {
+    for (int d = 0; d < D; ++d) {
+      bandLo_[d] = lo[d] / kBoxBlock * kBoxBlock;
+      bandHi_[d] = std::min(coarse_.res[d], (hi[d] + kBoxBlock - 1) / kBoxBlock * kBoxBlock);
+    }
+  }
   // Fine nodes of the marked coarse cells (a node belongs to the cell it is the lower corner of,
   // clamped at the upper walls).
   const IVec<D> nodes = fine_.res + IVec<D>::Ones();
   std::size_t nodeCount = 1;
   for (int d = 0; d < D; ++d) nodeCount *= static_cast<std::size_t>(nodes[d]);
-  nodeMask_.assign(nodeCount, 0);
+  nodeMask_.resize(nodeCount);
   const int r = params_.refinement;
-  const double marked = parallelSum(nodeCount, [&](std::size_t a) {
-    std::size_t rest = a, cell = 0, stride = 1;
-    for (int d = 0; d < D; ++d) {
-      const int n = static_cast<int>(rest % nodes[d]);
-      rest /= nodes[d];
-      cell += static_cast<std::size_t>(std::min(n / r, coarse_.res[d] - 1)) * stride;
-      stride *= static_cast<std::size_t>(coarse_.res[d]);
+  std::size_t rows = 1;
+  for (int d = 1; d < D; ++d) rows *= static_cast<std::size_t>(nodes[d]);
+  const double marked = parallelSum(rows, [&](std::size_t row) {
+    std::size_t coarseRow = 0, rest = row, coarseStride = 1;
+    for (int d = 1; d < D; ++d) {
+      const int n = static_cast<int>(rest % static_cast<std::size_t>(nodes[d]));
+      rest /= static_cast<std::size_t>(nodes[d]);
+      coarseStride *= static_cast<std::size_t>(coarse_.res[d - 1]);
+      coarseRow += static_cast<std::size_t>(std::min(n / r, coarse_.res[d] - 1)) * coarseStride;
     }
-    nodeMask_[a] = coarseBand_[cell];
-    return double(nodeMask_[a]);
+    const std::uint8_t* band = coarseBand_.data() + coarseRow;
+    std::uint8_t* mask = nodeMask_.data() + row * static_cast<std::size_t>(nodes[0]);
+    int count = 0;
+    for (int x = 0; x < nodes[0]; ++x) count += mask[x] = band[std::min(x / r, coarse_.res[0] - 1)];
+    return double(count);
   });
   bandFraction_ = marked / static_cast<double>(nodeCount);
 }
 
 template <int D>
-void SmokeTurbulence<D>::updateAdvectingVelocity(const MacGrid<D>& velocity) {
+SmokeTurbulence<D>::Window::Window(const GridSpec<D>& fine, const IVec<D>& lo, const IVec<D>& size,
+                                   const numerics::AdvectionSettings& advection)
+    : lo(lo),
+      size(size),
+      density(GridSpec<D>(fine.origin + lo.template cast<double>() * fine.dx, fine.dx, size)),
+      temperature(density.spec()),
+      velocity(density.spec()),
+      advector(density.spec(), advection) {}
+
+template <int D>
+void SmokeTurbulence<D>::advectScalars(const MacGrid<D>& velocity, double dt) {
+  if (bandHi_ == bandLo_) return;  // no smoke or heat anywhere
+  const int r = params_.refinement;
+  const IVec<D> lo = bandLo_ * r, size = (bandHi_ - bandLo_) * r;
+  if (!window_ || window_->lo != lo || window_->size != size) {
+    window_.reset();
+    window_.emplace(fine_, lo, size, advection_);
+    windowSolidStale_ = hasSolid_;
+  }
+  Window& w = *window_;
+  auto copyIn = [](const float* big, float* window, std::size_t n) { std::copy(big, big + n, window); };
+  auto copyOut = [](float* big, const float* window, std::size_t n) { std::copy(window, window + n, big); };
+  auto addIn = [](const float* big, float* window, std::size_t n) {
+    for (std::size_t i = 0; i < n; ++i) window[i] += big[i];
+  };
+  if (windowSolidStale_) {
+    Grid<float, D> solid(w.density.spec());
+    forEachWindowRow<D>(std::as_const(fineSolid_), lo, solid, copyIn);
+    w.advector.setSolid(solid);
+    windowSolidStale_ = false;
+  }
+  forEachWindowRow<D>(std::as_const(density_), lo, w.density, copyIn);
+  forEachWindowRow<D>(std::as_const(temperature_), lo, w.temperature, copyIn);
   for (int a = 0; a < D; ++a) {
-    auto& w = advecting_.component(a);
+    resampleLinear<D>(velocity.component(a), w.velocity.component(a));
+    forEachWindowRow<D>(std::as_const(turbulent_.component(a)), lo, w.velocity.component(a), addIn);
+  }
+  w.advector.advect(w.density, w.velocity, dt);
+  w.advector.advect(w.temperature, w.velocity, dt);
+  forEachWindowRow<D>(density_, lo, std::as_const(w.density), copyOut);
+  forEachWindowRow<D>(temperature_, lo, std::as_const(w.temperature), copyOut);
+}
+
+template <int D>
+MacGrid<D> SmokeTurbulence<D>::fineVelocity(const MacGrid<D>& velocity) const {
+  MacGrid<D> out(fine_);
+  for (int a = 0; a < D; ++a) {
+    auto& w = out.component(a);
     const auto& t = turbulent_.component(a);
     resampleLinear<D>(velocity.component(a), w);
     parallelFor(0, w.count(), [&](std::size_t i) { w[i] += t[i]; }, 1 << 14);
   }
+  return out;
 }
 
 template <int D>
@@ -139,23 +216,8 @@ void SmokeTurbulence<D>::applySources(double dt) {
 template <int D>
 void SmokeTurbulence<D>::downsample(Grid<float, D>& coarseDensity, Grid<float, D>& coarseTemperature) const {
   const int r = params_.refinement;
-  int children = 1;
-  for (int d = 0; d < D; ++d) children *= r;
-  parallelForCells<D>(coarse_.res, [&](const IVec<D>& c, std::size_t lin) {
-    double rho = 0.0, temp = 0.0;
-    for (int k = 0; k < children; ++k) {
-      IVec<D> f = c * r;
-      int rest = k;
-      for (int d = 0; d < D; ++d) {
-        f[d] += rest % r;
-        rest /= r;
-      }
-      rho += density_(f);
-      temp += temperature_(f);
-    }
-    coarseDensity[lin] = static_cast<float>(rho / children);
-    coarseTemperature[lin] = static_cast<float>(temp / children);
-  });
+  blockAverage<D>(density_, coarseDensity, r, IVec<D>::Constant(r));
+  blockAverage<D>(temperature_, coarseTemperature, r, IVec<D>::Constant(r));
 }
 
 template <int D>
@@ -163,25 +225,10 @@ void SmokeTurbulence<D>::averageTurbulenceToCoarse() {
   // The coarse face's flux is the mean of the fine faces that tile it (r^(D-1) of them), so each
   // coarse cell's net flux is the sum of its fine cells' (zero) divergences.
   const int r = params_.refinement;
-  int faces = 1;
-  for (int d = 0; d < D - 1; ++d) faces *= r;
   for (int a = 0; a < D; ++a) {
-    auto& coarse = coarseTurbulent_.component(a);
-    const auto& fine = turbulent_.component(a);
-    parallelForCells<D>(coarse.size(), [&](const IVec<D>& c, std::size_t lin) {
-      double sum = 0.0;
-      for (int k = 0; k < faces; ++k) {
-        IVec<D> f = c * r;
-        int rest = k;
-        for (int d = 0; d < D; ++d) {
-          if (d == a) continue;
-          f[d] += rest % r;
-          rest /= r;
-        }
-        sum += fine(f);
-      }
-      coarse[lin] = static_cast<float>(sum / faces);
-    });
+    IVec<D> block = IVec<D>::Constant(r);
+    block[a] = 1;
+    blockAverage<D>(turbulent_.component(a), coarseTurbulent_.component(a), r, block);
   }
 }
 
@@ -190,12 +237,11 @@ void SmokeTurbulence<D>::step(const MacGrid<D>& velocity, double dt, Grid<float,
                               Grid<float, D>& coarseTemperature) {
   energy_.step(velocity, dt);
   particles_->advance(velocity, energy_, dt);
-  markBand(velocity, dt, coarseDensity);
-  particles_->synthesize(energy_, turbulent_, &nodeMask_);
   applySources(dt);
-  updateAdvectingVelocity(velocity);
-  advector_.advect(density_, advecting_, dt);
-  advector_.advect(temperature_, advecting_, dt);
+  downsample(coarseDensity, coarseTemperature);  // the band sees this step's sources
+  markBand(velocity, dt, coarseDensity, coarseTemperature);
+  particles_->synthesize(energy_, turbulent_, &nodeMask_);
+  advectScalars(velocity, dt);
   downsample(coarseDensity, coarseTemperature);
   averageTurbulenceToCoarse();
 }

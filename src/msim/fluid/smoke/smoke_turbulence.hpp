@@ -8,12 +8,15 @@
 //
 // One step (SmokeTurbulence::step, before the coarse solver's step):
 //   1. energy model (eq. 3.5) in U; 2. noise particles move with U, noise times advance;
-//   3. u' on the fine faces where there is smoke (the coarse cells whose smoke exceeds the
-//      threshold, grown by one cell and by the distance the flow carries it in a step);
-//   4. fine sources, then the fine scalars advected by U (interpolated) + u';
-//   5. the scalars averaged onto the coarse cells, u' onto the coarse faces (flux averages, so the
+//   3. fine sources; the active cells: coarse cells with smoke (more than the threshold) or heat,
+//      grown by one cell and by the distance the flow carries it in a step;
+//   4. u' on the fine faces of the active cells;
+//   5. the fine scalars advected by U (interpolated) + u' in a window round the active cells
+//      (fainter smoke outside it stays where it is);
+//   6. the scalars averaged onto the coarse cells, u' onto the coarse faces (flux averages, so the
 //      coarse u' stays divergence-free).
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "msim/core/grid.hpp"
@@ -59,7 +62,8 @@ class SmokeTurbulence {
   Grid<float, D>& temperature() { return temperature_; }
   const Grid<float, D>& temperature() const { return temperature_; }
   const MacGrid<D>& turbulentVelocity() const { return turbulent_; }       // u' on the fine faces
-  const MacGrid<D>& fineVelocity() const { return advecting_; }  // U (interpolated) + u' of the last step
+  // U interpolated onto the fine faces plus the last step's u' (for outputs).
+  MacGrid<D> fineVelocity(const MacGrid<D>& velocity) const;
   const MacGrid<D>& coarseTurbulentVelocity() const { return coarseTurbulent_; }  // u' on the coarse faces
   turbulence::TurbulentEnergy<D>& energy() { return energy_; }
   const turbulence::TurbulentEnergy<D>& energy() const { return energy_; }
@@ -78,22 +82,37 @@ class SmokeTurbulence {
   double bandFraction() const { return bandFraction_; }
 
  private:
+  // The fine grids' box being advected (fine cells from lo, `size` of them) and its own copies of
+  // the scalars and U + u', kept while the box stays the same.
+  struct Window {
+    Window(const GridSpec<D>& fine, const IVec<D>& lo, const IVec<D>& size, const numerics::AdvectionSettings& advection);
+    IVec<D> lo, size;
+    Grid<float, D> density, temperature;
+    MacGrid<D> velocity;
+    numerics::Advector<float, D> advector;
+  };
+
   void applySolid(const Grid<float, D>& coarseSolid);
-  void markBand(const MacGrid<D>& velocity, double dt, const Grid<float, D>& coarseDensity);
-  void updateAdvectingVelocity(const MacGrid<D>& velocity);
+  void markBand(const MacGrid<D>& velocity, double dt, const Grid<float, D>& coarseDensity,
+                const Grid<float, D>& coarseTemperature);
+  void advectScalars(const MacGrid<D>& velocity, double dt);
   void applySources(double dt);
   void averageTurbulenceToCoarse();
 
   GridSpec<D> coarse_, fine_;
   SmokeTurbulenceParams params_;
+  numerics::AdvectionSettings advection_;
+  double ambientTemperature_;
   Grid<float, D> coarseSolid_, fineSolid_;
   bool hasSolid_ = false;
   Grid<float, D> density_, temperature_;
-  MacGrid<D> turbulent_, advecting_, coarseTurbulent_;
-  std::vector<std::uint8_t> nodeMask_, coarseBand_;
+  MacGrid<D> turbulent_, coarseTurbulent_;
+  std::vector<std::uint8_t> nodeMask_, coarseBand_, bandScratch_;
+  IVec<D> bandLo_ = IVec<D>::Zero(), bandHi_ = IVec<D>::Zero();  // coarse cells, rounded out; empty when equal
   turbulence::TurbulentEnergy<D> energy_;
   std::unique_ptr<turbulence::NoiseParticles<D>> particles_;
-  numerics::Advector<float, D> advector_;
+  std::optional<Window> window_;
+  bool windowSolidStale_ = false;
   std::vector<SmokeSource<D>> sources_;
   double bandFraction_ = 0.0;
 };
