@@ -77,6 +77,12 @@ TEST(SmokeTurbulenceCli, SmokeLivesOnTheFineGridAndUnsupportedCombinationsAreRef
   EXPECT_EQ(fire.exitCode, 2) << fire.output;
   EXPECT_NE(fire.output.find("smoke.turbulence.enabled"), std::string::npos) << fire.output;
   EXPECT_FALSE(fs::exists(dir / "fire_out"));
+  // So is the conservative scalar transport: the fine smoke moves with the advection scheme.
+  const Result conservative = runMsim("run " + (dir / "s.json").string() +
+                                      " --set smoke.advection.scalars=conservative --out " + (dir / "cons_out").string());
+  EXPECT_EQ(conservative.exitCode, 2) << conservative.output;
+  EXPECT_NE(conservative.output.find("smoke.advection.scalars"), std::string::npos) << conservative.output;
+  EXPECT_FALSE(fs::exists(dir / "cons_out"));
 }
 
 TEST(SmokeTurbulenceCli, MovingObstacleKeepsTheFineSmokeOut) {

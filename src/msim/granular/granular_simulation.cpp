@@ -55,6 +55,8 @@ GranularSimulation::GranularSimulation(GranularSettings settings, std::vector<Gr
   if (!(settings_.cfl > 0.0)) throw std::invalid_argument("granular: cfl must be > 0");
   if (!(settings_.flipRatio >= 0.0 && settings_.flipRatio <= 1.0))
     throw std::invalid_argument("granular: flip_ratio must lie in [0, 1]");
+  if (!(settings_.airResponseTime > 0.0) || !std::isfinite(settings_.airResponseTime))
+    throw std::invalid_argument("granular: the air response time must be > 0");
   settings_.stress.upAxis = dominantAxis(settings_.gravity);
   stress_.settings() = settings_.stress;
   world_.addDomainBox(settings_.grid.origin, settings_.grid.upper());
@@ -265,6 +267,7 @@ void GranularSimulation::step(double dt) {
       if (state_.open.values[a][i] != 0.0 && state_.rhoFace.values[a][i] > 0.0)
         velocity.values[a][i] = v[i] + dt * settings_.gravity[a];
   }
+  if (!winds_.empty()) applyWinds(dt, velocity);
   stress_.solve(state_, dt, velocity, coupled);
   times_.pressure = stress_.stats().pressureSeconds;
   times_.friction = stress_.stats().frictionSeconds;
@@ -290,6 +293,23 @@ void GranularSimulation::step(double dt) {
                            settings_.splitMerge ? splitMerge_.successors() : std::span<const SplitMerge::Successors>{});
   }
   time_ += dt;
+}
+
+// Drag towards the winds, dv/dt = (1 - phi) (u_air - v) / tau, integrated exactly over the step
+// (stable for any dt / tau) on the faces that hold material, winds at the middle of the step.
+void GranularSimulation::applyWinds(double dt, FaceField& velocity) {
+  const double t = time_ + 0.5 * dt;
+  for (int a = 0; a < 3; ++a) {
+    const auto& faces = fields_.velocity.component(a);  // the face layout of component a
+    windScratch_.assign(faces.count(), 0.0f);
+    for (const auto& w : winds_) w.forEachSample(faces, a, t, [&](std::size_t lin, float u) { windScratch_[lin] += u; });
+    std::vector<double>& v = velocity.values[a];
+    parallelFor(0, v.size(), [&](std::size_t i) {
+      if (state_.open.values[a][i] == 0.0 || state_.rhoFace.values[a][i] <= 0.0) return;
+      const double open = 1.0 - std::clamp(state_.phiFace.values[a][i], 0.0, 1.0);
+      v[i] += (1.0 - std::exp(-open * dt / settings_.airResponseTime)) * (windScratch_[i] - v[i]);
+    }, 4096);
+  }
 }
 
 double GranularSimulation::totalMass() const {

@@ -4,7 +4,7 @@
 //   2. density correction (eq. 5.14);
 //   3. staggered friction / pressure projections (ch. 5.3.5, 5.5.1) with the bodies coupled
 //      (ch. 5.3.4);
-//   4. the intermediate velocity v~ (eq. 5.27);
+//   4. the intermediate velocity v~ (eq. 5.27); v* includes gravity and the drag of winds, if any;
 //   5. bodies take the impulse dt F of eq. 5.23 and move (rigid/World: gravity, contacts with the
 //      domain, each other and static solids);
 //   6. particles: FLIP velocities, advection with the correction displacement, shapes (eq. 5.42),
@@ -25,6 +25,7 @@
 #include "msim/granular/split_merge.hpp"
 #include "msim/granular/stress_solver.hpp"
 #include "msim/rigid/world.hpp"
+#include "msim/turbulence/turbulent_wind.hpp"
 
 namespace msim::granular {
 
@@ -39,6 +40,9 @@ struct GranularSettings {
   bool splitMerge = true;
   std::size_t renderPointsPerParticle = 0;  // 0: no render points
   bool coupleBodies = true;         // false: bodies move through the material (one-way tests)
+  // Response time of a free grain to the air [s] (winds, addWind): the drag (u_air - v) / tau per
+  // unit mass, Stokes drag tau = rho_grain d^2 / (18 mu_air) for fine grains (0.1 s: about 0.1 mm).
+  double airResponseTime = 0.1;
 };
 
 // Stage times of the last step [s] (the split of Table 5.1: pressure, friction, particles).
@@ -55,6 +59,11 @@ class GranularSimulation {
   // centre lies inside. Call before the first step.
   void addStaticSolid(std::shared_ptr<const geometry::Shape<3>> solid);
   rigid::World& world() { return world_; }
+  // A turbulent wind blowing through the material (several add up): grains feel the drag of
+  // settings.airResponseTime in proportion to the open volume around them, 1 - phi, so a dispersed
+  // cloud is carried along and a packed pile is not (the air cannot flow through it).
+  void addWind(turbulence::TurbulentWind<3> wind) { winds_.push_back(std::move(wind)); }
+  const std::vector<turbulence::TurbulentWind<3>>& winds() const { return winds_; }
   const rigid::World& world() const { return world_; }
 
   GranularParticles& particles() { return particles_; }
@@ -98,6 +107,7 @@ class GranularSimulation {
   void pushOutOfSolids();
   void removeVelocityAgainstCorrection();
   void initialiseRenderPoints();
+  void applyWinds(double dt, FaceField& velocity);
 
   GranularSettings settings_;
   std::vector<GranularMaterial> materials_;
@@ -118,6 +128,8 @@ class GranularSimulation {
   MacGrid<3> velocityNew_, displacement_;
   std::vector<Vecf<3>> correctionAt_;  // the correction displacement at each particle
   std::vector<ParticleMotion> motion_;  // each particle's last step, for its render points
+  std::vector<turbulence::TurbulentWind<3>> winds_;
+  std::vector<float> windScratch_;  // the summed winds on one face component
   GranularStepTimes times_;
   double time_ = 0.0;
 };

@@ -175,8 +175,7 @@ class GasPhenomenon final : public Phenomenon {
 
   // Each wind's spectrum against the prescribed one (winds/), and its measures in run.json.
   json finishRun(const std::filesystem::path& runDir, const json& /*frames*/) override {
-    const json winds = writeWindReports<D>(solver_.winds(), runDir);
-    return winds.empty() ? json::object() : json{{"winds", winds}};
+    return writeWindReports<D>(solver_.winds(), runDir);
   }
 
   json statistics() const override {

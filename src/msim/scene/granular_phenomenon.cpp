@@ -13,6 +13,7 @@
 #include "msim/scene/phenomenon_support.hpp"
 #include "msim/scene/runner.hpp"
 #include "msim/scene/scene_file.hpp"
+#include "msim/scene/turbulent_wind_report.hpp"
 
 namespace msim::scene {
 namespace {
@@ -99,6 +100,11 @@ class GranularPhenomenon final : public Phenomenon {
   }
 
   io::Image preview() const override { return preview_.render(sim_, setup_.colours, setup_.bodies); }
+
+  // Each wind's spectrum against the prescribed one (winds/), and its measures in run.json.
+  json finishRun(const fs::path& runDir, const json& /*frames*/) override {
+    return writeWindReports<3>(sim_.winds(), runDir);
+  }
 
   json statistics() const override {
     const granular::GranularParticles& p = sim_.particles();

@@ -13,6 +13,7 @@
 #include "msim/scene/scene_file.hpp"
 #include "msim/scene/schema/shape_schema.hpp"
 #include "msim/scene/schema/key_suggestion.hpp"
+#include "msim/scene/turbulent_wind_keys.hpp"
 
 namespace msim::scene {
 namespace {
@@ -45,6 +46,10 @@ Schema granularKeys() {
   g.integer("render_points_per_particle", 0, "render points per particle (ch. 5.6); 0 = none").min(0).max(256);
   g.number("max_step", "s", 0.01, "longest time step").min(0.0, Bound::Exclusive);
   g.integer("seed", 1, "jitter of the seeded particles").min(0);
+  g.number("air_response_time", "s", 0.1,
+           "response time tau of a free grain to the air of winds[]: drag (u_air - v) / tau scaled by the open volume "
+           "1 - phi (Stokes: tau = rho_grain d^2 / (18 mu_air), 0.1 s for grains of about 0.1 mm)")
+      .min(0.0, Bound::Exclusive);
   return g;
 }
 
@@ -116,6 +121,7 @@ struct Builder {
     s.stress.bilateral = g.at("bilateral").get<bool>();
     s.splitMerge = g.at("split_merge").get<bool>();
     s.renderPointsPerParticle = g.at("render_points_per_particle").get<std::size_t>();
+    s.airResponseTime = g.at("air_response_time").get<double>();
     out.maxStep = g.at("max_step").get<double>();
     std::vector<granular::GranularMaterial> materials;
     const json& list = r.at("materials");
@@ -244,6 +250,7 @@ void declareGranularKeys(Schema& root) {
   root.array("explosions", explosionSchema(), "instantaneous blasts");
   root.array("solids", solidSchema(), "static solids (a container is an 'inverted' one)");
   root.array("bodies", granularBodySchema(), "rigid bodies coupled with the material");
+  declareTurbulentWinds(root);
 }
 
 GranularSceneSetup buildGranularScene(const Scene& scene) {
@@ -257,6 +264,7 @@ GranularSceneSetup buildGranularScene(const Scene& scene) {
   }
   b.regions();
   b.explosions();
+  for (auto& wind : turbulentWinds<3>(scene)) b.out.sim->addWind(std::move(wind));
   return std::move(b.out);
 }
 

@@ -183,8 +183,7 @@ class SmokePhenomenon final : public Phenomenon {
 
   // Each wind's spectrum against the prescribed one (winds/), and its measures in run.json.
   json finishRun(const std::filesystem::path& runDir, const json& /*frames*/) override {
-    const json winds = writeWindReports<D>(solver_.winds(), runDir);
-    return winds.empty() ? json::object() : json{{"winds", winds}};
+    return writeWindReports<D>(solver_.winds(), runDir);
   }
 
   json statistics() const override {
@@ -240,6 +239,10 @@ class SmokePhenomenon final : public Phenomenon {
     if (combustion_)
       throw InputError(fmt::format("{}: 'smoke.turbulence.enabled' with 'fire.enabled' is not supported yet (the fuel "
                                    "and flame stay on the simulation grid)",
+                                   source_));
+    if (solver_.params().scalarTransport == fluid::ScalarTransport::Conservative)
+      throw InputError(fmt::format("{}: 'smoke.advection.scalars' = 'conservative' with 'smoke.turbulence.enabled' is "
+                                   "not supported (the smoke lives on the fine grid, moved by the advection scheme)",
                                    source_));
     turbulence_ = std::make_unique<fluid::SmokeTurbulence<D>>(
         solver_.spec(), smokeTurbulenceParams(r), solver_.params().advection,

@@ -21,7 +21,7 @@ using nlohmann::json;
 template <int D>
 json writeWindReports(std::span<const turbulence::TurbulentWind<D>> winds, const fs::path& runDir) {
   json out = json::array();
-  if (winds.empty()) return out;
+  if (winds.empty()) return json::object();
   for (std::size_t i = 0; i < winds.size(); ++i) {
     if (!winds[i].lattice()) {
       out.push_back({{"synthesis", "spatial"}});  // no lattice to measure
@@ -66,7 +66,7 @@ json writeWindReports(std::span<const turbulence::TurbulentWind<D>> winds, const
     }
     out.push_back(r);
   }
-  return out;
+  return json{{"winds", out}};
 }
 
 template json writeWindReports<2>(std::span<const turbulence::TurbulentWind<2>>, const fs::path&);

@@ -11,6 +11,8 @@
 
 namespace msim::scene {
 
+// Writes the reports and returns run.json's results: {"winds": [one object per wind]}, or an empty
+// object without winds.
 template <int D>
 nlohmann::json writeWindReports(std::span<const turbulence::TurbulentWind<D>> winds, const std::filesystem::path& runDir);
 
