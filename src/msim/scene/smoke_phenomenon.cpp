@@ -31,10 +31,11 @@ double smokeBytesPerCell(int dimensions, const json& resolved) {
   // (velocity, scalars, advection stages and traced feet, projection matrix, PCG and multigrid
   // vectors, confinement), the fire fields and the VDB and preview copies at frame time.
   double bytes = 360.0;
-  // Sub-grid turbulence keeps the smoke on refinement^D fine cells per cell: their scalars, the
-  // advector's stages and feet, u' and U + u' on the faces, the potential at the nodes, the band
-  // mask and the VDB copies: peak RSS 2.24 GB against 0.14 GB without, smoke_turbulence at 16.8M
-  // fine cells, so 128 bytes per fine cell.
+  // Sub-grid turbulence keeps the smoke on refinement^D fine cells per cell: their scalars, u' on
+  // the faces, the potential at the nodes, the band mask, the VDB copies, and in the advection
+  // window (at most the whole fine grid) copies of the scalars and U + u' with the advector's
+  // stages and feet: 130 bytes per fine cell when the window is the whole grid (smoke_turbulence
+  // at 1 s, window about a third: peak RSS 1.15 GB for 16.8M fine cells).
   const json& t = resolved.at("smoke").at("turbulence");
   if (t.at("enabled").get<bool>())
     bytes += std::pow(t.at("refinement").get<double>(), dimensions) * 130.0;
