@@ -172,8 +172,13 @@ void NoiseParticles<D>::synthesize(const TurbulentEnergy<D>& energy, MacGrid<D>&
   // Row by row of nodes along x: a particle within l_0 of the row covers a run of its nodes, over
   // which the noise's rows (the other axes and time) stay fixed, so only the x tap varies.
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows, 8), [&](const tbb::blocked_range<std::size_t>& range) {
-    std::vector<Vecf<3>> acc(static_cast<std::size_t>(rowLength));
-    std::vector<float> weights(static_cast<std::size_t>(rowLength)), rho(static_cast<std::size_t>(rowLength));
+    RowScratch& scratch = rowScratch_.local();  // kept per thread from step to step
+    scratch.acc.resize(static_cast<std::size_t>(rowLength));
+    scratch.weights.resize(static_cast<std::size_t>(rowLength));
+    scratch.rho.resize(static_cast<std::size_t>(rowLength));
+    std::vector<Vecf<3>>& acc = scratch.acc;
+    std::vector<float>& weights = scratch.weights;
+    std::vector<float>& rho = scratch.rho;
     for (std::size_t rowIndex = range.begin(); rowIndex != range.end(); ++rowIndex) {
       Vecf<3>* psiRow = psi_.data() + rowIndex * static_cast<std::size_t>(rowLength);
       const std::uint8_t* maskRow = nodeMask ? nodeMask->data() + rowIndex * static_cast<std::size_t>(rowLength) : nullptr;

@@ -22,6 +22,8 @@
 #include <optional>
 #include <vector>
 
+#include <tbb/enumerable_thread_specific.h>
+
 #include "msim/core/grid.hpp"
 #include "msim/core/mac_grid.hpp"
 #include "msim/turbulence/curl_noise.hpp"
@@ -82,6 +84,12 @@ class NoiseParticles {
   std::vector<std::array<float, kMaxOctaves>> amplitude_;
   std::vector<std::array<LinearTap, kMaxOctaves>> timeTap_;
   std::vector<Vecf<3>> psi_;
+  // Per thread: one row of nodes' blended noise, summed weights and falloffs.
+  struct RowScratch {
+    std::vector<Vecf<3>> acc;
+    std::vector<float> weights, rho;
+  };
+  tbb::enumerable_thread_specific<RowScratch> rowScratch_;
   // The particles are kept in coverage-cell order (refill sorts them): cell c holds
   // [cellStart_[c], cellStart_[c + 1]), which the synthesis's neighbour search reads.
   std::vector<std::uint32_t> cellStart_;

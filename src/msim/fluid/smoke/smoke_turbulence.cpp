@@ -166,9 +166,6 @@ void SmokeTurbulence<D>::advectScalars(const MacGrid<D>& velocity, double dt) {
   Window& w = *window_;
   auto copyIn = [](const float* big, float* window, std::size_t n) { std::copy(big, big + n, window); };
   auto copyOut = [](float* big, const float* window, std::size_t n) { std::copy(window, window + n, big); };
-  auto addIn = [](const float* big, float* window, std::size_t n) {
-    for (std::size_t i = 0; i < n; ++i) window[i] += big[i];
-  };
   if (windowSolidStale_) {
     Grid<float, D> solid(w.density.spec());
     forEachWindowRow<D>(std::as_const(fineSolid_), lo, solid, copyIn);
@@ -177,10 +174,7 @@ void SmokeTurbulence<D>::advectScalars(const MacGrid<D>& velocity, double dt) {
   }
   forEachWindowRow<D>(std::as_const(density_), lo, w.density, copyIn);
   forEachWindowRow<D>(std::as_const(temperature_), lo, w.temperature, copyIn);
-  for (int a = 0; a < D; ++a) {
-    resampleLinear<D>(velocity.component(a), w.velocity.component(a));
-    forEachWindowRow<D>(std::as_const(turbulent_.component(a)), lo, w.velocity.component(a), addIn);
-  }
+  advectingVelocity(velocity, lo, w.velocity);
   w.advector.advect(w.density, w.velocity, dt);
   w.advector.advect(w.temperature, w.velocity, dt);
   forEachWindowRow<D>(density_, lo, std::as_const(w.density), copyOut);
@@ -188,14 +182,20 @@ void SmokeTurbulence<D>::advectScalars(const MacGrid<D>& velocity, double dt) {
 }
 
 template <int D>
+void SmokeTurbulence<D>::advectingVelocity(const MacGrid<D>& velocity, const IVec<D>& lo, MacGrid<D>& out) const {
+  auto addIn = [](const float* big, float* window, std::size_t n) {
+    for (std::size_t i = 0; i < n; ++i) window[i] += big[i];
+  };
+  for (int a = 0; a < D; ++a) {
+    resampleLinear<D>(velocity.component(a), out.component(a));
+    forEachWindowRow<D>(turbulent_.component(a), lo, out.component(a), addIn);
+  }
+}
+
+template <int D>
 MacGrid<D> SmokeTurbulence<D>::fineVelocity(const MacGrid<D>& velocity) const {
   MacGrid<D> out(fine_);
-  for (int a = 0; a < D; ++a) {
-    auto& w = out.component(a);
-    const auto& t = turbulent_.component(a);
-    resampleLinear<D>(velocity.component(a), w);
-    parallelFor(0, w.count(), [&](std::size_t i) { w[i] += t[i]; }, 1 << 14);
-  }
+  advectingVelocity(velocity, IVec<D>::Zero(), out);
   return out;
 }
 

@@ -96,6 +96,8 @@ class SmokeTurbulence {
   void markBand(const MacGrid<D>& velocity, double dt, const Grid<float, D>& coarseDensity,
                 const Grid<float, D>& coarseTemperature);
   void advectScalars(const MacGrid<D>& velocity, double dt);
+  // U resampled onto the faces of `out` (the fine grid or a window of it from fine cell lo) plus u'.
+  void advectingVelocity(const MacGrid<D>& velocity, const IVec<D>& lo, MacGrid<D>& out) const;
   void applySources(double dt);
   void averageTurbulenceToCoarse();
 
