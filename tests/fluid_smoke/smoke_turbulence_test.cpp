@@ -33,7 +33,10 @@ TEST(SmokeTurbulence, CoarseTurbulenceIsDivergenceFreeAndScalarsAverage) {
   }
   Grid<float, 3> rho(coarse, 0.0f), temperature(coarse, 293.15f);
   rho.fill(1.0f);  // smoke everywhere: u' is synthesised over the whole grid
-  for (int s = 0; s < 3; ++s) turbulence.step(u, 0.02, rho, temperature);
+  for (int s = 0; s < 3; ++s) {
+    turbulence.applySources(0.02, rho, temperature);
+    turbulence.step(u, 0.02, rho, temperature);
+  }
   const auto& ut = turbulence.coarseTurbulentVelocity();
   double worst = 0.0, largest = 0.0;
   for (int k = 0; k < 16; ++k)

@@ -3,6 +3,7 @@
 // variance, periodic when tiled, and clear errors.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 
 #include "msim/core/error.hpp"
@@ -159,10 +160,10 @@ TEST(SparseConvolutionWind, PlacedAsAWindItIsCarriedByTheMeanAndSampledOnGrids) 
   const GridSpec<3> spec(Vec3::Zero(), 0.125, IVec3(8, 8, 8));
   const MacGrid<3> faces(spec);
   const auto& uy = faces.component(1);
-  int checked = 0;
+  std::atomic<int> checked = 0;  // the sampler runs in parallel
   wind.forEachSample(uy, 1, 0.4, [&](std::size_t lin, float v) {
     EXPECT_NEAR(v, wind.velocity(uy.position(uy.coord(lin)), 0.4).y(), 1e-6);
     ++checked;
   });
-  EXPECT_EQ(checked, static_cast<int>(uy.count()));
+  EXPECT_EQ(checked.load(), static_cast<int>(uy.count()));
 }

@@ -91,9 +91,9 @@ class SmokePhenomenon final : public Phenomenon {
       if (turbulence_) turbulence_->source(i).active = active;
     }
     if (turbulence_) {
-      // Sub-grid turbulence and the fine scalars, before the simulated flow moves on (ch. 3).
+      // The smoke and heat of the sources go into the fine grid; the step's buoyancy sees them.
       ScopedStage stage(timers_, "smoke: turbulence");
-      turbulence_->step(solver_.velocity(), dt, solver_.density(), solver_.temperature());
+      turbulence_->applySources(dt, solver_.density(), solver_.temperature());
     }
     if (obstacles_.moving()) {
       ScopedStage stage(timers_, "smoke: move obstacles");
@@ -106,6 +106,12 @@ class SmokePhenomenon final : public Phenomenon {
       } catch (const SimulationError& e) {
         throw SimulationError(fmt::format("t = {:.4g} s: {}", time_, e.what()));
       }
+    }
+    if (turbulence_) {
+      // Sub-grid turbulence, and the fine scalars carried by the new velocity plus the eddies
+      // (ch. 3.5.2), as the solver carries its own scalars after its projection.
+      ScopedStage stage(timers_, "smoke: turbulence");
+      turbulence_->step(solver_.velocity(), dt, solver_.density(), solver_.temperature());
     }
     if (combustion_) {
       ScopedStage stage(timers_, "fire: reactions");

@@ -67,7 +67,13 @@ Schema smokeKeys() {
   turbulence.number("largest_eddy", "m", 0.0, "l_0, size of the largest modelled eddies; 0 = four grid cells").min(0.0);
   turbulence.number("viscosity", "m^2/s", 1.5e-5, "nu: sets the viscous cutoff that turns turbulence off in calm flow")
       .min(0.0);
+  turbulence.number("eddy_viscosity_constant", "", 0.09,
+                    "C in the eddy viscosity nu_t = C l_0 sqrt(E_0) (eq. 3.6, 3.8): 0.09 = k-epsilon's C_mu; 1 = the seed")
+      .min(0.0, Bound::Exclusive);
   turbulence.number("initial_energy", "m^2/s^2", 1e-4, "E_0 at the start (production needs E_0 > 0)").min(0.0);
+  turbulence.number("intensity", "", 1.0,
+                    "scales the eddies' speed (1: the seed's calibration, eddies of speed sqrt(E_i) per octave)")
+      .min(0.0);
   turbulence.integer("octaves", 0, "noise octaves; 0 = down to two fine cells").min(0).max(8);
   turbulence.boolean("coupling", true, "the simulated flow is advected by itself plus the turbulence (ch. 3.5.2)");
   turbulence.number("smoke_threshold", "kg/m^3", 1e-4, "cells with less smoke (and not near smoke) get no eddies")
@@ -229,8 +235,10 @@ fluid::SmokeTurbulenceParams smokeTurbulenceParams(const json& resolved) {
   p.energy.largestEddy = t.at("largest_eddy").get<double>();
   p.energy.viscosity = t.at("viscosity").get<double>();
   p.energy.initialEnergy = t.at("initial_energy").get<double>();
+  p.energy.eddyViscosityConstant = t.at("eddy_viscosity_constant").get<double>();
   p.particles.octaves = t.at("octaves").get<int>();
   p.particles.seed = t.at("seed").get<std::uint64_t>();
+  p.particles.intensity = t.at("intensity").get<double>();
   p.coupling = t.at("coupling").get<bool>();
   p.smokeThreshold = t.at("smoke_threshold").get<double>();
   p.writeVelocity = t.at("write_velocity").get<bool>();

@@ -63,7 +63,7 @@ NoiseTile<D>::NoiseTile(std::uint64_t seed) {
       }
     }, 1 << 14);
   }
-  // Scale so that <|curl N|^2> = 2 for the noise as it is read (interpolated). Measured by central differences at 4096 random points and times.
+  // Scale so that <|curl N|^2> = 1 for the noise as it is read (interpolated). Measured by central differences at 4096 random points and times.
   Rng sampler(seed ^ 0x5bd1e995ull);
   const double h = 1e-3;
   double sum = 0.0;
@@ -87,7 +87,7 @@ NoiseTile<D>::NoiseTile(std::uint64_t seed) {
       sum += grad[0][0] * grad[0][0] + grad[0][1] * grad[0][1];
     }
   }
-  const float scale = static_cast<float>(std::sqrt(2.0 / (sum / points)));
+  const float scale = static_cast<float>(std::sqrt(1.0 / (sum / points)));
   for (Sample& v : samples_) v *= scale;
 }
 

@@ -11,9 +11,9 @@
 // its three components are independent realisations stored side by side, so one lookup's taps
 // serve all three (the potential's evaluation is the seed's bottleneck, ch. 3.6.2). It is scaled so
 // the curl of the vector noise (2D: the rotated gradient of the scalar), interpolated as it is
-// read, has <|curl N|^2> = 2 (measured at random points): a potential A N(x / l) then gives
-// velocities of rms sqrt(2) A / l, so A = sqrt(E) l (Narain: A_i = u_i l_i, u_i = sqrt(E_i)) gives
-// the kinetic energy 1/2 <|u|^2> = E.
+// read, has <|curl N|^2> = 1 (measured at random points): a potential A N(x / l) then gives
+// velocities of rms A / l, so Narain's A_i = u_i l_i gives eddies of "magnitude u_i" (ch. 3.5.1),
+// u_i = sqrt(E_i): <|u|^2> = E_i.
 //
 // curlOfNodalPotential turns a potential sampled at the nodes of a grid into face velocities that
 // are divergence-free to round-off (2D: psi is a stream function; 3D: psi is averaged to the cell

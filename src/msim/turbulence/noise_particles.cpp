@@ -148,9 +148,9 @@ void NoiseParticles<D>::advance(const MacGrid<D>& velocity, const TurbulentEnerg
 
 template <int D>
 void NoiseParticles<D>::synthesize(const TurbulentEnergy<D>& energy, MacGrid<D>& turbulent,
-                                   const std::vector<std::uint8_t>* nodeMask) {
+                                   const std::vector<float>* nodeWeight) {
   const GridSpec<D>& fine = turbulent.component(0).spec();
-  // Per particle and octave: amplitude A_i = sqrt(E_i) l_i and the noise's time tap.
+  // Per particle and octave: amplitude A_i = s sqrt(E_i) l_i and the noise's time tap.
   const std::size_t n = position_.size();
   amplitude_.resize(n);
   timeTap_.resize(n);
@@ -158,7 +158,7 @@ void NoiseParticles<D>::synthesize(const TurbulentEnergy<D>& energy, MacGrid<D>&
     const double e0 = std::max(0.0f, sampleLinear<D>(energy.energy(), position_[j]));
     for (int i = 0; i < octaves_; ++i) {
       const double l = l0_ / std::ldexp(1.0, i);
-      amplitude_[j][i] = static_cast<float>(std::sqrt(energy.octaveEnergy(e0, i)) * l);
+      amplitude_[j][i] = static_cast<float>(params_.intensity * std::sqrt(energy.octaveEnergy(e0, i)) * l);
       timeTap_[j][i] = tile_.timeTap(time_[j][i]);
     }
   }, 1024);
@@ -181,13 +181,13 @@ void NoiseParticles<D>::synthesize(const TurbulentEnergy<D>& energy, MacGrid<D>&
     std::vector<float>& rho = scratch.rho;
     for (std::size_t rowIndex = range.begin(); rowIndex != range.end(); ++rowIndex) {
       Vecf<3>* psiRow = psi_.data() + rowIndex * static_cast<std::size_t>(rowLength);
-      const std::uint8_t* maskRow = nodeMask ? nodeMask->data() + rowIndex * static_cast<std::size_t>(rowLength) : nullptr;
+      const float* weightRow = nodeWeight ? nodeWeight->data() + rowIndex * static_cast<std::size_t>(rowLength) : nullptr;
       std::fill(psiRow, psiRow + rowLength, Vecf<3>::Zero());
-      // The marked nodes' extent along the row (every node without a mask).
+      // The weighted nodes' extent along the row (every node without weights).
       int markedFirst = 0, markedEnd = rowLength;
-      if (maskRow) {
-        while (markedFirst < rowLength && !maskRow[markedFirst]) ++markedFirst;
-        while (markedEnd > markedFirst && !maskRow[markedEnd - 1]) --markedEnd;
+      if (weightRow) {
+        while (markedFirst < rowLength && weightRow[markedFirst] == 0.0f) ++markedFirst;
+        while (markedEnd > markedFirst && weightRow[markedEnd - 1] == 0.0f) --markedEnd;
       }
       if (markedFirst == markedEnd) continue;
       // The row's position across x, and the coverage cells within l_0 of it.
@@ -224,7 +224,7 @@ void NoiseParticles<D>::synthesize(const TurbulentEnergy<D>& energy, MacGrid<D>&
             const double dist = std::sqrt(std::min(1.0, dx * dx + crossSquared));
             const float r = static_cast<float>(1.0 - dist * dist * (3.0 - 2.0 * dist));
             rho[static_cast<std::size_t>(i)] = r;
-            weights[static_cast<std::size_t>(i)] += r * r;
+            weights[static_cast<std::size_t>(i)] += r;
           }
           for (int o = 0; o < octaves_; ++o) {
             if (amplitude_[j][o] == 0.0f) continue;
@@ -245,8 +245,8 @@ void NoiseParticles<D>::synthesize(const TurbulentEnergy<D>& energy, MacGrid<D>&
         if (d == D) break;
       }
       for (int i = 0; i < rowLength; ++i) {
-        if (weights[static_cast<std::size_t>(i)] > 0.0f && (!maskRow || maskRow[i]))
-          psiRow[i] = acc[static_cast<std::size_t>(i)] / std::sqrt(weights[static_cast<std::size_t>(i)]);
+        if (weights[static_cast<std::size_t>(i)] > 0.0f)
+          psiRow[i] = acc[static_cast<std::size_t>(i)] * ((weightRow ? weightRow[i] : 1.0f) / weights[static_cast<std::size_t>(i)]);
       }
     }
   });

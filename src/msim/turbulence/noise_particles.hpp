@@ -2,17 +2,19 @@
 // Noise particles (Narain 2011 ch. 3.5.1): the turbulent velocity u' as the curl of a potential
 // carried by particles that move with the mean flow, so the eddies travel with the fluid without
 // being distorted by it. Each particle j carries an offset o_j into the animated noise tile and a
-// noise time t_ij per octave i; octave i of the potential is the blend
-//   psi_i(x) = sum_j rho(|x - p_j|) A_i(p_j) N(o_j + (x - p_j) / l_i, t_ij) / sqrt(sum_j rho^2)
-// with rho(r) = 1 - 3 (r/l_0)^2 + 2 (r/l_0)^3 (r < l_0), l_i = l_0 / 2^i and A_i = sqrt(E_i) l_i,
-// E_i the octave's energy from the energy model (eq. 3.4, 3.10). The noise time advances by
+// noise time t_ij per octave i; octave i of the potential is the weighted average of eq. 3.12
+//   psi_i(x) = sum_j rho(|x - p_j|) A_i(p_j) N(o_j + (x - p_j) / l_i, t_ij) / sum_j rho(|x - p_j|)
+// with rho(r) = 1 - 3 (r/l_0)^2 + 2 (r/l_0)^3 (r < l_0), l_i = l_0 / 2^i and A_i = s sqrt(E_i) l_i,
+// E_i the octave's energy from the energy model (eq. 3.4, 3.10) and s the user's intensity (1: the
+// seed). One particle's noise then has eddy speeds of rms sqrt(E_i) ("magnitude u_i = sqrt(E_i)",
+// ch. 3.3-3.5; the tile's scale, curl_noise.hpp); the average of eq. 3.12 lowers the variance
+// where particles overlap (to about a third where four do), so 1/2 <|u'|^2> comes out below E_i:
+// the seed's calibration, kept because a variance-preserving blend that gives 1/2 <|u'|^2> = E_i
+// made the plume of Fig. 3.6 far too turbulent (docs/turbulence.md). The noise time advances by
 // 1 / tau_i per second, tau_i = l_i / sqrt(E_i) the eddy turnover time. u' = curl sum_i psi_i on the
 // faces of a finer grid, divergence-free to round-off (curl_noise.hpp).
 //
 // Departures from the seed, each for a reason:
-// - The seed divides by sum_j rho (eq. 3.12), a partition of unity; blending independent noises
-//   that way lowers their variance (to about a third where four particles overlap). Dividing by
-//   sqrt(sum_j rho^2) keeps the variance, so u' carries the energy the model prescribes.
 // - The seed samples a Poisson disk of spacing l_0 once and notes that dynamic resampling was not
 //   needed; with open boundaries particles leave, so here cells of side l_0 without a particle get
 //   one each step (and particles beyond three per cell are dropped where the flow converges).
@@ -34,6 +36,7 @@ namespace msim::turbulence {
 struct NoiseParticleParams {
   int octaves = 0;  // 0: every octave whose shortest wavelength l_i / 2 spans two fine cells
   std::uint64_t seed = 0;
+  double intensity = 1.0;  // s: multiplies every octave's amplitude (1: the seed's A_i = sqrt(E_i) l_i)
 };
 
 template <int D>
@@ -50,10 +53,11 @@ class NoiseParticles {
   // those that left the domain or entered a solid, and refills empty cells.
   void advance(const MacGrid<D>& velocity, const TurbulentEnergy<D>& energy, double dt);
 
-  // u' on the faces of `turbulent` (a MAC grid over the fine spec). Nodes with nodeMask[n] == 0
-  // (res + 1 per axis, x fastest) get no potential; null: every node.
+  // u' on the faces of `turbulent` (a MAC grid over the fine spec). nodeWeight (res + 1 per axis, x
+  // fastest) multiplies the potential at each node, and nodes of weight 0 are not evaluated; null:
+  // every node, weight 1.
   void synthesize(const TurbulentEnergy<D>& energy, MacGrid<D>& turbulent,
-                  const std::vector<std::uint8_t>* nodeMask = nullptr);
+                  const std::vector<float>* nodeWeight = nullptr);
 
   // Moving obstacles: the new solid mask (> 0.5); particles inside it are dropped at the next
   // advance() and empty cells refilled around it.

@@ -28,6 +28,8 @@ TurbulentEnergy<D>::TurbulentEnergy(const GridSpec<D>& spec, const TurbulentEner
     throw std::invalid_argument("TurbulentEnergy: the viscosity must be >= 0");
   if (!(params.initialEnergy >= 0.0) || !std::isfinite(params.initialEnergy))
     throw std::invalid_argument("TurbulentEnergy: the initial energy must be >= 0");
+  if (!(params.eddyViscosityConstant > 0.0) || !std::isfinite(params.eddyViscosityConstant))
+    throw std::invalid_argument("TurbulentEnergy: the eddy viscosity constant must be > 0");
 }
 
 template <int D>
@@ -87,12 +89,12 @@ void TurbulentEnergy<D>::strainRateSquared(const MacGrid<D>& velocity, Grid<floa
 }
 
 template <int D>
-double TurbulentEnergy<D>::react(double energy, double strain2, double k0, double dt) {
-  const double a = strain2 / k0, b = k0;
+double TurbulentEnergy<D>::react(double energy, double cStrain2, double k0, double dt) {
+  const double a = cStrain2 / k0, b = k0;
   const double e = std::max(energy, 0.0);
   if (e == 0.0) return 0.0;  // G carries a factor sqrt(E_0): nothing to produce from
   const double root = std::sqrt(e);
-  const double equilibrium = a / b;  // f(E) = 0: S^2 l_0^2
+  const double equilibrium = a / b;  // f(E) = 0: C S^2 l_0^2
   const double slope = a / (2.0 * root) - 1.5 * b * root;
   if (slope > 0.0) {
     // Growing towards the equilibrium from below: forward Euler, not past it.
@@ -151,11 +153,11 @@ void TurbulentEnergy<D>::filteredEnergy(Grid<float, D>& out) const {
 
 template <int D>
 void TurbulentEnergy<D>::diffuse(double dt) {
-  // Eq. 3.11: dE/dt = div(kappa grad E), kappa = k_0^-1 sqrt(E~) frozen over the step, implicit
+  // Eq. 3.11: dE/dt = div(kappa grad E), kappa = C k_0^-1 sqrt(E~) frozen over the step, implicit
   // along one axis after the other (tridiagonal solves per line); no flux through walls and solids.
   filteredEnergy(filtered_);
   parallelFor(0, filtered_.count(), [&](std::size_t i) {
-    filtered_[i] = static_cast<float>(largestEddy_ * std::sqrt(std::max(filtered_[i], 0.0f)));
+    filtered_[i] = static_cast<float>(params_.eddyViscosityConstant * largestEddy_ * std::sqrt(std::max(filtered_[i], 0.0f)));
   });
   const double r = dt / (spec_.dx * spec_.dx);
   for (int a = 0; a < D; ++a) {
@@ -211,13 +213,13 @@ void TurbulentEnergy<D>::step(const MacGrid<D>& velocity, double dt) {
   if (params_.diffusion) diffuse(dt);
   advector_.advect(energy_, velocity, dt);
   strainRateSquared(velocity, strain2_);
-  const double k = k0();
+  const double k = k0(), constant = params_.eddyViscosityConstant;
   parallelForCells<D>(spec_.res, [&](const IVec<D>& c, std::size_t lin) {
     if (solidAt(c)) {
       energy_[lin] = 0.0f;
       return;
     }
-    energy_[lin] = static_cast<float>(react(energy_[lin], strain2_[lin], k, dt));
+    energy_[lin] = static_cast<float>(react(energy_[lin], constant * strain2_[lin], k, dt));
   });
 }
 

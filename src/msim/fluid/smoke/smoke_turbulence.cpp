@@ -1,6 +1,7 @@
 #include "msim/fluid/smoke/smoke_turbulence.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <utility>
@@ -70,42 +71,49 @@ void SmokeTurbulence<D>::reseedParticles() {
 template <int D>
 void SmokeTurbulence<D>::markBand(const MacGrid<D>& velocity, double dt, const Grid<float, D>& coarseDensity,
                                   const Grid<float, D>& coarseTemperature) {
-  // Coarse cells with smoke or heat, grown by one cell and by the cells the fastest face crosses in
-  // a step.
+  // Each coarse cell's distance (in cells, the maximum over the axes) to the cells with smoke or
+  // heat, by one pass per axis: d_a(c) = min_k max(|k|, d_(a-1)(c + k e_a)), counted up to `far`.
+  // The core, within `reach` of them (one cell and the distance the fastest face covers in a
+  // step), gets the full u'; the potential then falls linearly to zero over kTaper more cells, so
+  // the band's edge makes no sheet of velocity (cutting psi off from one fine node to the next
+  // would put about twice the eddies' speed on it).
   double fastest = 0.0;
   for (int a = 0; a < D; ++a) {
     const auto& u = velocity.component(a);
     fastest = std::max(fastest, parallelMax(u.count(), [&](std::size_t i) { return std::abs(u[i]); }));
   }
-  const int grow = 1 + static_cast<int>(std::ceil(fastest * dt / coarse_.dx));
+  constexpr int kTaper = 2;
+  const int reach = std::min(200, 1 + static_cast<int>(std::ceil(fastest * dt / coarse_.dx)));
+  const int far = reach + kTaper;
   const std::size_t cells = coarseDensity.count();
-  coarseBand_.assign(cells, 0);
+  coarseLevel_.resize(cells);
   constexpr double kHeatTolerance = 0.01;  // [K] warmer or cooler than ambient: heat the flow carries
   parallelFor(0, cells, [&](std::size_t i) {
-    coarseBand_[i] = coarseDensity[i] > params_.smokeThreshold ||
-                     std::abs(coarseTemperature[i] - ambientTemperature_) > kHeatTolerance;
+    const bool source = coarseDensity[i] > params_.smokeThreshold ||
+                        std::abs(coarseTemperature[i] - ambientTemperature_) > kHeatTolerance;
+    coarseLevel_[i] = static_cast<std::uint8_t>(source ? 0 : far + 1);
   }, 4096);
-  std::vector<std::uint8_t>& next = bandScratch_;
+  std::vector<std::uint8_t>& next = levelScratch_;
   next.resize(cells);
   for (int a = 0; a < D; ++a) {
     parallelForCells<D>(coarse_.res, [&](const IVec<D>& c, std::size_t lin) {
-      std::uint8_t any = 0;
-      for (int k = -grow; k <= grow && !any; ++k) {
-        IVec<D> n = c;
-        n[a] += k;
-        if (n[a] < 0 || n[a] >= coarse_.res[a]) continue;
-        any = coarseBand_[static_cast<std::size_t>(lin + static_cast<std::ptrdiff_t>(k) * static_cast<std::ptrdiff_t>(coarseDensity.stride(a)))];
-      }
-      next[lin] = any;
+      int level = coarseLevel_[lin];
+      for (int k = 1; k <= far && k < level; ++k)
+        for (const int n : {c[a] - k, c[a] + k}) {
+          if (n < 0 || n >= coarse_.res[a]) continue;
+          const std::ptrdiff_t offset = static_cast<std::ptrdiff_t>(n - c[a]) * static_cast<std::ptrdiff_t>(coarseDensity.stride(a));
+          level = std::min(level, std::max(k, int(coarseLevel_[static_cast<std::size_t>(static_cast<std::ptrdiff_t>(lin) + offset)])));
+        }
+      next[lin] = static_cast<std::uint8_t>(level);
     });
-    coarseBand_.swap(next);
+    coarseLevel_.swap(next);
   }
-  // Their bounding box, rounded out to whole blocks of kBoxBlock cells so the advection window
+  // The core's bounding box, rounded out to whole blocks of kBoxBlock cells so the advection window
   // changes only every few steps as the smoke spreads.
   constexpr int kBoxBlock = 4;
   IVec<D> lo = coarse_.res, hi = IVec<D>::Zero();
   for (std::size_t i = 0; i < cells; ++i) {
-    if (!coarseBand_[i]) continue;
+    if (coarseLevel_[i] > reach) continue;
     const IVec<D> c = coarseDensity.coord(i);
     lo = lo.cwiseMin(c);
     hi = hi.cwiseMax(c + IVec<D>::Ones());
@@ -117,27 +125,80 @@ void SmokeTurbulence<D>::markBand(const MacGrid<D>& velocity, double dt, const G
       bandHi_[d] = std::min(coarse_.res[d], (hi[d] + kBoxBlock - 1) / kBoxBlock * kBoxBlock);
     }
   }
-  // Fine nodes of the marked coarse cells (a node belongs to the cell it is the lower corner of,
-  // clamped at the upper walls).
-  const IVec<D> nodes = fine_.res + IVec<D>::Ones();
-  std::size_t nodeCount = 1;
-  for (int d = 0; d < D; ++d) nodeCount *= static_cast<std::size_t>(nodes[d]);
-  nodeMask_.resize(nodeCount);
-  const int r = params_.refinement;
-  std::size_t rows = 1;
-  for (int d = 1; d < D; ++d) rows *= static_cast<std::size_t>(nodes[d]);
-  const double marked = parallelSum(rows, [&](std::size_t row) {
-    std::size_t coarseRow = 0, rest = row, coarseStride = 1;
-    for (int d = 1; d < D; ++d) {
-      const int n = static_cast<int>(rest % static_cast<std::size_t>(nodes[d]));
-      rest /= static_cast<std::size_t>(nodes[d]);
-      coarseStride *= static_cast<std::size_t>(coarse_.res[d - 1]);
-      coarseRow += static_cast<std::size_t>(std::min(n / r, coarse_.res[d] - 1)) * coarseStride;
+  // The weight at the coarse nodes: 1 at the corners of core cells, falling by 1 / kTaper per cell
+  // beyond; at the fine nodes, interpolated multilinearly from them.
+  const IVec<D> coarseNodes = coarse_.res + IVec<D>::Ones();
+  std::size_t coarseNodeCount = 1;
+  for (int d = 0; d < D; ++d) coarseNodeCount *= static_cast<std::size_t>(coarseNodes[d]);
+  coarseNodeWeight_.resize(coarseNodeCount);
+  parallelFor(0, coarseNodeCount, [&](std::size_t n) {
+    IVec<D> node;
+    std::size_t rest = n;
+    for (int d = 0; d < D; ++d) {
+      node[d] = static_cast<int>(rest % static_cast<std::size_t>(coarseNodes[d]));
+      rest /= static_cast<std::size_t>(coarseNodes[d]);
     }
-    const std::uint8_t* band = coarseBand_.data() + coarseRow;
-    std::uint8_t* mask = nodeMask_.data() + row * static_cast<std::size_t>(nodes[0]);
+    int level = far + 1;
+    for (int corner = 0; corner < (1 << D); ++corner) {
+      IVec<D> c = node;
+      bool inside = true;
+      for (int d = 0; d < D; ++d) {
+        c[d] -= (corner >> d) & 1;
+        inside = inside && c[d] >= 0 && c[d] < coarse_.res[d];
+      }
+      if (inside) level = std::min(level, int(coarseLevel_[coarseDensity.index(c)]));
+    }
+    coarseNodeWeight_[n] = std::clamp(1.0f - static_cast<float>(level - reach) / kTaper, 0.0f, 1.0f);
+  }, 4096);
+  const IVec<D> nodes = fine_.res + IVec<D>::Ones();
+  std::size_t nodeCount = 1, rows = 1;
+  for (int d = 0; d < D; ++d) nodeCount *= static_cast<std::size_t>(nodes[d]);
+  for (int d = 1; d < D; ++d) rows *= static_cast<std::size_t>(nodes[d]);
+  nodeWeight_.resize(nodeCount);
+  const int r = params_.refinement;
+  const float invR = 1.0f / static_cast<float>(r);
+  auto tap = [&](int fineIndex, int coarseCount) {  // coarse node below, its fraction; the stride is the caller's
+    const int below = std::min(fineIndex / r, coarseCount - 2);
+    return std::pair<int, float>(below, static_cast<float>(fineIndex - below * r) * invR);
+  };
+  const double marked = parallelSum(rows, [&](std::size_t row) {
+    // The coarse node rows bracketing this fine row, blended across the other axes.
+    thread_local std::vector<float> blended;
+    blended.assign(static_cast<std::size_t>(coarseNodes[0]), 0.0f);
+    std::array<std::pair<int, float>, D> across{};
+    std::size_t rest = row;
+    for (int d = 1; d < D; ++d) {
+      across[d] = tap(static_cast<int>(rest % static_cast<std::size_t>(nodes[d])), coarseNodes[d]);
+      rest /= static_cast<std::size_t>(nodes[d]);
+    }
+    bool any = false;
+    for (int corner = 0; corner < (1 << (D - 1)); ++corner) {
+      float w = 1.0f;
+      std::size_t offset = 0, stride = static_cast<std::size_t>(coarseNodes[0]);
+      for (int d = 1; d < D; ++d) {
+        const bool up = (corner >> (d - 1)) & 1;
+        w *= up ? across[d].second : 1.0f - across[d].second;
+        offset += static_cast<std::size_t>(across[d].first + up) * stride;
+        stride *= static_cast<std::size_t>(coarseNodes[d]);
+      }
+      if (w == 0.0f) continue;
+      const float* source = coarseNodeWeight_.data() + offset;
+      for (int x = 0; x < coarseNodes[0]; ++x) {
+        blended[static_cast<std::size_t>(x)] += w * source[x];
+        any = any || source[x] > 0.0f;
+      }
+    }
+    float* weight = nodeWeight_.data() + row * static_cast<std::size_t>(nodes[0]);
+    if (!any) {
+      std::fill(weight, weight + nodes[0], 0.0f);
+      return 0.0;
+    }
     int count = 0;
-    for (int x = 0; x < nodes[0]; ++x) count += mask[x] = band[std::min(x / r, coarse_.res[0] - 1)];
+    for (int x = 0; x < nodes[0]; ++x) {
+      const auto [below, f] = tap(x, coarseNodes[0]);
+      weight[x] = blended[static_cast<std::size_t>(below)] + f * (blended[static_cast<std::size_t>(below) + 1] - blended[static_cast<std::size_t>(below)]);
+      count += weight[x] > 0.0f;
+    }
     return double(count);
   });
   bandFraction_ = marked / static_cast<double>(nodeCount);
@@ -207,10 +268,11 @@ void SmokeTurbulence<D>::addSource(SmokeSource<D> source) {
 }
 
 template <int D>
-void SmokeTurbulence<D>::applySources(double dt) {
+void SmokeTurbulence<D>::applySources(double dt, Grid<float, D>& coarseDensity, Grid<float, D>& coarseTemperature) {
   // addSource refused extra scalars, so the accessor is never called.
   auto noScalars = [&](std::size_t) -> Grid<float, D>& { throw std::logic_error("SmokeTurbulence: no extra scalars"); };
   for (const auto& src : sources_) applySourceScalars<D>(src, dt, density_, temperature_, noScalars);
+  downsample(coarseDensity, coarseTemperature);
 }
 
 template <int D>
@@ -237,10 +299,8 @@ void SmokeTurbulence<D>::step(const MacGrid<D>& velocity, double dt, Grid<float,
                               Grid<float, D>& coarseTemperature) {
   energy_.step(velocity, dt);
   particles_->advance(velocity, energy_, dt);
-  applySources(dt);
-  downsample(coarseDensity, coarseTemperature);  // the band sees this step's sources
   markBand(velocity, dt, coarseDensity, coarseTemperature);
-  particles_->synthesize(energy_, turbulent_, &nodeMask_);
+  particles_->synthesize(energy_, turbulent_, &nodeWeight_);
   advectScalars(velocity, dt);
   downsample(coarseDensity, coarseTemperature);
   averageTurbulenceToCoarse();

@@ -6,15 +6,20 @@
 // eddies the coarse grid cannot hold. The coarse solver sees the scalars downsampled (for its
 // buoyancy) and, with coupling on, advects U by U + u' averaged onto its faces (ch. 3.5.2).
 //
-// One step (SmokeTurbulence::step, before the coarse solver's step):
+// One step, in the order of the coarse solver's own (sources, velocity, scalars advected by the new
+// velocity):
+//   SmokeTurbulence::applySources, before the coarse solver's step: the fine sources, and the
+//   scalars averaged onto the coarse cells, so the step's buoyancy sees this step's heat;
+//   SmokeTurbulence::step, after it, with its new velocity U:
 //   1. energy model (eq. 3.5) in U; 2. noise particles move with U, noise times advance;
-//   3. fine sources; the active cells: coarse cells with smoke (more than the threshold) or heat,
-//      grown by one cell and by the distance the flow carries it in a step;
-//   4. u' on the fine faces of the active cells;
+//   3. the active cells: coarse cells with smoke (more than the threshold) or heat, grown by one
+//      cell and by the distance the flow carries it in a step, and a taper of two cells beyond;
+//   4. u' on the fine faces of the active cells, its potential weighted down to zero across the
+//      taper;
 //   5. the fine scalars advected by U (interpolated) + u' in a window round the active cells
 //      (fainter smoke outside it stays where it is);
 //   6. the scalars averaged onto the coarse cells, u' onto the coarse faces (flux averages, so the
-//      coarse u' stays divergence-free).
+//      coarse u' stays divergence-free) for the next step's coupling.
 #include <memory>
 #include <optional>
 #include <vector>
@@ -52,7 +57,11 @@ class SmokeTurbulence {
   void addSource(SmokeSource<D> source);
   SmokeSource<D>& source(std::size_t i) { return sources_[i]; }
 
-  // Steps 1-5 above; coarseDensity and coarseTemperature receive the averaged fine scalars.
+  // Before the coarse solver's step: the fine sources; coarseDensity and coarseTemperature receive
+  // the averaged fine scalars.
+  void applySources(double dt, Grid<float, D>& coarseDensity, Grid<float, D>& coarseTemperature);
+  // After the coarse solver's step, with its new velocity: steps 1-6 above; coarseDensity and
+  // coarseTemperature receive the averaged fine scalars.
   void step(const MacGrid<D>& velocity, double dt, Grid<float, D>& coarseDensity, Grid<float, D>& coarseTemperature);
 
   const GridSpec<D>& fineSpec() const { return fine_; }
@@ -98,7 +107,6 @@ class SmokeTurbulence {
   void advectScalars(const MacGrid<D>& velocity, double dt);
   // U resampled onto the faces of `out` (the fine grid or a window of it from fine cell lo) plus u'.
   void advectingVelocity(const MacGrid<D>& velocity, const IVec<D>& lo, MacGrid<D>& out) const;
-  void applySources(double dt);
   void averageTurbulenceToCoarse();
 
   GridSpec<D> coarse_, fine_;
@@ -109,7 +117,8 @@ class SmokeTurbulence {
   bool hasSolid_ = false;
   Grid<float, D> density_, temperature_;
   MacGrid<D> turbulent_, coarseTurbulent_;
-  std::vector<std::uint8_t> nodeMask_, coarseBand_, bandScratch_;
+  std::vector<std::uint8_t> coarseLevel_, levelScratch_;  // cells from the smoke and heat (markBand)
+  std::vector<float> coarseNodeWeight_, nodeWeight_;      // the potential's weight: coarse and fine nodes
   IVec<D> bandLo_ = IVec<D>::Zero(), bandHi_ = IVec<D>::Zero();  // coarse cells, rounded out; empty when equal
   turbulence::TurbulentEnergy<D> energy_;
   std::unique_ptr<turbulence::NoiseParticles<D>> particles_;
