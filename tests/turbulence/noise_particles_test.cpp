@@ -76,6 +76,14 @@ TEST(NoiseParticles, SynthesisedVelocityIsIncompressibleAndCarriesTheOctavesEner
   EXPECT_LT(worstDiv, 1e-5 * largest);
   EXPECT_NEAR(sum2 / counted / (octaves * blend), 1.0, 0.15);
 
+  // The intensity scales u' and nothing else: the same particles at half the intensity.
+  NoiseParticles<3> half(coarse, energy, fine.dx, NoiseParticleParams{.seed = 2, .intensity = 0.5});
+  MacGrid<3> uHalf(fine);
+  half.synthesize(energy, uHalf);
+  for (int a = 0; a < 3; ++a)
+    for (std::size_t i = 0; i < u.component(a).count(); ++i)
+      ASSERT_NEAR(uHalf.component(a)[i], 0.5f * u.component(a)[i], 1e-6f * largest);
+
   // No energy, no turbulence.
   energy.energy().fill(0.0f);
   particles.synthesize(energy, u);

@@ -131,13 +131,7 @@ void SmokeTurbulence<D>::markBand(const MacGrid<D>& velocity, double dt, const G
   std::size_t coarseNodeCount = 1;
   for (int d = 0; d < D; ++d) coarseNodeCount *= static_cast<std::size_t>(coarseNodes[d]);
   coarseNodeWeight_.resize(coarseNodeCount);
-  parallelFor(0, coarseNodeCount, [&](std::size_t n) {
-    IVec<D> node;
-    std::size_t rest = n;
-    for (int d = 0; d < D; ++d) {
-      node[d] = static_cast<int>(rest % static_cast<std::size_t>(coarseNodes[d]));
-      rest /= static_cast<std::size_t>(coarseNodes[d]);
-    }
+  parallelForCells<D>(coarseNodes, [&](const IVec<D>& node, std::size_t n) {
     int level = far + 1;
     for (int corner = 0; corner < (1 << D); ++corner) {
       IVec<D> c = node;
@@ -149,7 +143,7 @@ void SmokeTurbulence<D>::markBand(const MacGrid<D>& velocity, double dt, const G
       if (inside) level = std::min(level, int(coarseLevel_[coarseDensity.index(c)]));
     }
     coarseNodeWeight_[n] = std::clamp(1.0f - static_cast<float>(level - reach) / kTaper, 0.0f, 1.0f);
-  }, 4096);
+  });
   const IVec<D> nodes = fine_.res + IVec<D>::Ones();
   std::size_t nodeCount = 1, rows = 1;
   for (int d = 0; d < D; ++d) nodeCount *= static_cast<std::size_t>(nodes[d]);
