@@ -51,8 +51,8 @@ class NoiseTile {
     std::array<float, kRowCorners> weight;
   };
   Row row(const Vec<D>& y, const LinearTap& time) const;
-  // The noise at first coordinate x on `row`: trilinear (bilinear) in space, linear in time,
-  // periodic. Components past kComponents are zero.
+  // The noise at first coordinate x on `row`: trilinear (bilinear) in space, linear in time with
+  // the blend's variance restored, periodic. Components past kComponents are zero.
   Vecf<3> onRow(const Row& row, double x) const {
     static_assert((kSamples & (kSamples - 1)) == 0, "the wrap is a mask");
     const float g = static_cast<float>(x) * static_cast<float>(kSamples / kSide);
@@ -78,6 +78,7 @@ class NoiseTile {
   // One sample: the components side by side (3D: padded to 16 bytes, one vector load).
   using Sample = std::conditional_t<D == 3, Eigen::Array4f, float>;
   std::vector<Sample> samples_;  // x fastest, then y, (z), t
+  float adjacentCorrelation_ = 0.0f;  // of two samples one time step apart (row() corrects the blend)
 };
 
 // u = curl psi on the faces of `u` (over `spec`'s cells). psi holds one value per node (res + 1 per
