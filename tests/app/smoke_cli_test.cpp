@@ -1,6 +1,7 @@
 // The "smoke" phenomenon end to end: a run writes volumes and pictures, --resume continues
-// bit-exactly (fire fields and a moving obstacle included), bad input names its key, and NaN or
-// CFL blow-ups stop with a message naming the step and the field.
+// bit-exactly (fire fields and a moving obstacle included), bad input names its key, NaN or CFL
+// blow-ups stop with a message naming the step and the field, and an obstacle that will run into
+// a closed side is warned of.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -124,4 +125,19 @@ TEST(SmokeCli, CflBlowUpStopsWithAMessage) {
   EXPECT_EQ(r.exitCode, 3) << r.output;
   EXPECT_NE(r.output.find("max_substeps"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("step "), std::string::npos) << r.output;
+}
+
+TEST(SmokeCli, ObstacleRunningIntoAClosedSideIsWarnedOf) {
+  // The paddle driven at 2 m/s towards the closed side x_max reaches it by t = 0.375 s (frames of
+  // 1/8 s); swinging in place it never does.
+  const fs::path dir = scratch("smoke_obstacle_wall");
+  writeText(dir / "into_wall.json", replaced(tinySmoke(), "\"oscillation\": [0.1, 0.0]", "\"velocity\": [2.0, 0.0]"));
+  const Result into = runMsim("run " + (dir / "into_wall.json").string() + " --out " + (dir / "into").string());
+  EXPECT_EQ(into.exitCode, 0) << into.output;
+  EXPECT_NE(into.output.find("obstacles[0] reaches the closed side x_max of the domain by t = 0.375 s"), std::string::npos)
+      << into.output;
+  writeText(dir / "swinging.json", tinySmoke());
+  const Result swinging = runMsim("run " + (dir / "swinging.json").string() + " --out " + (dir / "swinging").string());
+  EXPECT_EQ(swinging.exitCode, 0) << swinging.output;
+  EXPECT_EQ(swinging.output.find("reaches the closed side"), std::string::npos) << swinging.output;
 }

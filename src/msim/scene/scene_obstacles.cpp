@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "msim/core/error.hpp"
+#include "msim/core/log.hpp"
 #include "msim/core/parallel.hpp"
 #include "msim/numerics/pressure/face_fractions.hpp"
 #include "msim/scene/json_vectors.hpp"
@@ -52,7 +53,36 @@ SceneObstacles<D>::SceneObstacles(const Scene& scene, const GridSpec<D>& spec) :
     if (!seen)
       throw InputError(fmt::format("{}: '{}.shape' lies outside the domain{}", scene.file.string(), key,
                                    o.moving() ? fmt::format(" during the whole run (0 to {:.3g} s)", duration) : ""));
+    if (o.moving()) warnOfClosedSides(scene, key, o, bounds);
     obstacles_.push_back(std::move(o));
+  }
+}
+
+template <int D>
+void SceneObstacles<D>::warnOfClosedSides(const Scene& scene, const std::string& key, const Obstacle& o,
+                                          const geometry::Bounds<D>& bounds) const {
+  // A solid moving into a closed side squeezes the air between them out through a closing gap
+  // (and, once it passes the wall, takes volume from a box that cannot give it): the steps shrink
+  // tenfold or more. Not an error (the scene may end first), but worth saying before the run.
+  const nlohmann::json& sides = scene.resolved.at("domain").at("boundaries");
+  const Vec<D> lo = spec_.origin, hi = spec_.origin + spec_.extent();
+  static const char* axes[] = {"x", "y", "z"};
+  for (int frame = 1; frame <= scene.frameCount; ++frame) {
+    const double t = frame / scene.fps;
+    const Vec<D> shift = o.offset(t);
+    for (int a = 0; a < D; ++a) {
+      const bool lowClosed = sides.at(std::string(axes[a]) + "_min").get<std::string>() == "closed";
+      const bool highClosed = sides.at(std::string(axes[a]) + "_max").get<std::string>() == "closed";
+      const char* side = nullptr;
+      if (lowClosed && bounds.min[a] >= lo[a] && bounds.min[a] + shift[a] < lo[a]) side = "_min";
+      if (highClosed && bounds.max[a] <= hi[a] && bounds.max[a] + shift[a] > hi[a]) side = "_max";
+      if (!side) continue;
+      logger().warn("{}: {} reaches the closed side {}{} of the domain by t = {:.3g} s; the air pushed against the "
+                    "wall escapes through a closing gap and the steps become much smaller (open that side, or end "
+                    "the run before)",
+                    scene.file.string(), key, axes[a], side, t);
+      return;
+    }
   }
 }
 

@@ -4,6 +4,7 @@
 // of the union of all solids and the velocity of the solid at every face (the moving-obstacle
 // boundary condition of the projection).
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "msim/core/grid.hpp"
@@ -42,6 +43,10 @@ class SceneObstacles {
     Vec<D> offset(double t) const;
     Vec<D> velocityAt(double t) const;
   };
+  // Warns (once) if the moving obstacle's box, inside a closed side at t = 0, crosses it at a frame
+  // of the run.
+  void warnOfClosedSides(const Scene& scene, const std::string& key, const Obstacle& o,
+                         const geometry::Bounds<D>& bounds) const;
   // min over obstacles of their distance at x and time t; `nearest` gets the index of the closest.
   double distance(const Vec<D>& x, double t, std::size_t* nearest = nullptr) const;
 
