@@ -179,7 +179,7 @@ TEST(SmokeTurbulenceCli, PlumeRisesAndSpreadsLikeTheRefinedSimulation) {
   // Fig. 3.6 in 2D: smoke rising from a small hot source on 32 x 128 cells with the model (smoke on
   // 128 x 512) against the same scene simulated on 128 x 512 cells. The model's eddies add detail
   // and spread the plume, but must not mix it away: its height stays within 25% of the refined
-  // simulation's and its width within 40% (measured: 13% and 19% low, 30% and 25% wider). With the
+  // simulation's and its width within 40% (measured: 13% and 17% low, 22% and 30% wider). With the
   // seed's eddy viscosity constant (1 instead of 0.09) the plume is 24% low at 2 s, at the edge;
   // with eddies 2.4 times stronger still (about the noise scaling msim used before), 39% low.
   const fs::path dir = scratch("turbulence_plume");

@@ -65,3 +65,27 @@ TEST(SmokeTurbulence, CoarseTurbulenceIsDivergenceFreeAndScalarsAverage) {
   EXPECT_GT(rho(IVec3(8, 8, 8)), 0.5);
   EXPECT_GT(turbulence.turbulentKineticEnergy(), 0.0);
 }
+
+TEST(SmokeTurbulence, FineSmokeDissipatesAtTheSmokeRates) {
+  // The fine grid carries the smoke, so the smoke's decay rates act there: in still air with no
+  // energy, the fine mass falls as exp(-rate t) and T - T_ambient likewise.
+  const GridSpec<2> coarse(Vec2::Zero(), 1.0 / 16, IVec2(16, 16));
+  SmokeTurbulenceParams params;
+  params.energy.initialEnergy = 0.0;
+  params.densityDissipation = 2.0;
+  params.temperatureDissipation = 1.0;
+  SmokeTurbulence<2> turbulence(coarse, params, numerics::AdvectionSettings{}, nullptr, 293.15);
+  for (int j = 24; j < 40; ++j)
+    for (int i = 24; i < 40; ++i) {
+      turbulence.density()(IVec2(i, j)) = 1.0f;
+      turbulence.temperature()(IVec2(i, j)) = 393.15f;
+    }
+  const MacGrid<2> still(coarse);
+  Grid<float, 2> rho(coarse, 0.0f), temperature(coarse, 293.15f);
+  for (int s = 0; s < 10; ++s) turbulence.step(still, 0.05, rho, temperature);
+  double mass = 0.0;
+  for (std::size_t i = 0; i < turbulence.density().count(); ++i) mass += turbulence.density()[i];
+  EXPECT_NEAR(mass / 256.0, std::exp(-1.0), 1e-4);
+  EXPECT_NEAR(turbulence.temperature()(IVec2(32, 32)) - 293.15, 100.0 * std::exp(-0.5), 1e-2);
+  EXPECT_NEAR(rho(IVec2(8, 8)), std::exp(-1.0), 1e-4);  // the coarse average follows
+}

@@ -32,13 +32,13 @@ double smokeBytesPerCell(int dimensions, const json& resolved) {
   // vectors, confinement), the fire fields and the VDB and preview copies at frame time.
   double bytes = 360.0;
   // Sub-grid turbulence keeps the smoke on refinement^D fine cells per cell: their scalars, u' on
-  // the faces, the potential at the nodes, the band mask, the VDB copies, and in the advection
+  // the faces, the potential and its weights at the nodes, the VDB copies, and in the advection
   // window (at most the whole fine grid) copies of the scalars and U + u' with the advector's
-  // stages and feet: 130 bytes per fine cell when the window is the whole grid (smoke_turbulence
-  // at 1 s, window about a third: peak RSS 1.15 GB for 16.8M fine cells).
+  // stages and feet: 133 bytes per fine cell when the window is the whole grid (smoke_turbulence
+  // at 1 s, window about a third: peak RSS 1.12 GB for 16.8M fine cells).
   const json& t = resolved.at("smoke").at("turbulence");
   if (t.at("enabled").get<bool>())
-    bytes += std::pow(t.at("refinement").get<double>(), dimensions) * 130.0;
+    bytes += std::pow(t.at("refinement").get<double>(), dimensions) * 133.0;
   return bytes;
 }
 
@@ -255,6 +255,7 @@ class SmokePhenomenon final : public Phenomenon {
         solver_.spec(), smokeTurbulenceParams(r), solver_.params().advection,
         obstacles_.empty() ? nullptr : &solver_.solid(), solver_.params().buoyancy.ambientTemperature);
     if (turbulence_->params().coupling) solver_.setAdvectionOffset(&turbulence_->coarseTurbulentVelocity());
+    solver_.setScalarsCarriedElsewhere(true);
   }
 
   void addSources(const Scene& scene) {

@@ -242,6 +242,8 @@ fluid::SmokeTurbulenceParams smokeTurbulenceParams(const json& resolved) {
   p.coupling = t.at("coupling").get<bool>();
   p.smokeThreshold = t.at("smoke_threshold").get<double>();
   p.writeVelocity = t.at("write_velocity").get<bool>();
+  p.densityDissipation = resolved.at("smoke").at("density_dissipation").get<double>();
+  p.temperatureDissipation = resolved.at("smoke").at("temperature_dissipation").get<double>();
   return p;
 }
 

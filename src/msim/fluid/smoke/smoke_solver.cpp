@@ -234,10 +234,11 @@ void SmokeSolver<D>::step(double dt) {
 
 template <int D>
 void SmokeSolver<D>::advectScalars(double dt) {
-  for (Grid<float, D>* f : {&density_, &temperature_}) {
-    extendIntoSolid(*f);
-    advector_.advect(*f, velocity_, dt);
-  }
+  if (!scalarsElsewhere_)
+    for (Grid<float, D>* f : {&density_, &temperature_}) {
+      extendIntoSolid(*f);
+      advector_.advect(*f, velocity_, dt);
+    }
   for (auto& sc : scalars_) {
     extendIntoSolid(sc.field);
     advector_.advect(sc.field, velocity_, dt);
@@ -386,15 +387,23 @@ void SmokeSolver<D>::applyInflow() {
 }
 
 template <int D>
-void SmokeSolver<D>::dissipate(double dt) {
-  const float keepRho = static_cast<float>(std::exp(-params_.densityDissipation * dt));
-  const float keepT = static_cast<float>(std::exp(-params_.temperatureDissipation * dt));
-  const float ambient = static_cast<float>(params_.buoyancy.ambientTemperature);
+void dissipateSmoke(Grid<float, D>& density, Grid<float, D>& temperature, double densityRate, double temperatureRate,
+                    double ambientTemperature, double dt) {
+  const float keepRho = static_cast<float>(std::exp(-densityRate * dt));
+  const float keepT = static_cast<float>(std::exp(-temperatureRate * dt));
+  const float ambient = static_cast<float>(ambientTemperature);
   if (keepRho != 1.0f || keepT != 1.0f)
-    parallelFor(0, density_.count(), [&](std::size_t i) {
-      density_[i] *= keepRho;
-      temperature_[i] = ambient + (temperature_[i] - ambient) * keepT;
-    });
+    parallelFor(0, density.count(), [&](std::size_t i) {
+      density[i] *= keepRho;
+      temperature[i] = ambient + (temperature[i] - ambient) * keepT;
+    }, 1 << 14);
+}
+
+template <int D>
+void SmokeSolver<D>::dissipate(double dt) {
+  if (!scalarsElsewhere_)
+    dissipateSmoke<D>(density_, temperature_, params_.densityDissipation, params_.temperatureDissipation,
+                      params_.buoyancy.ambientTemperature, dt);
   for (auto& sc : scalars_) {
     const float keep = static_cast<float>(std::exp(-sc.dissipation * dt));
     if (keep != 1.0f) parallelFor(0, sc.field.count(), [&](std::size_t i) { sc.field[i] *= keep; });
@@ -478,6 +487,8 @@ void SmokeSolver<D>::applyWinds(double dt) {
   }
 }
 
+template void dissipateSmoke<2>(Grid<float, 2>&, Grid<float, 2>&, double, double, double, double);
+template void dissipateSmoke<3>(Grid<float, 3>&, Grid<float, 3>&, double, double, double, double);
 template class SmokeSolver<2>;
 template class SmokeSolver<3>;
 

@@ -116,6 +116,12 @@ struct SmokeStatistics {
   long step = 0;                // steps taken
 };
 
+// Smoke decays as exp(-densityRate dt) per step and T - T_ambient as exp(-temperatureRate dt)
+// (params.densityDissipation, temperatureDissipation), on whichever grid carries them.
+template <int D>
+void dissipateSmoke(Grid<float, D>& density, Grid<float, D>& temperature, double densityRate, double temperatureRate,
+                    double ambientTemperature, double dt);
+
 template <int D>
 class SmokeSolver {
  public:
@@ -138,6 +144,9 @@ class SmokeSolver {
   // Velocity added to U when U advects itself (procedural turbulence's coupling, Narain ch. 3.5.2:
   // U moves with U + u'); null: U alone. The grid must outlive its use.
   void setAdvectionOffset(const MacGrid<D>* offset) { advectionOffset_ = offset; }
+  // Procedural turbulence carries density and temperature on its own finer grid and sets the
+  // solver's each step (their averages): the solver then neither advects nor dissipates them.
+  void setScalarsCarriedElsewhere(bool elsewhere) { scalarsElsewhere_ = elsewhere; }
   // The clock the winds are sampled at [s]; step() advances it, a resumed run sets it.
   void setTime(double time) { time_ = time; }
   double time() const { return time_; }
@@ -236,6 +245,7 @@ class SmokeSolver {
   std::vector<turbulence::TurbulentWind<D>> winds_;
   std::vector<float> windScratch_;  // the winds on one face component
   const MacGrid<D>* advectionOffset_ = nullptr;
+  bool scalarsElsewhere_ = false;
   std::optional<MacGrid<D>> advecting_;  // U + offset
   double time_ = 0.0;
 };

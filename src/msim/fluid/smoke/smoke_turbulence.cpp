@@ -296,6 +296,8 @@ void SmokeTurbulence<D>::step(const MacGrid<D>& velocity, double dt, Grid<float,
   markBand(velocity, dt, coarseDensity, coarseTemperature);
   particles_->synthesize(energy_, turbulent_, &nodeWeight_);
   advectScalars(velocity, dt);
+  dissipateSmoke<D>(density_, temperature_, params_.densityDissipation, params_.temperatureDissipation,
+                    ambientTemperature_, dt);
   downsample(coarseDensity, coarseTemperature);
   averageTurbulenceToCoarse();
 }

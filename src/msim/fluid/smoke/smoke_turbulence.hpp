@@ -17,7 +17,8 @@
 //   4. u' on the fine faces of the active cells, its potential weighted down to zero across the
 //      taper;
 //   5. the fine scalars advected by U (interpolated) + u' in a window round the active cells
-//      (fainter smoke outside it stays where it is);
+//      (fainter smoke outside it stays where it is), and dissipated (the coarse solver, told that
+//      its scalars are carried here, neither advects nor dissipates them);
 //   6. the scalars averaged onto the coarse cells, u' onto the coarse faces (flux averages, so the
 //      coarse u' stays divergence-free) for the next step's coupling.
 #include <memory>
@@ -40,6 +41,7 @@ struct SmokeTurbulenceParams {
   bool coupling = true;            // U advected by U + u' (ch. 3.5.2)
   double smokeThreshold = 1e-4;    // [kg/m^3] coarse cells with less smoke get no u'
   bool writeVelocity = false;      // the scene writes U + u' on the fine grid as its "vel" (outputs only)
+  double densityDissipation = 0.0, temperatureDissipation = 0.0;  // [1/s] the smoke's decay (SmokeParams)
 };
 
 template <int D>
