@@ -130,11 +130,12 @@ struct SweepSlots {
 
 // Corrections of agent i against its coincident partners (closer than 1e-7 target) among the
 // slots forEachPartner(f) enumerates, along a direction hashed from the pair; moves the partners
-// and returns i's share. Rare, and out of line so that the loops of projectPairs and
+// and returns i's share. Rare, and out of line so that the loops of projectPartners and
 // projectRanges keep their values in registers (a call there spills them).
-template <typename ForEachPartner>
+template <typename ForEachPartner, typename OnPartner>
 [[gnu::cold, gnu::noinline]] Vec2f coincidentCorrections(const SweepSlots& a, std::uint32_t i,
-                                                          const ForEachPartner& forEachPartner, float s) {
+                                                          const ForEachPartner& forEachPartner, float s,
+                                                          const OnPartner& onPartner) {
   Vec2f share = Vec2f::Zero();
   const float xi = a.x[i], yi = a.y[i], ri = a.radius[i], yieldI = a.yield[i];
   forEachPartner([&](std::uint32_t j) {
@@ -150,17 +151,18 @@ template <typename ForEachPartner>
     a.y[j] -= sj * c.y();
     const float lx = a.x[j] - a.bucketX[j], ly = a.y[j] - a.bucketY[j];
     a.far[j] = std::max(a.far[j], lx * lx + ly * ly);
+    onPartner(j);
   });
   return share;
 }
 
 // The end of agent i's projections: its coincident partners (rare, out of line), then its own
 // shares (dx, dy) applied together.
-template <typename ForEachPartner>
+template <typename ForEachPartner, typename OnPartner>
 inline void applyShares(const SweepSlots& a, std::uint32_t i, float dx, float dy, bool coincident,
-                        const ForEachPartner& forEachPartner, float s) {
+                        const ForEachPartner& forEachPartner, float s, const OnPartner& onPartner) {
   if (coincident) [[unlikely]] {
-    const Vec2f share = coincidentCorrections(a, i, forEachPartner, s);
+    const Vec2f share = coincidentCorrections(a, i, forEachPartner, s, onPartner);
     dx += share.x();
     dy += share.y();
   }
@@ -177,8 +179,9 @@ inline void applyShares(const SweepSlots& a, std::uint32_t i, float dx, float dy
 // sj = yield_i (2 - 2 yield_j) (0 if j is scripted): equal and opposite for two movable agents.
 // Each j is moved in place as it comes; i's shares are taken from its position at the start and
 // applied together at the end (coincident partners last).
-template <typename ForEachPartner>
-inline void projectPartners(const SweepSlots& a, std::uint32_t i, const ForEachPartner& forEachPartner, float s) {
+template <typename ForEachPartner, typename OnPartner>
+inline void projectPartners(const SweepSlots& a, std::uint32_t i, const ForEachPartner& forEachPartner, float s,
+                            const OnPartner& onPartner) {
   // The slot arrays do not overlap: without restrict every store would force the loads again.
   float* __restrict x = a.x;
   float* __restrict y = a.y;
@@ -212,23 +215,23 @@ inline void projectPartners(const SweepSlots& a, std::uint32_t i, const ForEachP
       const float lx = x[j] - bucketX[j], ly = y[j] - bucketY[j];
       far[j] = std::max(far[j], lx * lx + ly * ly);
     }
+    onPartner(j);
   });
-  applyShares(a, i, dx, dy, coincident, forEachPartner, s);
-}
-
-// projectPartners over a list of partner slots js[q], q < count (local sweeps).
-inline void projectPairs(const SweepSlots& a, std::uint32_t i, const std::uint32_t* js, std::uint32_t count, float s) {
-  projectPartners(
-      a, i, [&](const auto& f) { for (std::uint32_t q = 0; q < count; ++q) f(js[q]); }, s);
+  applyShares(a, i, dx, dy, coincident, forEachPartner, s, onPartner);
 }
 
 // Gauss-Seidel projections of agent i against every slot of the ranges [lo[q], hi[q]), q < count
-// (no j == i among them): the pairs of projectPairs without a list, found by testing the
-// distances at the current positions. Equal to projectPairs over the same slots: i's shares are
-// taken from its start position and applied at the end, so its partners do not depend on each
-// other and eight are projected at a time (AVX2; reads up to 7 slots past a range, masked off).
+// (no j == i among them): projectPartners over those slots, the partners found by testing the
+// distances at the current positions. i's shares are taken from its start position and applied at
+// the end, so its partners do not depend on each other and eight are projected at a time (AVX2;
+// reads up to 7 slots past a range, masked off). onPartner(j) for every partner pushed (the
+// local sweeps list the agents they moved; whole sweeps need not).
+struct NoPartnerCallback {
+  void operator()(std::uint32_t) const {}
+};
+template <typename OnPartner = NoPartnerCallback>
 inline void projectRanges(const SweepSlots& a, std::uint32_t i, const std::uint32_t* lo, const std::uint32_t* hi,
-                          int count, float s) {
+                          int count, float s, const OnPartner& onPartner = {}) {
   auto ranges = [&](const auto& f) {
     for (int r = 0; r < count; ++r)
       for (std::uint32_t j = lo[r]; j < hi[r]; ++j) f(j);
@@ -259,7 +262,7 @@ inline void projectRanges(const SweepSlots& a, std::uint32_t i, const std::uint3
       const __m256 apart = _mm256_cmp_ps(d2, _mm256_mul_ps(_mm256_set1_ps(1e-14f), t2), _CMP_GT_OQ);
       coincident |= !_mm256_testz_ps(in, _mm256_andnot_ps(apart, in));
       const __m256 m = _mm256_and_ps(in, apart);
-      // (target - dist) / dist with 1 / dist as in inverseSqrt (same rounding as projectPairs).
+      // (target - dist) / dist with 1 / dist as in inverseSqrt (same rounding as projectPartners).
       const __m256 est = _mm256_rsqrt_ps(d2);
       const __m256 inv = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(0.5f), est),
                                        _mm256_sub_ps(_mm256_set1_ps(3.0f), _mm256_mul_ps(_mm256_mul_ps(d2, est), est)));
@@ -288,11 +291,12 @@ inline void projectRanges(const SweepSlots& a, std::uint32_t i, const std::uint3
         x[j + l] = lanes[0][l];
         y[j + l] = lanes[1][l];
         far[j + l] = lanes[2][l];
+        onPartner(j + l);
       }
     }
-  applyShares(a, i, sum8(ax), sum8(ay), coincident, ranges, s);
+  applyShares(a, i, sum8(ax), sum8(ay), coincident, ranges, s, onPartner);
 #else
-  projectPartners(a, i, ranges, s);
+  projectPartners(a, i, ranges, s, onPartner);
 #endif
 }
 }  // namespace msim::crowd::collision_kernels

@@ -343,25 +343,29 @@ CollisionResolver::SweepMoves CollisionResolver::localSweep(const StaticObstacle
   auto project = [&](RowGroup& g, std::uint32_t i, float& farthest2, bool parallel) {
     const float f = std::sqrt(farthest2) * 1.001f + 1e-6f * range;
     if (parallel && range + 2.0f * f >= cellSize) return false;
-    g.partners.clear();
-    const float xi = x_[i], yi = y_[i], ri = radius_[i];
-    grid_.forEachSlotNear(Vec2f(xi, yi), range + f, [&](std::uint32_t j) {
-      // The pairs projectPairs will push: only those partners are touched.
-      const float ex = xi - x_[j], ey = yi - y_[j], target = s * (ri + radius_[j]);
-      if (j != i && ex * ex + ey * ey < target * target) g.partners.push_back(j);
+    // The slots near i, row by row, without i itself.
+    g.lo.clear();
+    g.hi.clear();
+    grid_.forEachSlotRowNear(Vec2f(x_[i], y_[i]), range + f, [&](std::uint32_t first, std::uint32_t last) {
+      if (first <= i && i < last) {
+        g.lo.push_back(first);
+        g.hi.push_back(i);
+        first = i + 1;
+      }
+      g.lo.push_back(first);
+      g.hi.push_back(last);
     });
+    // The agents the projection moves: i and every partner it pushes.
     auto touch = [&](std::uint32_t k) {
+      farthest2 = std::max(farthest2, far_[k]);
       if (touchedMark_[k]) return;
       touchedMark_[k] = 1;
       g.touched.push_back(k);
     };
+    checkX_[i] = x_[i];  // all of i's pairs are projected now
+    checkY_[i] = y_[i];
+    projectRanges(slots, i, g.lo.data(), g.hi.data(), static_cast<int>(g.lo.size()), s, touch);
     touch(i);
-    checkX_[i] = xi;  // all of i's pairs are projected now
-    checkY_[i] = yi;
-    for (const std::uint32_t j : g.partners) touch(j);
-    projectPairs(slots, i, g.partners.data(), static_cast<std::uint32_t>(g.partners.size()), s);
-    farthest2 = std::max(farthest2, far_[i]);
-    for (const std::uint32_t j : g.partners) farthest2 = std::max(farthest2, far_[j]);
     return true;
   };
   float farthest2 = lastEnd2;

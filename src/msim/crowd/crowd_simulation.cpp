@@ -55,6 +55,11 @@ CrowdSimulation::CrowdSimulation(const CrowdSettings& settings, std::vector<Poly
       obstacleReach_(obstacleReach(agents_, inflows_, settings.orca)),
       freeArea_(settings.grid),
       uic_(settings.grid, settings.uicSettings) {
+  goalSummaries_.reserve(goals_.size());
+  for (const Goal& g : goals_)
+    goalSummaries_.push_back(
+        GoalSummary{g.point.cast<float>(), static_cast<float>(g.arrivalRadius * g.arrivalRadius),
+                    g.kind == Goal::Kind::Point, g.exit});
   if (!planner_ || planner_->goalCount() != goals_.size())
     throw InputError("crowd: the planner does not answer for the scene's goals");
   for (std::size_t k = 0; k < obstacles_.size(); ++k) {
@@ -157,18 +162,32 @@ double CrowdSimulation::maxSpeed() const {
 void CrowdSimulation::plan() {
   // Preferred velocity along the planned path at the agent's maximum speed, slowed on the last
   // stretch to a point goal so that it stops there instead of oscillating around it.
+  const bool straight = planner_->straightToPointGoals();
   parallelFor(0, agents_.size(), [&](std::size_t i) {
     if (agents_.model[i] == AgentModel::Scripted) return;
     const std::uint32_t g = agents_.goal[i];
+    const GoalSummary& goal = goalSummaries_[g];
     const Vec2 x = agents_.position[i].cast<double>();
-    const Goal& goal = goals_[g];
-    if (!goal.exit && goal.reached(x)) {
+    double speed = agents_.maxSpeed[i];
+    if (!goal.isPoint) {  // a region: arrived inside it
+      if (!goal.exit && contains(goals_[g].region, x)) {
+        agents_.preferredVelocity[i].setZero();
+        return;
+      }
+      agents_.preferredVelocity[i] = (speed * planner_->direction(g, x)).cast<float>();
+      return;
+    }
+    const Vec2 d = goal.point.cast<double>() - x;
+    const double dist2 = d.squaredNorm();
+    if (!goal.exit && dist2 <= double(goal.arrival2)) {  // Goal::reached
       agents_.preferredVelocity[i].setZero();
       return;
     }
-    double speed = agents_.maxSpeed[i];
-    if (goal.kind == Goal::Kind::Point && !goal.exit) speed = std::min(speed, (goal.point - x).norm());
-    agents_.preferredVelocity[i] = (speed * planner_->direction(g, x)).cast<float>();
+    const double dist = std::sqrt(dist2);
+    if (!goal.exit) speed = std::min(speed, dist);
+    // DirectPlanner::direction, formed here from the compact copy.
+    const Vec2 direction = !straight ? planner_->direction(g, x) : dist > 1e-12 ? Vec2(d / dist) : Vec2::Zero();
+    agents_.preferredVelocity[i] = (speed * direction).cast<float>();
   });
 }
 

@@ -17,6 +17,7 @@ class DirectPlanner final : public GlobalPlanner {
   // Towards the goal point, or the closest point of a region goal (zero inside it).
   Vec2 direction(std::size_t goal, const Vec2& position) const override;
   double distance(std::size_t goal, const Vec2& position) const override;
+  bool straightToPointGoals() const override { return true; }
 
  private:
   Vec2 target(std::size_t goal, const Vec2& position) const;

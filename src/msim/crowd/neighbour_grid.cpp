@@ -18,7 +18,7 @@ struct Bounds {
 };
 
 // Points per counting block: below this a block's histogram costs more than it saves.
-constexpr std::size_t kBlockPoints = 1 << 16;
+constexpr std::size_t kBlockPoints = 1 << 14;
 constexpr std::size_t kMaxBlocks = 8;
 
 }  // namespace

@@ -29,13 +29,12 @@ class NeighbourGrid {
   // Calls f(j) for every built point j with |x_j - x| < radius.
   template <typename F>
   void forEachWithin(const Vecf<2>& x, float radius, F&& f) const;
-  // Calls f(slot) for every slot of cellOrder() in the cells a disc of the radius around x
-  // touches: a superset of the built points within the radius (no distance test), for callers
-  // that keep their own cell-ordered copies.
+  // Calls f(first, last) for each row of cells a disc of the radius around x touches, bottom to
+  // top, with the slots [first, last) of cellOrder() in that row's touched cells (contiguous, as
+  // cells are row-major): a superset of the built points within the radius (no distance test),
+  // for callers that keep their own cell-ordered copies.
   template <typename F>
-  void forEachSlotNear(const Vecf<2>& x, float radius, F&& f) const {
-    visitCells(x, radius, f);
-  }
+  void forEachSlotRowNear(const Vecf<2>& x, float radius, F&& f) const;
 
   // The built points (a copy, in input order).
   std::span<const Vecf<2>> points() const { return points_; }
@@ -85,7 +84,7 @@ class NeighbourGrid {
 };
 
 template <typename F>
-void NeighbourGrid::visitCells(const Vecf<2>& x, float radius, F&& f) const {
+void NeighbourGrid::forEachSlotRowNear(const Vecf<2>& x, float radius, F&& f) const {
   if (nx_ == 0) return;
   const Vecf<2> rel = (x - origin_) / cellSize_;
   const float reach = radius / cellSize_;
@@ -93,11 +92,17 @@ void NeighbourGrid::visitCells(const Vecf<2>& x, float radius, F&& f) const {
   const int i1 = std::min(nx_ - 1, static_cast<int>(std::floor(rel.x() + reach)));
   const int j0 = std::max(0, static_cast<int>(std::floor(rel.y() - reach)));
   const int j1 = std::min(ny_ - 1, static_cast<int>(std::floor(rel.y() + reach)));
-  for (int j = j0; j <= j1; ++j)
-    for (int i = i0; i <= i1; ++i) {
-      const std::size_t c = static_cast<std::size_t>(j) * nx_ + i;
-      for (std::uint32_t k = cellStart_[c]; k < cellStart_[c + 1]; ++k) f(k);
-    }
+  for (int j = j0; j <= j1; ++j) {
+    const std::size_t row = static_cast<std::size_t>(j) * nx_;
+    f(cellStart_[row + i0], cellStart_[row + i1 + 1]);
+  }
+}
+
+template <typename F>
+void NeighbourGrid::visitCells(const Vecf<2>& x, float radius, F&& f) const {
+  forEachSlotRowNear(x, radius, [&](std::uint32_t first, std::uint32_t last) {
+    for (std::uint32_t k = first; k < last; ++k) f(k);
+  });
 }
 
 template <typename F>

@@ -19,6 +19,10 @@ class GlobalPlanner {
   virtual Vec2 direction(std::size_t goal, const Vec2& position) const = 0;
   // Length of the planned path to the goal [m]; +infinity where the goal cannot be reached.
   virtual double distance(std::size_t goal, const Vec2& position) const = 0;
+  // True when direction() towards a point goal is the unit vector straight at the point (no
+  // obstacles to plan around), so that callers stepping many agents may form it themselves from a
+  // compact copy of the goal points instead of calling through here per agent.
+  virtual bool straightToPointGoals() const { return false; }
 };
 
 }  // namespace msim::crowd

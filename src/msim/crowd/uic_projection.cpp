@@ -142,18 +142,18 @@ namespace {
 
 // Linear (tent) taps along one axis of a grid with n samples, sample coordinate s: the two folded
 // sample indices and their weights (taps outside the grid fold onto the border sample, as in
-// core/transfer.hpp).
+// core/transfer.hpp). Single precision, as the agents' positions: the weights are good to ~1e-7 of
+// the coordinate, and the transfers cost half as much as in double.
 struct Taps {
   int at[2];
-  double w[2];
-  Taps(double s, int n) {
-    const double first = std::floor(s);
-    const double t = s - first;
+  float w[2];
+  Taps(float s, int n) {
+    const float first = std::floor(s);
     const int f = static_cast<int>(first);
     at[0] = std::clamp(f, 0, n - 1);
     at[1] = std::clamp(f + 1, 0, n - 1);
-    w[0] = 1.0 - t;
-    w[1] = t;
+    w[1] = s - first;
+    w[0] = 1.0f - w[1];
   }
 };
 
@@ -201,7 +201,8 @@ void UicProjection::splatAgents(std::span<const Vec2f> positions, std::span<cons
   }
   bucketAgents(positions);
 
-  const double ox = grid_.origin.x(), oy = grid_.origin.y(), invDx = 1.0 / grid_.dx;
+  const float ox = static_cast<float>(grid_.origin.x()), oy = static_cast<float>(grid_.origin.y());
+  const float invDx = static_cast<float>(1.0 / grid_.dx);
   const std::size_t slabs = buckets_.buckets();
   const std::span<const std::uint32_t> order = buckets_.order();
   const std::size_t xStride = static_cast<std::size_t>(nx) + 1, yStride = static_cast<std::size_t>(nx);
@@ -210,20 +211,20 @@ void UicProjection::splatAgents(std::span<const Vec2f> positions, std::span<cons
       const std::size_t slab = 2 * j + colour;
       for (std::size_t k = buckets_.begin(slab); k < buckets_.begin(slab + 1); ++k) {
         const std::uint32_t p = order[k];
-        const double sx = (double(positions[p].x()) - ox) * invDx, sy = (double(positions[p].y()) - oy) * invDx;
-        const Taps cx(sx - 0.5, nx), cy(sy - 0.5, ny), fx(sx, nx + 1), fy(sy, ny + 1);
+        const float sx = (positions[p].x() - ox) * invDx, sy = (positions[p].y() - oy) * invDx;
+        const Taps cx(sx - 0.5f, nx), cy(sy - 0.5f, ny), fx(sx, nx + 1), fy(sy, ny + 1);
         const float vx = preferredVelocities[p].x(), vy = preferredVelocities[p].y();
         const float speed = maxSpeeds[p];
         for (int b = 0; b < 2; ++b)
           for (int c = 0; c < 2; ++c) {
-            const auto wc = static_cast<float>(cy.w[b] * cx.w[c]);
+            const float wc = cy.w[b] * cx.w[c];
             cellMass_[static_cast<std::size_t>(cy.at[b]) * yStride + cx.at[c]] += wc;
             const std::size_t xi = static_cast<std::size_t>(cy.at[b]) * xStride + fx.at[c];
-            const auto wx = static_cast<float>(cy.w[b] * fx.w[c]);
+            const float wx = cy.w[b] * fx.w[c];
             faceMass_[0][xi] += wx;
             faceFlow_[0][xi] += wx * vx;
             const std::size_t yi = static_cast<std::size_t>(fy.at[b]) * yStride + cx.at[c];
-            const auto wy = static_cast<float>(fy.w[b] * cx.w[c]);
+            const float wy = fy.w[b] * cx.w[c];
             faceMass_[1][yi] += wy;
             faceFlow_[1][yi] += wy * vy;
             if (speeds) {
@@ -489,23 +490,24 @@ void UicProjection::agentVelocities(std::span<const Vec2f> positions, std::span<
   // One pass over the agents: r from the cells, v from both face grids (bilinear, folded taps as
   // in core/transfer.hpp's gather).
   const int nx = grid_.res.x(), ny = grid_.res.y();
-  const double ox = grid_.origin.x(), oy = grid_.origin.y(), invDx = 1.0 / grid_.dx;
+  const float ox = static_cast<float>(grid_.origin.x()), oy = static_cast<float>(grid_.origin.y());
+  const float invDx = static_cast<float>(1.0 / grid_.dx);
   const float* rc = ratio_.data().data();
   const float* ux = velocity_.component(0).data().data();
   const float* uy = velocity_.component(1).data().data();
   const std::size_t xStride = static_cast<std::size_t>(nx) + 1, yStride = static_cast<std::size_t>(nx);
   parallelFor(0, positions.size(), [&](std::size_t i) {
-    const double sx = (double(positions[i].x()) - ox) * invDx, sy = (double(positions[i].y()) - oy) * invDx;
-    const Taps cx(sx - 0.5, nx), cy(sy - 0.5, ny), fx(sx, nx + 1), fy(sy, ny + 1);
-    double r = 0.0, vx = 0.0, vy = 0.0;
+    const float sx = (positions[i].x() - ox) * invDx, sy = (positions[i].y() - oy) * invDx;
+    const Taps cx(sx - 0.5f, nx), cy(sy - 0.5f, ny), fx(sx, nx + 1), fy(sy, ny + 1);
+    float r = 0.0f, vx = 0.0f, vy = 0.0f;
     for (int b = 0; b < 2; ++b)
       for (int c = 0; c < 2; ++c) {
         r += cy.w[b] * cx.w[c] * rc[static_cast<std::size_t>(cy.at[b]) * yStride + cx.at[c]];
         vx += cy.w[b] * fx.w[c] * ux[static_cast<std::size_t>(cy.at[b]) * xStride + fx.at[c]];
         vy += fy.w[b] * cx.w[c] * uy[static_cast<std::size_t>(fy.at[b]) * yStride + cx.at[c]];
       }
-    const float ratio = std::clamp(static_cast<float>(r), 0.0f, 1.0f);
-    const Vec2f flow(static_cast<float>(vx), static_cast<float>(vy));
+    const float ratio = std::clamp(r, 0.0f, 1.0f);
+    const Vec2f flow(vx, vy);
     velocities[i] = preferredVelocities[i] + ratio * (flow - preferredVelocities[i]);
   }, 2048);
 }
