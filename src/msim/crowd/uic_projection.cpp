@@ -6,6 +6,10 @@
 #include <limits>
 #include <stdexcept>
 
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -157,101 +161,153 @@ struct Taps {
   }
 };
 
-}  // namespace
-
-// Agents bucketed once per projection into slabs of kSlabRows cell rows (stable counting sort with
-// per-block histograms, independent of the thread count). An agent in cell row r touches rows r - 1
-// to r + 1 of the cell and x-face grids and r to r + 1 of the y-face grid, so slabs two apart
-// never share a sample: even slabs run in parallel, then odd ones, each in input order, and every
-// sample sums its contributions in the same order whatever the thread count.
-void UicProjection::bucketAgents(std::span<const Vec2f> positions) {
-  const int ny = grid_.res.y();
-  const double oy = grid_.origin.y(), invDx = 1.0 / grid_.dx;
-  buckets_.sort(positions.size(), static_cast<std::size_t>((ny + kSlabRows - 1) / kSlabRows), [&](std::size_t i) {
-    const int row = std::clamp(static_cast<int>(std::floor((double(positions[i].y()) - oy) * invDx)), 0, ny - 1);
-    return static_cast<std::size_t>(row / kSlabRows);
-  });
+// p[q] += s w[q] for q < 4 (one 128-bit load, multiply-add and store where SSE is there).
+inline void addScaled4(float* p, float s, const float* w) {
+#if defined(__SSE2__)
+  _mm_storeu_ps(p, _mm_add_ps(_mm_loadu_ps(p), _mm_mul_ps(_mm_set1_ps(s), _mm_loadu_ps(w))));
+#else
+  for (int q = 0; q < 4; ++q) p[q] += s * w[q];
+#endif
 }
 
-// Eqs. 4.1-4.2 with the Linear (bilinear) kernel, all fields in one pass over the bucketed agents:
-// unit masses onto the cells and both face grids (Sum), and v~ (and the speeds, if they differ)
-// onto the faces, normalised by the face weight sums, which are the face masses.
+}  // namespace
+
+// Eqs. 4.1-4.2 with the Linear (bilinear) kernel, all fields in one pass over the agents: unit
+// masses onto the cells and both face grids (Sum), and v~ (and the speeds, if they differ) onto the
+// faces, normalised by the face weight sums, which are the face masses. The agents are split into
+// a fixed number of contiguous chunks (it depends on the agent count only), each splatted into
+// grids of its own in parallel; the chunks are then summed sample by sample in chunk order, so the
+// result does not depend on the thread count. Crowds are stored along a space-filling curve, so a
+// chunk's agents lie close together: its grids stay in cache, and only the rows it touched are
+// summed and zeroed again (the chunk grids are all zero between calls).
 void UicProjection::splatAgents(std::span<const Vec2f> positions, std::span<const Vec2f> preferredVelocities,
                                 std::span<const float> maxSpeeds, SpeedRange range) {
   const std::size_t n = positions.size();
   const int nx = grid_.res.x(), ny = grid_.res.y();
-  const float perArea = static_cast<float>(1.0 / (grid_.dx * grid_.dx));
   // The Normalized splat of a common speed is that speed wherever agents are, and renorm reads
   // v_max only there: skip the speed sums for uniform speeds (the usual case).
-  const double fastest = range.fastest;
   const bool speeds = n > 0 && range.slowest != range.fastest;
-
-  const std::size_t cells = density_.count(), xFaces = faceDensity_.component(0).count(),
-                    yFaces = faceDensity_.component(1).count();
-  auto zeroed = [](std::vector<float>& v, std::size_t size) {
-    v.resize(size);
-    parallelFor(0, size, [&](std::size_t i) { v[i] = 0.0f; }, 1 << 14);
-  };
-  zeroed(cellMass_, cells);
-  for (int a = 0; a < 2; ++a) {
-    const std::size_t size = a == 0 ? xFaces : yFaces;
-    zeroed(faceMass_[a], size);
-    zeroed(faceFlow_[a], size);
-    zeroed(faceSpeed_[a], speeds ? size : 0);
+  const std::size_t cells = density_.count(), faces[2] = {faceDensity_.component(0).count(),
+                                                          faceDensity_.component(1).count()};
+  const std::size_t chunks = std::clamp<std::size_t>((n + kChunkAgents - 1) / kChunkAgents, 1, kMaxChunks);
+  if (chunks_.size() < chunks) chunks_.resize(chunks);
+  for (std::size_t c = 0; c < chunks; ++c) {
+    SplatChunk& k = chunks_[c];
+    k.cellMass.resize(cells, 0.0f);
+    for (int a = 0; a < 2; ++a) {
+      k.faceMassFlow[a].resize(2 * faces[a], 0.0f);
+      if (speeds) k.faceSpeed[a].resize(faces[a], 0.0f);
+    }
   }
-  bucketAgents(positions);
 
   const float ox = static_cast<float>(grid_.origin.x()), oy = static_cast<float>(grid_.origin.y());
   const float invDx = static_cast<float>(1.0 / grid_.dx);
-  const std::size_t slabs = buckets_.buckets();
-  const std::span<const std::uint32_t> order = buckets_.order();
-  const std::size_t xStride = static_cast<std::size_t>(nx) + 1, yStride = static_cast<std::size_t>(nx);
-  for (std::size_t colour = 0; colour < 2; ++colour) {
-    tbb::parallel_for(std::size_t(0), (slabs + 1 - colour) / 2, [&](std::size_t j) {
-      const std::size_t slab = 2 * j + colour;
-      for (std::size_t k = buckets_.begin(slab); k < buckets_.begin(slab + 1); ++k) {
-        const std::uint32_t p = order[k];
-        const float sx = (positions[p].x() - ox) * invDx, sy = (positions[p].y() - oy) * invDx;
-        const Taps cx(sx - 0.5f, nx), cy(sy - 0.5f, ny), fx(sx, nx + 1), fy(sy, ny + 1);
-        const float vx = preferredVelocities[p].x(), vy = preferredVelocities[p].y();
-        const float speed = maxSpeeds[p];
-        for (int b = 0; b < 2; ++b)
-          for (int c = 0; c < 2; ++c) {
-            const float wc = cy.w[b] * cx.w[c];
-            cellMass_[static_cast<std::size_t>(cy.at[b]) * yStride + cx.at[c]] += wc;
-            const std::size_t xi = static_cast<std::size_t>(cy.at[b]) * xStride + fx.at[c];
-            const float wx = cy.w[b] * fx.w[c];
-            faceMass_[0][xi] += wx;
-            faceFlow_[0][xi] += wx * vx;
-            const std::size_t yi = static_cast<std::size_t>(fy.at[b]) * yStride + cx.at[c];
-            const float wy = fy.w[b] * cx.w[c];
-            faceMass_[1][yi] += wy;
-            faceFlow_[1][yi] += wy * vy;
-            if (speeds) {
-              faceSpeed_[0][xi] += wx * speed;
-              faceSpeed_[1][yi] += wy * speed;
-            }
-          }
+  const std::size_t stride[2] = {static_cast<std::size_t>(nx) + 1, static_cast<std::size_t>(nx)};  // x, y faces
+  const std::size_t cellStride = static_cast<std::size_t>(nx);
+  const std::size_t per = (n + chunks - 1) / chunks;
+  tbb::parallel_for(std::size_t(0), chunks, [&](std::size_t c) {
+    SplatChunk& k = chunks_[c];
+    float* const cellMass = k.cellMass.data();
+    float* const massFlowX = k.faceMassFlow[0].data();
+    float* const massFlowY = k.faceMassFlow[1].data();
+    float* const speedX = speeds ? k.faceSpeed[0].data() : nullptr;
+    float* const speedY = speeds ? k.faceSpeed[1].data() : nullptr;
+    const std::size_t xStride = stride[0], yStride = stride[1];
+    const Vec2f* const x = positions.data();
+    const Vec2f* const vPreferred = preferredVelocities.data();
+    const float* const vMax = maxSpeeds.data();
+    int rowLo = ny + 1, rowHi = -1;
+    for (std::size_t p = c * per, end = std::min(n, (c + 1) * per); p < end; ++p) {
+      const float sx = (x[p].x() - ox) * invDx, sy = (x[p].y() - oy) * invDx;
+      const float vx = vPreferred[p].x(), vy = vPreferred[p].y();
+      const Taps cx(sx - 0.5f, nx), cy(sy - 0.5f, ny), fx(sx, nx + 1), fy(sy, ny + 1);
+      rowLo = std::min({rowLo, cy.at[0], fy.at[0]});
+      rowHi = std::max({rowHi, cy.at[1], fy.at[1]});
+      for (int b = 0; b < 2; ++b) {
+        float* cellRow = cellMass + static_cast<std::size_t>(cy.at[b]) * cellStride;
+        cellRow[cx.at[0]] += cy.w[b] * cx.w[0];
+        cellRow[cx.at[1]] += cy.w[b] * cx.w[1];
       }
-    });
-  }
+      // (mass, flow) of the two columns of each face grid, interleaved as in faceMassFlow; rows of
+      // x faces from cy, of y faces from fy.
+      const float xw[4] = {fx.w[0], fx.w[0] * vx, fx.w[1], fx.w[1] * vx};
+      const float yw[4] = {cx.w[0], cx.w[0] * vy, cx.w[1], cx.w[1] * vy};
+      if (cx.at[1] == cx.at[0] + 1) {
+        // Away from the left and right sides (the usual case) both grids' columns are neighbours
+        // (sx lies in [cx.at[0] + 0.5, cx.at[0] + 1.5)): one block of four floats per row.
+        for (int b = 0; b < 2; ++b) {
+          addScaled4(massFlowX + 2 * (static_cast<std::size_t>(cy.at[b]) * xStride + fx.at[0]), cy.w[b], xw);
+          addScaled4(massFlowY + 2 * (static_cast<std::size_t>(fy.at[b]) * yStride + cx.at[0]), fy.w[b], yw);
+        }
+      } else {  // folded at a side
+        for (int b = 0; b < 2; ++b)
+          for (int a = 0; a < 2; ++a)
+            for (int q = 0; q < 2; ++q) {
+              massFlowX[2 * (static_cast<std::size_t>(cy.at[b]) * xStride + fx.at[a]) + q] += cy.w[b] * xw[2 * a + q];
+              massFlowY[2 * (static_cast<std::size_t>(fy.at[b]) * yStride + cx.at[a]) + q] += fy.w[b] * yw[2 * a + q];
+            }
+      }
+      if (speedX)
+        for (int b = 0; b < 2; ++b)
+          for (int a = 0; a < 2; ++a) {
+            speedX[static_cast<std::size_t>(cy.at[b]) * xStride + fx.at[a]] += cy.w[b] * fx.w[a] * vMax[p];
+            speedY[static_cast<std::size_t>(fy.at[b]) * yStride + cx.at[a]] += fy.w[b] * cx.w[a] * vMax[p];
+          }
+    }
+    k.rowLo = rowLo;
+    k.rowHi = rowHi;
+  }, tbb::simple_partitioner());
 
-  parallelFor(0, cells, [&](std::size_t i) { density_[i] = cellMass_[i] * perArea; }, 1 << 14);
-  for (int a = 0; a < 2; ++a) {
-    auto& rho = faceDensity_.component(a);
-    auto& v = preferred_.component(a);
-    auto& vmax = speed_.component(a);
-    const auto& mass = faceMass_[a];
-    const auto& flow = faceFlow_[a];
-    const auto& speedSum = faceSpeed_[a];
-    const float common = static_cast<float>(fastest);
-    parallelFor(0, rho.count(), [&](std::size_t i) {
-      const float m = mass[i];
-      rho[i] = m * perArea;
-      v[i] = m > 0.0f ? flow[i] / m : 0.0f;
-      vmax[i] = speeds ? (m > 0.0f ? speedSum[i] / m : 0.0f) : common;
-    }, 1 << 14);
-  }
+  // Sum the chunks row by row in chunk order (only the chunks whose rows include the row hold
+  // anything there), zeroing their copies, then normalise.
+  const float perArea = static_cast<float>(1.0 / (grid_.dx * grid_.dx));
+  const float common = range.fastest;
+  tbb::parallel_for(tbb::blocked_range<int>(0, ny + 1, 4), [&](const tbb::blocked_range<int>& rowRange) {
+    for (int j = rowRange.begin(); j != rowRange.end(); ++j) {
+      if (j < ny) {
+        float* rho = density_.data().data() + static_cast<std::size_t>(j) * cellStride;
+        std::fill(rho, rho + nx, 0.0f);
+        for (std::size_t c = 0; c < chunks; ++c) {
+          if (j < chunks_[c].rowLo || j > chunks_[c].rowHi) continue;
+          float* part = chunks_[c].cellMass.data() + static_cast<std::size_t>(j) * cellStride;
+          for (int i = 0; i < nx; ++i) rho[i] += part[i];
+          std::fill(part, part + nx, 0.0f);
+        }
+        for (int i = 0; i < nx; ++i) rho[i] *= perArea;
+      }
+      for (int axis = 0; axis < 2; ++axis) {
+        if (axis == 0 && j == ny) continue;  // x faces have ny rows, y faces ny + 1
+        const std::size_t width = stride[axis], first = static_cast<std::size_t>(j) * width;
+        float* rho = faceDensity_.component(axis).data().data() + first;  // the mass sums, then rho
+        float* vel = preferred_.component(axis).data().data() + first;   // the flow sums, then v~
+        float* vmax = speed_.component(axis).data().data() + first;      // the speed sums, then v_max
+        std::fill(rho, rho + width, 0.0f);
+        std::fill(vel, vel + width, 0.0f);
+        std::fill(vmax, vmax + width, speeds ? 0.0f : common);
+        for (std::size_t c = 0; c < chunks; ++c) {
+          SplatChunk& k = chunks_[c];
+          if (j < k.rowLo || j > k.rowHi) continue;
+          float* part = k.faceMassFlow[axis].data() + 2 * first;
+          for (std::size_t i = 0; i < width; ++i) {
+            rho[i] += part[2 * i];
+            vel[i] += part[2 * i + 1];
+          }
+          std::fill(part, part + 2 * width, 0.0f);
+          if (speeds) {
+            float* speedPart = k.faceSpeed[axis].data() + first;
+            for (std::size_t i = 0; i < width; ++i) vmax[i] += speedPart[i];
+            std::fill(speedPart, speedPart + width, 0.0f);
+          }
+        }
+        for (std::size_t i = 0; i < width; ++i) {
+          const float m = rho[i];
+          vel[i] = m > 0.0f ? vel[i] / m : 0.0f;
+          if (speeds) vmax[i] = m > 0.0f ? vmax[i] / m : 0.0f;
+          rho[i] = m * perArea;
+        }
+      }
+    }
+  });
 }
 
 // A of eq. 4.18: face weights rho_face dt / dx^2 on interior faces, walls (0) on the domain boundary.
@@ -496,20 +552,33 @@ void UicProjection::agentVelocities(std::span<const Vec2f> positions, std::span<
   const float* ux = velocity_.component(0).data().data();
   const float* uy = velocity_.component(1).data().data();
   const std::size_t xStride = static_cast<std::size_t>(nx) + 1, yStride = static_cast<std::size_t>(nx);
-  parallelFor(0, positions.size(), [&](std::size_t i) {
-    const float sx = (positions[i].x() - ox) * invDx, sy = (positions[i].y() - oy) * invDx;
-    const Taps cx(sx - 0.5f, nx), cy(sy - 0.5f, ny), fx(sx, nx + 1), fy(sy, ny + 1);
-    float r = 0.0f, vx = 0.0f, vy = 0.0f;
-    for (int b = 0; b < 2; ++b)
-      for (int c = 0; c < 2; ++c) {
-        r += cy.w[b] * cx.w[c] * rc[static_cast<std::size_t>(cy.at[b]) * yStride + cx.at[c]];
-        vx += cy.w[b] * fx.w[c] * ux[static_cast<std::size_t>(cy.at[b]) * xStride + fx.at[c]];
-        vy += fy.w[b] * cx.w[c] * uy[static_cast<std::size_t>(fy.at[b]) * yStride + cx.at[c]];
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, positions.size(), 2048), [&](const tbb::blocked_range<std::size_t>& range) {
+    // Local copies: the velocity stores (floats) could otherwise alias the captured scalars, which
+    // would then be loaded again for every agent.
+    const float x0 = ox, y0 = oy, scale = invDx;
+    const int cellsX = nx, cellsY = ny;
+    const std::size_t xs = xStride, ys = yStride;
+    const float *ratio = rc, *flowX = ux, *flowY = uy;
+    const Vec2f* x = positions.data();
+    const Vec2f* preferred = preferredVelocities.data();
+    Vec2f* out = velocities.data();
+    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+      const float sx = (x[i].x() - x0) * scale, sy = (x[i].y() - y0) * scale;
+      const Taps cx(sx - 0.5f, cellsX), cy(sy - 0.5f, cellsY), fx(sx, cellsX + 1), fy(sy, cellsY + 1);
+      float r = 0.0f, vx = 0.0f, vy = 0.0f;
+      for (int b = 0; b < 2; ++b) {
+        const float* ratioRow = ratio + static_cast<std::size_t>(cy.at[b]) * ys;
+        const float* xRow = flowX + static_cast<std::size_t>(cy.at[b]) * xs;
+        const float* yRow = flowY + static_cast<std::size_t>(fy.at[b]) * ys;
+        r += cy.w[b] * (cx.w[0] * ratioRow[cx.at[0]] + cx.w[1] * ratioRow[cx.at[1]]);
+        vx += cy.w[b] * (fx.w[0] * xRow[fx.at[0]] + fx.w[1] * xRow[fx.at[1]]);
+        vy += fy.w[b] * (cx.w[0] * yRow[cx.at[0]] + cx.w[1] * yRow[cx.at[1]]);
       }
-    const float ratio = std::clamp(r, 0.0f, 1.0f);
-    const Vec2f flow(vx, vy);
-    velocities[i] = preferredVelocities[i] + ratio * (flow - preferredVelocities[i]);
-  }, 2048);
+      const float share = std::clamp(r, 0.0f, 1.0f);
+      const Vec2f v = preferred[i];
+      out[i] = v + share * (Vec2f(vx, vy) - v);
+    }
+  });
 }
 
 const UicStats& UicProjection::project(std::span<const Vec2f> positions, std::span<const Vec2f> preferredVelocities,

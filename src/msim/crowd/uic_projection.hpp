@@ -35,7 +35,6 @@
 #include <span>
 #include <vector>
 
-#include "msim/core/bucket_sort.hpp"
 #include "msim/core/grid.hpp"
 #include "msim/core/mac_grid.hpp"
 #include "msim/core/transfer.hpp"
@@ -120,7 +119,6 @@ class UicProjection {
                       std::span<Vec2f> velocities) const;
   void splatAgents(std::span<const Vec2f> positions, std::span<const Vec2f> preferredVelocities,
                    std::span<const float> maxSpeeds, SpeedRange speeds);
-  void bucketAgents(std::span<const Vec2f> positions);
   void buildStencil(double dt);
   template <typename F>
   void forBox(const F& f) const;
@@ -137,13 +135,18 @@ class UicProjection {
   GridSpec<2> grid_;
   UicSettings settings_;
   UicStats stats_;
-  // Fused splat: agents bucketed once into slabs of kSlabRows cell rows. Single-precision
-  // accumulators (a cell sums tens of weights <= 1): half the memory of double, so the five grids
-  // of a 126^2 crowd grid stay in a 512 KB L2 cache.
-  static constexpr int kSlabRows = 4;
-  BucketSort buckets_;
-  std::vector<float> cellMass_;
-  std::array<std::vector<float>, 2> faceMass_, faceFlow_, faceSpeed_;
+  // Fused splat: each chunk of agents sums into grids of its own, zero between calls, and
+  // records the rows of samples it touched. Single-precision accumulators (a cell sums tens of
+  // weights <= 1): half the memory of double, so the five grids of a 126^2 crowd grid stay in a
+  // 512 KB L2 cache.
+  static constexpr std::size_t kChunkAgents = 16384, kMaxChunks = 8;
+  struct SplatChunk {
+    std::vector<float> cellMass;
+    std::array<std::vector<float>, 2> faceMassFlow;  // per face: mass, then flow (one block per two faces)
+    std::array<std::vector<float>, 2> faceSpeed;
+    int rowLo = 0, rowHi = -1;                         // rows of samples it holds
+  };
+  std::vector<SplatChunk> chunks_;
 
   Grid<float, 2> density_, pressure_, predicted_, freeArea_, ratio_;
   MacGrid<2> faceDensity_, preferred_, speed_, inner_, renormed_, velocity_;
