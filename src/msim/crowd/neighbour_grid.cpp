@@ -20,6 +20,8 @@ struct Bounds {
 // Points per counting block: below this a block's histogram costs more than it saves.
 constexpr std::size_t kBlockPoints = 1 << 14;
 constexpr std::size_t kMaxBlocks = 8;
+// Spans of cells the offset scan runs in parallel over.
+constexpr std::size_t kScanSpans = 64;
 
 }  // namespace
 
@@ -69,13 +71,10 @@ void NeighbourGrid::build(std::span<const Vecf<2>> points, float cellSize) {
   ny_ = static_cast<int>(std::floor(extent.y() / cs)) + 1;
   const std::size_t cells = static_cast<std::size_t>(nx_) * ny_;
 
-  // Same cell formula as visitCells, so a query sees exactly the cell a point was put in.
-  assignCells();
-
-  // Stable counting sort in blocks: each block counts its own points, an exclusive scan over
-  // (cell, block) turns the counts into write offsets, each block scatters its points. A stable
-  // sort has a unique result, so the order does not depend on the block or thread count.
-  // One block per thread at most: every block adds a cell-count row to zero and to scan.
+  // Stable counting sort in blocks: each block finds and counts the cells of its own points, an
+  // exclusive scan over (cell, block) turns the counts into write offsets, each block scatters its
+  // points. A stable sort has a unique result, so the order does not depend on the block or thread
+  // count. One block per thread at most: every block adds a cell-count row to zero and to scan.
   const std::size_t threads = static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
   const std::size_t blocks = std::clamp<std::size_t>(n / kBlockPoints, 1, std::min(kMaxBlocks, threads));
   const std::size_t per = (n + blocks - 1) / blocks;
@@ -84,20 +83,44 @@ void NeighbourGrid::build(std::span<const Vecf<2>> points, float cellSize) {
     std::uint32_t* count = blockCount_.data() + blk * cells;
     std::fill(count, count + cells, 0u);
     const std::size_t end = std::min(n, (blk + 1) * per);
-    for (std::size_t i = blk * per; i < end; ++i) ++count[cellOf_[i]];
-  });
-  cellStart_.resize(cells + 1);
-  std::uint32_t running = 0;
-  for (std::size_t c = 0; c < cells; ++c) {
-    cellStart_[c] = running;
-    for (std::size_t blk = 0; blk < blocks; ++blk) {
-      std::uint32_t& slot = blockCount_[blk * cells + c];
-      const std::uint32_t k = slot;
-      slot = running;
-      running += k;
+    // Same cell formula as visitCells, so a query sees exactly the cell a point was put in.
+    const Vecf<2> origin = origin_;
+    const float size = cellSize_;
+    const int lastX = nx_ - 1, lastY = ny_ - 1, rowLength = nx_;
+    for (std::size_t i = blk * per; i < end; ++i) {
+      const Vecf<2> rel = (points[i] - origin) / size;
+      const int cx = std::clamp(static_cast<int>(std::floor(rel.x())), 0, lastX);
+      const int cy = std::clamp(static_cast<int>(std::floor(rel.y())), 0, lastY);
+      const std::uint32_t c = static_cast<std::uint32_t>(cy) * rowLength + cx;
+      cellOf_[i] = c;
+      ++count[c];
     }
-  }
-  cellStart_[cells] = running;
+  });
+  // The exclusive scan over (cell, block), cell major, in parallel over spans of cells: the span
+  // totals first, then each span from its offset.
+  cellStart_.resize(cells + 1);
+  const std::size_t spans = std::min<std::size_t>(cells, kScanSpans), perSpan = (cells + spans - 1) / spans;
+  spanTotal_.assign(spans + 1, 0u);
+  tbb::parallel_for(std::size_t(0), spans, [&](std::size_t sp) {
+    std::uint32_t total = 0;
+    for (std::size_t c = sp * perSpan; c < std::min(cells, (sp + 1) * perSpan); ++c)
+      for (std::size_t blk = 0; blk < blocks; ++blk) total += blockCount_[blk * cells + c];
+    spanTotal_[sp + 1] = total;
+  });
+  for (std::size_t sp = 0; sp < spans; ++sp) spanTotal_[sp + 1] += spanTotal_[sp];
+  tbb::parallel_for(std::size_t(0), spans, [&](std::size_t sp) {
+    std::uint32_t running = spanTotal_[sp];
+    for (std::size_t c = sp * perSpan; c < std::min(cells, (sp + 1) * perSpan); ++c) {
+      cellStart_[c] = running;
+      for (std::size_t blk = 0; blk < blocks; ++blk) {
+        std::uint32_t& slot = blockCount_[blk * cells + c];
+        const std::uint32_t k = slot;
+        slot = running;
+        running += k;
+      }
+    }
+  });
+  cellStart_[cells] = static_cast<std::uint32_t>(n);
   tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t blk) {
     std::uint32_t* offset = blockCount_.data() + blk * cells;
     const std::size_t end = std::min(n, (blk + 1) * per);
@@ -107,19 +130,6 @@ void NeighbourGrid::build(std::span<const Vecf<2>> points, float cellSize) {
       sorted_[k] = points_[i];
     }
   });
-}
-
-void NeighbourGrid::assignCells() {
-  const std::span<const Vecf<2>> points = points_;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 1 << 14),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                        const Vecf<2> rel = (points[i] - origin_) / cellSize_;
-                        const int cx = std::clamp(static_cast<int>(std::floor(rel.x())), 0, nx_ - 1);
-                        const int cy = std::clamp(static_cast<int>(std::floor(rel.y())), 0, ny_ - 1);
-                        cellOf_[i] = static_cast<std::uint32_t>(cy) * nx_ + cx;
-                      }
-                    });
 }
 
 }  // namespace msim::crowd

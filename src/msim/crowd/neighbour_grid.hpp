@@ -67,7 +67,6 @@ class NeighbourGrid {
   void forEachCellInRows(int row0, int row1, F&& f) const;
 
  private:
-  void assignCells();  // cellOf_ from points_, in parallel
   // Calls f(k) for each slot k of order_ in the cells a disc of the radius around x touches.
   template <typename F>
   void visitCells(const Vecf<2>& x, float radius, F&& f) const;
@@ -81,6 +80,7 @@ class NeighbourGrid {
   std::vector<std::uint32_t> order_;
   std::vector<Vecf<2>> sorted_;  // points_[order_[k]]: the distance tests stream through memory
   std::vector<std::uint32_t> blockCount_;  // build scratch: per-block cell counts, then offsets
+  std::vector<std::uint32_t> spanTotal_;   // build scratch: points before each span of cells
 };
 
 template <typename F>
