@@ -5,6 +5,8 @@
 #include <span>
 
 #include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
 
 #include "msim/core/error.hpp"
 #include "msim/core/parallel.hpp"
@@ -16,12 +18,9 @@ constexpr int kRelaxSweeps = 50;
 
 // Largest radius and speed over the initial agents and every agent an inflow will create.
 void extremes(const Agents& agents, const std::vector<Inflow>& inflows, float& radius, float& speed) {
-  radius = 0.0f;
-  speed = 0.0f;
-  for (std::size_t i = 0; i < agents.size(); ++i) {
-    radius = std::max(radius, agents.radius[i]);
-    speed = std::max(speed, agents.maxSpeed[i]);
-  }
+  // Parallel: the time step asks for the fastest agent every step.
+  radius = static_cast<float>(parallelMax(agents.size(), [&](std::size_t i) { return agents.radius[i]; }));
+  speed = static_cast<float>(parallelMax(agents.size(), [&](std::size_t i) { return agents.maxSpeed[i]; }));
   for (const Inflow& f : inflows) {
     radius = std::max(radius, f.agent.radius);
     speed = std::max(speed, f.agent.maxSpeed);
@@ -335,12 +334,23 @@ void CrowdSimulation::step(double dt, StageTimers* timers) {
   StageTimers& t = timers ? *timers : local;
   if (!(dt > 0.0) || !std::isfinite(dt)) throw SimulationError(fmt::format("crowd: invalid time step {}", dt));
   stats_.agents = agents_.size();
-  stats_.uicAgents = stats_.orcaAgents = stats_.scriptedAgents = 0;
-  for (AgentModel m : agents_.model) {
-    if (m == AgentModel::Uic) ++stats_.uicAgents;
-    else if (m == AgentModel::Orca) ++stats_.orcaAgents;
-    else ++stats_.scriptedAgents;
-  }
+  // Agents of each model (one pass, in parallel: the count is exact whatever the order).
+  struct ModelCounts {
+    std::size_t uic = 0, orca = 0;
+  };
+  const ModelCounts counts = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, agents_.size(), 1 << 14), ModelCounts{},
+      [&](const tbb::blocked_range<std::size_t>& r, ModelCounts c) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+          c.uic += agents_.model[i] == AgentModel::Uic;
+          c.orca += agents_.model[i] == AgentModel::Orca;
+        }
+        return c;
+      },
+      [](ModelCounts a, const ModelCounts& b) { return ModelCounts{a.uic + b.uic, a.orca + b.orca}; });
+  stats_.uicAgents = counts.uic;
+  stats_.orcaAgents = counts.orca;
+  stats_.scriptedAgents = agents_.size() - counts.uic - counts.orca;
   if (!moving_.empty()) {
     ScopedStage s(t, "crowd: moving obstacles");
     placeMovingObstacles(time_ + dt);  // where they are at the end of the step

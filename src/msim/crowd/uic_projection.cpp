@@ -100,7 +100,19 @@ UicProjection::SpeedRange UicProjection::validate(std::span<const Vec2f> positio
   if (!freeArea.sameLayout(density_))
     throw InputError("UIC projection: the free-area grid does not match the crowd grid's cells");
   const Vec2 lo = grid_.origin, hi = grid_.upper();
-  // One pass: the first bad agent (the minimum index, so deterministic) and the speed range.
+  // One pass: the first bad agent (the minimum index, so deterministic) and the speed range. The
+  // test is branch-free (comparisons with NaN are false); a block with a bad agent is scanned
+  // again for the first one.
+  const float loX = static_cast<float>(lo.x()), loY = static_cast<float>(lo.y());
+  const float hiX = static_cast<float>(hi.x()), hiY = static_cast<float>(hi.y());
+  constexpr float kLargest = std::numeric_limits<float>::max();
+  auto good = [&](std::size_t i) {
+    const Vec2f& x = positions[i];
+    const Vec2f& v = preferredVelocities[i];
+    const float speed = maxSpeeds[i];
+    return (x.x() >= loX) & (x.x() <= hiX) & (x.y() >= loY) & (x.y() <= hiY) & (std::abs(v.x()) <= kLargest) &
+           (std::abs(v.y()) <= kLargest) & (speed >= 0.0f) & (speed <= kLargest);
+  };
   struct Scan {
     std::size_t bad;
     SpeedRange speeds;
@@ -109,17 +121,17 @@ UicProjection::SpeedRange UicProjection::validate(std::span<const Vec2f> positio
       tbb::blocked_range<std::size_t>(0, n, 4096),
       Scan{n, SpeedRange{0.0f, std::numeric_limits<float>::infinity()}},
       [&](const tbb::blocked_range<std::size_t>& r, Scan acc) {
+        bool all = true;
+        float fastest = acc.speeds.fastest, slowest = acc.speeds.slowest;
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
-          const Vec2f& x = positions[i];
-          const float v = maxSpeeds[i];
-          if (!x.allFinite() || !preferredVelocities[i].allFinite() || !std::isfinite(v) || v < 0.0f ||
-              x.x() < lo.x() || x.y() < lo.y() || x.x() > hi.x() || x.y() > hi.y()) {
-            acc.bad = std::min(acc.bad, i);
-            break;
-          }
-          acc.speeds.fastest = std::max(acc.speeds.fastest, v);
-          acc.speeds.slowest = std::min(acc.speeds.slowest, v);
+          all &= good(i);
+          fastest = std::max(fastest, maxSpeeds[i]);
+          slowest = std::min(slowest, maxSpeeds[i]);
         }
+        acc.speeds = SpeedRange{fastest, slowest};
+        if (!all)
+          for (std::size_t i = r.begin(); i != r.end() && i < acc.bad; ++i)
+            if (!good(i)) acc.bad = i;
         return acc;
       },
       [](Scan a, const Scan& b) {
