@@ -78,6 +78,7 @@ void BM_CircleScalingRun(benchmark::State& state) {
     state.PauseTiming();
     StageTimers timers;
     auto phenomenon = s.type->create(s, timers);
+    timers.reset();  // the stage counters per step, without the first frame's metrics
     state.ResumeTiming();
     for (int k = 0; k < kSteps; ++k) phenomenon->step(phenomenon->stableTimestep());
     state.PauseTiming();

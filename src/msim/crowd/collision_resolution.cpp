@@ -331,6 +331,7 @@ CollisionResolver::SweepMoves CollisionResolver::localSweep(const StaticObstacle
     g.end = end;
     g.touched.clear();
     g.deferred.clear();
+    g.active.clear();
     q = end;
   }
   // Active agent i of group g: its pairs with every agent within range now, which lies in the
@@ -408,6 +409,7 @@ CollisionResolver::SweepMoves CollisionResolver::localSweep(const StaticObstacle
             const float cx = x.x() - checkX_[slot], cy = x.y() - checkY_[slot];
             active_[slot] = cx * cx + cy * cy > tolerance2 ? 1 : 0;
             m.active += active_[slot];
+            if (active_[slot]) rowGroups_[k].active.push_back(slot);
           }
         return m;
       },
@@ -416,8 +418,7 @@ CollisionResolver::SweepMoves CollisionResolver::localSweep(const StaticObstacle
       });
   activeSlots_.clear();
   for (std::size_t k = 0; k < groups; ++k)
-    for (const std::uint32_t slot : rowGroups_[k].touched)
-      if (active_[slot]) activeSlots_.push_back(slot);
+    activeSlots_.insert(activeSlots_.end(), rowGroups_[k].active.begin(), rowGroups_[k].active.end());
   std::sort(activeSlots_.begin(), activeSlots_.end());
   return moves;
 }

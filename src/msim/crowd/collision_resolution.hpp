@@ -132,12 +132,12 @@ class CollisionResolver {
   std::vector<std::uint8_t> active_, touchedMark_;
   std::vector<std::uint32_t> activeSlots_;
   // Local sweeps: the active agents of one row of cells (activeSlots_[begin, end)), the agents
-  // the group moved, its scratch (the slot ranges near an agent), the agents it left to the serial
-  // pass, and its F^2.
+  // the group moved and those of them still active after the sweep, its scratch (the slot ranges
+  // near an agent), the agents it left to the serial pass, and its F^2.
   struct RowGroup {
     int row = 0;
     std::size_t begin = 0, end = 0;
-    std::vector<std::uint32_t> touched, lo, hi, deferred;
+    std::vector<std::uint32_t> touched, active, lo, hi, deferred;
     float farthest2 = 0.0f;
   };
   std::vector<RowGroup> rowGroups_;
