@@ -139,7 +139,7 @@ class UicProjection {
   // records the rows of samples it touched. Single-precision accumulators (a cell sums tens of
   // weights <= 1): half the memory of double, so the five grids of a 126^2 crowd grid stay in a
   // 512 KB L2 cache.
-  static constexpr std::size_t kChunkAgents = 16384, kMaxChunks = 8;
+  static constexpr std::size_t kChunkAgents = 32768, kMaxChunks = 8;
   struct SplatChunk {
     std::vector<float> cellMass;
     std::array<std::vector<float>, 2> faceMassFlow;  // per face: mass, then flow (one block per two faces)
