@@ -61,26 +61,6 @@ void advance(IVec<D>& c, const IVec<D>& res) {
   }
 }
 
-// Previous cell coordinate in x-fastest order.
-template <int D>
-void retreat(IVec<D>& c, const IVec<D>& res) {
-  for (int a = 0; a < D; ++a) {
-    if (--c[a] >= 0) return;
-    c[a] = res[a] - 1;
-  }
-}
-
-// Coordinates of cell i (x fastest).
-template <int D>
-IVec<D> coordOf(std::size_t i, const IVec<D>& res) {
-  IVec<D> c;
-  for (int a = 0; a < D; ++a) {
-    c[a] = static_cast<int>(i % static_cast<std::size_t>(res[a]));
-    i /= static_cast<std::size_t>(res[a]);
-  }
-  return c;
-}
-
 // Parallel copy (same size) for large arrays.
 void copyInto(const std::vector<double>& from, std::vector<double>& to) {
   to.resize(from.size());
@@ -193,8 +173,7 @@ GridMic0FacePreconditioner<D>::GridMic0FacePreconditioner(const IVec<D>& res,
       free_(diagonal_.size(), 1),
       precon_(diagonal_.size(), 0.0),
       q_(diagonal_.size(), 0.0) {
-  freeList_.reserve(diagonal_.size());
-  for (std::size_t i = 0; i < diagonal_.size(); ++i) freeList_.push_back(i);
+  listFreeCells();
   if (!(settings.tau >= 0.0 && settings.tau <= 1.0) || !(settings.sigma >= 0.0 && settings.sigma <= 1.0))
     throw std::invalid_argument("GridMic0FacePreconditioner: need 0 <= tau <= 1 and 0 <= sigma <= 1");
   factor();
@@ -209,12 +188,26 @@ void GridMic0FacePreconditioner<D>::setFace(const std::vector<std::uint8_t>& fre
                             [](std::uint8_t a, std::uint8_t b) { return (a != 0) == (b != 0); }))
     return;
   for (std::size_t i : freeList_) precon_[i] = 0.0;  // the old face; the new one is factored below
-  freeList_.clear();
-  for (std::size_t i = 0; i < free.size(); ++i) {
-    free_[i] = free[i] ? 1 : 0;
-    if (free_[i]) freeList_.push_back(i);
-  }
+  for (std::size_t i = 0; i < free.size(); ++i) free_[i] = free[i] ? 1 : 0;
+  listFreeCells();
   factor();
+}
+
+template <int D>
+void GridMic0FacePreconditioner<D>::listFreeCells() {
+  freeList_.clear();
+  neighbours_.clear();
+  IVec<D> c = IVec<D>::Zero();
+  for (std::size_t i = 0; i < free_.size(); ++i, advance<D>(c, res_)) {
+    if (!free_[i]) continue;
+    std::uint8_t bits = 0;
+    for (int a = 0; a < D; ++a) {
+      if (c[a] > 0) bits |= std::uint8_t(1u << a);
+      if (c[a] + 1 < res_[a]) bits |= std::uint8_t(1u << (D + a));
+    }
+    freeList_.push_back(i);
+    neighbours_.push_back(bits);
+  }
 }
 
 template <int D>
@@ -235,8 +228,7 @@ void GridMic0FacePreconditioner<D>::assign(const IVec<D>& res, const std::array<
     free_.assign(n, 1);
     precon_.assign(n, 0.0);
     q_.assign(n, 0.0);
-    freeList_.clear();
-    for (std::size_t i = 0; i < n; ++i) freeList_.push_back(i);
+    listFreeCells();
   }
   stale_ = true;
 }
@@ -253,18 +245,19 @@ void GridMic0FacePreconditioner<D>::factor() {
   const double tau = settings_.tau, sigma = settings_.sigma;
   // Held cells keep precon = 0 (setFace() zeroes the old face), so only the free cells, in
   // increasing order, need the sweep.
-  for (const std::size_t i : freeList_) {
-    const IVec<D> c = coordOf<D>(i, res_);
+  for (std::size_t f = 0; f < freeList_.size(); ++f) {
+    const std::size_t i = freeList_[f];
+    const unsigned bits = neighbours_[f];
     double e = diagonal_[i];
     for (int a = 0; a < D; ++a) {
-      if (c[a] == 0) continue;
+      if (!(bits & (1u << a))) continue;
       const std::size_t j = i - stride_[a];
       const double pj = precon_[j];
       if (pj == 0.0) continue;
       const double w = lower_[a][i];
       double fill = 0.0;  // couplings of j to its other upper neighbours: the fill-in that (j, i) would create
       for (int b = 0; b < D; ++b) {
-        if (b == a || c[b] + 1 >= res_[b]) continue;  // j shares i's coordinate on axes b != a
+        if (b == a || !(bits & (1u << (D + b)))) continue;  // j shares i's coordinate on axes b != a
         const std::size_t k = j + stride_[b];
         if (free_[k]) fill += lower_[b][k];
       }
@@ -287,19 +280,21 @@ void GridMic0FacePreconditioner<D>::apply(const Eigen::VectorXd& g, Eigen::Vecto
   // Only the free cells carry values: q on held cells may be stale but is multiplied by their
   // precon = 0, and z is zeroed first so the held neighbours contribute nothing to L^T z = q.
   z.setZero();
-  for (const std::size_t i : freeList_) {  // L q = g
-    const IVec<D> c = coordOf<D>(i, res_);
+  const std::size_t count = freeList_.size();
+  for (std::size_t f = 0; f < count; ++f) {  // L q = g
+    const std::size_t i = freeList_[f];
+    const unsigned bits = neighbours_[f];
     double t = g[i];
     for (int a = 0; a < D; ++a)
-      if (c[a] > 0) t += lower_[a][i] * pc[i - stride_[a]] * q[i - stride_[a]];
+      if (bits & (1u << a)) t += lower_[a][i] * pc[i - stride_[a]] * q[i - stride_[a]];
     q[i] = t * pc[i];
   }
-  for (auto it = freeList_.rbegin(); it != freeList_.rend(); ++it) {  // L^T z = q, reverse order
-    const std::size_t i = *it;
-    const IVec<D> c = coordOf<D>(i, res_);
+  for (std::size_t f = count; f-- > 0;) {  // L^T z = q, reverse order
+    const std::size_t i = freeList_[f];
+    const unsigned bits = neighbours_[f];
     double t = q[i];
     for (int a = 0; a < D; ++a)
-      if (c[a] + 1 < res_[a]) t += lower_[a][i + stride_[a]] * pc[i] * z[i + stride_[a]];
+      if (bits & (1u << (D + a))) t += lower_[a][i + stride_[a]] * pc[i] * z[i + stride_[a]];
     z[i] = t * pc[i];
   }
 }

@@ -95,6 +95,8 @@ class GridMic0FacePreconditioner final : public QpFacePreconditioner {
 
  private:
   void factor();
+  // freeList_ and neighbours_ from free_ (one pass in cell order).
+  void listFreeCells();
 
   IVec<D> res_;
   std::array<std::size_t, D> stride_{};
@@ -104,6 +106,9 @@ class GridMic0FacePreconditioner final : public QpFacePreconditioner {
   std::vector<std::uint8_t> free_;
   std::vector<double> precon_;  // 1 / L_ii on the face, 0 off it
   std::vector<std::size_t> freeList_;  // the free cells in increasing order
+  // Per free cell, which neighbours exist: bit a the lower one on axis a, bit D + a the upper one
+  // (kept with the list, so the sweeps need no coordinates, i.e. no divisions).
+  std::vector<std::uint8_t> neighbours_;
   std::vector<double> q_;       // L q = g (meaningful on the face only)
   int factorizations_ = 0;
   bool stale_ = false;          // stencil replaced since the last factorisation
