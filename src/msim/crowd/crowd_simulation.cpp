@@ -10,6 +10,7 @@
 
 #include "msim/core/error.hpp"
 #include "msim/core/parallel.hpp"
+#include "msim/crowd/direct_planner.hpp"
 
 namespace msim::crowd {
 namespace {
@@ -182,10 +183,9 @@ void CrowdSimulation::plan() {
       agents_.preferredVelocity[i].setZero();
       return;
     }
-    const double dist = std::sqrt(dist2);
-    if (!goal.exit) speed = std::min(speed, dist);
-    // DirectPlanner::direction, formed here from the compact copy.
-    const Vec2 direction = !straight ? planner_->direction(g, x) : dist > 1e-12 ? Vec2(d / dist) : Vec2::Zero();
+    if (!goal.exit) speed = std::min(speed, std::sqrt(dist2));
+    // The straight direction formed here from the compact copy, without a call per agent.
+    const Vec2 direction = straight ? DirectPlanner::unitTowards(d) : planner_->direction(g, x);
     agents_.preferredVelocity[i] = (speed * direction).cast<float>();
   });
 }

@@ -11,9 +11,7 @@ Vec2 DirectPlanner::target(std::size_t goal, const Vec2& position) const {
 }
 
 Vec2 DirectPlanner::direction(std::size_t goal, const Vec2& position) const {
-  const Vec2 d = target(goal, position) - position;
-  const double n = d.norm();
-  return n > 1e-12 ? Vec2(d / n) : Vec2::Zero();
+  return unitTowards(target(goal, position) - position);
 }
 
 double DirectPlanner::distance(std::size_t goal, const Vec2& position) const {

@@ -18,6 +18,11 @@ class DirectPlanner final : public GlobalPlanner {
   Vec2 direction(std::size_t goal, const Vec2& position) const override;
   double distance(std::size_t goal, const Vec2& position) const override;
   bool straightToPointGoals() const override { return true; }
+  // The unit vector along d (from an agent to its target), zero when the agent is there.
+  static Vec2 unitTowards(const Vec2& d) {
+    const double n = d.norm();
+    return n > 1e-12 ? Vec2(d / n) : Vec2::Zero();
+  }
 
  private:
   Vec2 target(std::size_t goal, const Vec2& position) const;

@@ -142,7 +142,7 @@ class UicProjection {
   static constexpr std::size_t kChunkAgents = 32768, kMaxChunks = 8;
   struct SplatChunk {
     std::vector<float> cellMass;
-    std::array<std::vector<float>, 2> faceMassFlow;  // per face: mass, then flow (one block per two faces)
+    std::array<std::vector<float>, 2> faceMassFlow;  // per face its mass and its flow, interleaved
     std::array<std::vector<float>, 2> faceSpeed;
     int rowLo = 0, rowHi = -1;                         // rows of samples it holds
   };
