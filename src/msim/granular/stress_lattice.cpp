@@ -1,6 +1,10 @@
 #include "msim/granular/stress_lattice.hpp"
 
 #include <algorithm>
+#include <utility>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include "msim/core/parallel.hpp"
 
@@ -47,49 +51,83 @@ IVec3 latticeSize(const StressComponent& c, const IVec3& cells) {
 
 namespace {
 
-bool insideBox(const IVec3& n, const IVec3& q) {
-  return q[0] >= 0 && q[1] >= 0 && q[2] >= 0 && q[0] < n[0] && q[1] < n[1] && q[2] < n[2];
+// The faces of one axis that component c acts on, as the two samples each face reads: face f of
+// axis `faceAxis` gets s(f + plus) - s(f + minus) (the rows of D_c; forEachFaceSample). Two
+// samples share a face only as such a pair, and the pair's upper sample q has its lower neighbour
+// q - e_lowerAxis across face q - plus.
+struct FaceLinks {
+  int faceAxis, lowerAxis;
+  IVec3 plus, minus;
+};
+
+// Diagonal a: face-a f reads s(f) - s(f - e_a). OffDiagonal (a, b): face-a f reads
+// s(f + e_b) - s(f), face-b f reads s(f + e_a) - s(f).
+int faceLinks(const StressComponent& c, std::array<FaceLinks, 2>& out) {
+  const IVec3 zero = IVec3::Zero();
+  if (c.diagonal()) {
+    out[0] = {c.a, c.a, zero, -IVec3::Unit(c.a)};
+    return 1;
+  }
+  out[0] = {c.a, c.b, IVec3::Unit(c.b), zero};
+  out[1] = {c.b, c.a, IVec3::Unit(c.a), zero};
+  return 2;
 }
 
-// The faces sample q of component c touches, with the sign of its contribution: calls
-// f(face axis, face index q_f, sign). Diagonal a: +1 on its lower face-a q, -1 on the upper q + e_a.
-// OffDiagonal (a, b): on face-a q - e_b with +1 and face-a q with -1 (the b-difference), and on
-// face-b q - e_a with +1 and face-b q with -1 (the a-difference); edges on the domain boundary
-// have only the faces that exist.
+// Row (y, z) of a grid of size n seen in a grid of size m shifted by delta: element x of the row
+// is element base + x of m, for x in [x0, x1) (where x + delta.x lies inside m). False if the row
+// lies outside m or no x does.
+struct ShiftedRow {
+  std::ptrdiff_t base = 0;
+  int x0 = 0, x1 = 0;
+};
+bool shiftRow(const IVec3& n, const IVec3& m, const IVec3& delta, int y, int z, ShiftedRow& r) {
+  const int yy = y + delta[1], zz = z + delta[2];
+  if (yy < 0 || yy >= m[1] || zz < 0 || zz >= m[2]) return false;
+  r.base = (static_cast<std::ptrdiff_t>(zz) * m[1] + yy) * m[0] + delta[0];
+  r.x0 = std::max(0, -delta[0]);
+  r.x1 = std::min(n[0], m[0] - delta[0]);
+  return r.x0 < r.x1;
+}
+
+// f(y, z, index of the row's first element) for every x-row of a grid of size n, in parallel
+// (rows are independent; about 4096 elements per task).
 template <typename F>
-void forEachLink(const StressComponent& c, const FaceField& faces, const IVec3& q, F&& f) {
-  if (c.diagonal()) {
-    f(c.a, q, 1.0);
-    IVec3 up = q;
-    up[c.a] += 1;
-    f(c.a, up, -1.0);
-    return;
-  }
-  for (const auto& [faceAxis, diffAxis] : {std::pair{c.a, c.b}, std::pair{c.b, c.a}}) {
-    const IVec3 n = faces.size(faceAxis);
-    IVec3 below = q;
-    below[diffAxis] -= 1;
-    if (insideBox(n, below)) f(faceAxis, below, 1.0);
-    if (insideBox(n, q)) f(faceAxis, q, -1.0);
-  }
+void forRows(const IVec3& n, const F& f) {
+  const std::size_t rows = static_cast<std::size_t>(n[1]) * n[2];
+  const std::size_t grain = std::max<std::size_t>(1, 4096 / std::max(1, n[0]));
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows, grain), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t row = r.begin(); row != r.end(); ++row)
+      f(static_cast<int>(row % static_cast<std::size_t>(n[1])), static_cast<int>(row / static_cast<std::size_t>(n[1])),
+        row * static_cast<std::size_t>(n[0]));
+  });
 }
 
 }  // namespace
 
+// The three passes below run row by row: along a row the samples a face reads (and the faces a
+// sample touches) sit at fixed offsets, so the inner loops only index arrays.
 void addDivergence(const StressComponent& c, const std::vector<double>& s, double scale, double dx,
                    const FaceField& mask, FaceField& force) {
   // Gather form (each face reads the samples around it), so the faces can be written in parallel.
   const IVec3 lattice = latticeSize(c, force.res);
   const double k = scale / dx;
-  for (int faceAxis = 0; faceAxis < 3; ++faceAxis) {
-    if (c.diagonal() ? faceAxis != c.a : (faceAxis != c.a && faceAxis != c.b)) continue;
-    std::vector<double>& out = force.values[faceAxis];
-    const std::vector<double>& m = mask.values[faceAxis];
-    parallelForCells<3>(force.size(faceAxis), [&](const IVec3& f, std::size_t i) {
-      if (m[i] == 0.0) return;
-      double d = 0.0;
-      forEachFaceSample(c, lattice, faceAxis, f, [&](std::size_t q, double sign) { d += sign * s[q]; });
-      out[i] += k * d;
+  std::array<FaceLinks, 2> links;
+  const int count = faceLinks(c, links);
+  for (int e = 0; e < count; ++e) {
+    const FaceLinks& l = links[static_cast<std::size_t>(e)];
+    const IVec3 n = force.size(l.faceAxis);
+    double* out = force.values[l.faceAxis].data();
+    const double* m = mask.values[l.faceAxis].data();
+    forRows(n, [&](int y, int z, std::size_t row) {
+      ShiftedRow hi, lo;
+      if (!shiftRow(n, lattice, l.plus, y, z, hi)) hi.x0 = hi.x1 = 0;
+      if (!shiftRow(n, lattice, l.minus, y, z, lo)) lo.x0 = lo.x1 = 0;
+      for (int x = std::min(hi.x0, lo.x0); x < std::max(hi.x1, lo.x1); ++x) {
+        if (m[row + x] == 0.0) continue;
+        const double up = x >= hi.x0 && x < hi.x1 ? s[static_cast<std::size_t>(hi.base + x)] : 0.0;
+        const double down = x >= lo.x0 && x < lo.x1 ? s[static_cast<std::size_t>(lo.base + x)] : 0.0;
+        out[row + x] += k * (up - down);
+      }
     });
   }
 }
@@ -99,13 +137,26 @@ void divergenceTranspose(const StressComponent& c, const FaceField& u, double dx
   const IVec3 lattice = latticeSize(c, u.res);
   out.assign(static_cast<std::size_t>(lattice[0]) * lattice[1] * lattice[2], 0.0);
   const double k = 1.0 / dx;
-  parallelForCells<3>(lattice, [&](const IVec3& q, std::size_t i) {
-    double sum = 0.0;
-    forEachLink(c, u, q, [&](int axis, const IVec3& f, double sign) {
-      const std::size_t fi = u.index(axis, f);
-      if (mask.values[axis][fi] != 0.0) sum += sign * u.values[axis][fi];
-    });
-    out[i] = k * sum;
+  std::array<FaceLinks, 2> links;
+  const int count = faceLinks(c, links);
+  forRows(lattice, [&](int y, int z, std::size_t row) {
+    double* o = out.data() + row;
+    // Sample q reads +u on face q - plus and -u on face q - minus (masked faces count as 0).
+    for (int e = 0; e < count; ++e) {
+      const FaceLinks& l = links[static_cast<std::size_t>(e)];
+      const IVec3 n = u.size(l.faceAxis);
+      const double* v = u.values[l.faceAxis].data();
+      const double* m = mask.values[l.faceAxis].data();
+      for (const auto& [delta, sign] : {std::pair{l.plus, 1.0}, std::pair{l.minus, -1.0}}) {
+        ShiftedRow r;
+        if (!shiftRow(lattice, n, -delta, y, z, r)) continue;
+        for (int x = r.x0; x < r.x1; ++x) {
+          const std::size_t f = static_cast<std::size_t>(r.base + x);
+          if (m[f] != 0.0) o[x] += sign * v[f];
+        }
+      }
+    }
+    for (int x = 0; x < lattice[0]; ++x) o[x] *= k;
   });
 }
 
@@ -116,26 +167,34 @@ void poissonStencil(const StressComponent& c, const FaceField& weight, double dx
   for (auto& w : lowerWeight) w.assign(count, 0.0);
   diagonal.assign(count, 0.0);
   const double k = 1.0 / (dx * dx);
-  auto w = [&](int axis, const IVec3& f) {
-    const std::size_t fi = weight.index(axis, f);
-    return mask.values[axis][fi] != 0.0 ? weight.values[axis][fi] * k : 0.0;
-  };
-  parallelForCells<3>(lattice, [&](const IVec3& q, std::size_t i) {
-    double d = 0.0;
-    forEachLink(c, weight, q, [&](int axis, const IVec3& f, double) { d += w(axis, f); });
-    diagonal[i] = d > 0.0 ? d : isolated;
-    // The link to q - e_l shares one face: for a diagonal component the lower face-a (l = a); for
-    // an off-diagonal one the face-a q - e_b (l = b) or the face-b q - e_a (l = a).
-    for (int l = 0; l < 3; ++l) {
-      if (q[l] == 0) continue;
-      if (c.diagonal() && l == c.a) lowerWeight[l][i] = w(c.a, q);
-      if (!c.diagonal() && (l == c.a || l == c.b)) {
-        const int faceAxis = l == c.b ? c.a : c.b;
-        IVec3 f = q;
-        f[l] -= 1;
-        if (insideBox(weight.size(faceAxis), f)) lowerWeight[l][i] = w(faceAxis, f);
+  std::array<FaceLinks, 2> links;
+  const int linkCount = faceLinks(c, links);
+  forRows(lattice, [&](int y, int z, std::size_t row) {
+    double* d = diagonal.data() + row;
+    for (int e = 0; e < linkCount; ++e) {
+      const FaceLinks& l = links[static_cast<std::size_t>(e)];
+      const IVec3 n = weight.size(l.faceAxis);
+      const double* w = weight.values[l.faceAxis].data();
+      const double* m = mask.values[l.faceAxis].data();
+      // The upper sample of a pair links to its lower neighbour across face q - plus (not on the
+      // lattice's lower side along the link's axis).
+      const int yz[3] = {0, y, z};
+      double* lower = lowerWeight[l.lowerAxis].data() + row;
+      const int firstX = l.lowerAxis == 0 ? 1 : 0;
+      const bool rowLinks = l.lowerAxis == 0 || yz[l.lowerAxis] > 0;
+      for (const auto& [delta, plus] : {std::pair{l.plus, true}, std::pair{l.minus, false}}) {
+        ShiftedRow r;
+        if (!shiftRow(lattice, n, -delta, y, z, r)) continue;
+        for (int x = r.x0; x < r.x1; ++x) {
+          const std::size_t f = static_cast<std::size_t>(r.base + x);
+          const double wf = m[f] != 0.0 ? w[f] * k : 0.0;
+          d[x] += wf;
+          if (plus && rowLinks && x >= firstX) lower[x] = wf;
+        }
       }
     }
+    for (int x = 0; x < lattice[0]; ++x)
+      if (!(d[x] > 0.0)) d[x] = isolated;
   });
 }
 
