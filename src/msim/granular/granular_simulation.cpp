@@ -180,17 +180,24 @@ void GranularSimulation::rasterizeBodies(double dt) {
           any |= f > 0.0;
         }
     if (!any) continue;
+    // Face fractions, the mean of the two cells: nonzero only on the faces of the box's cells.
     c.faceFraction = FaceField(g.res);
-    for (int a = 0; a < 3; ++a)
-      parallelForCells<3>(c.faceFraction.size(a), [&](const IVec3& q, std::size_t i) {
-        IVec3 below = q;
-        below[a] -= 1;
-        auto cell = [&](const IVec3& k) {
-          if (k[a] < 0 || k[a] >= g.res[a]) return 0.0;
-          return c.cellFraction[(static_cast<std::size_t>(k[2]) * g.res[1] + k[1]) * g.res[0] + k[0]];
-        };
-        c.faceFraction.values[a][i] = 0.5 * (cell(q) + cell(below));
-      });
+    for (int a = 0; a < 3; ++a) {
+      const IVec3 n = c.faceFraction.size(a);
+      for (int z = lo[2]; z <= hi[2] + (a == 2); ++z)
+        for (int y = lo[1]; y <= hi[1] + (a == 1); ++y)
+          for (int x = lo[0]; x <= hi[0] + (a == 0); ++x) {
+            const IVec3 q(x, y, z);
+            IVec3 below = q;
+            below[a] -= 1;
+            auto cell = [&](const IVec3& k) {
+              if (k[a] < 0 || k[a] >= g.res[a]) return 0.0;
+              return c.cellFraction[(static_cast<std::size_t>(k[2]) * g.res[1] + k[1]) * g.res[0] + k[0]];
+            };
+            c.faceFraction.values[a][(static_cast<std::size_t>(z) * n[1] + y) * n[0] + x] =
+                0.5 * (cell(q) + cell(below));
+          }
+    }
     bodies_.push_back(std::move(c));
     bodyIndex_.push_back(static_cast<int>(k));
   }
