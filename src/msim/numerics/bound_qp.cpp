@@ -178,10 +178,21 @@ BoundQpResult BoundQpSolver::solveBox(const QpOperator& A, const Eigen::VectorXd
   // After a step that may change the free set, restart CG from the new preconditioned free
   // gradient (the face changed, so the old conjugate directions are no longer A_FF-conjugate).
   auto restart = [&] {
-    setFace(p, preconditioner);
-    precondition(preconditioner);
+    if (preconditioner) {  // it needs the whole face before it can apply
+      setFace(p, preconditioner);
+      precondition(preconditioner);
+      forBlocks(n, [&](Eigen::Index begin, Eigen::Index end) {
+        for (Eigen::Index i = begin; i < end; ++i) d_[i] = z_[i];
+      });
+      return;
+    }
+    // Diagonal (or no) preconditioning is entrywise: the face, z and d in one pass.
     forBlocks(n, [&](Eigen::Index begin, Eigen::Index end) {
-      for (Eigen::Index i = begin; i < end; ++i) d_[i] = z_[i];
+      for (Eigen::Index i = begin; i < end; ++i) {
+        free_[i] = p[i] > lo(i) && p[i] < hi(i) ? 1 : 0;
+        z_[i] = free_[i] ? (jacobi_ ? g_[i] * invDiagonal_[i] : g_[i]) : 0.0;
+        d_[i] = z_[i];
+      }
     });
   };
   updateGradient();
