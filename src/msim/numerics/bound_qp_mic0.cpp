@@ -78,22 +78,6 @@ void forSlices(const IVec<D>& res, std::size_t sliceSize, int begin, int end, co
   for (std::size_t i = static_cast<std::size_t>(begin) * sliceSize; i < stop; advance<D>(c, res), ++i) f(c, i);
 }
 
-// f(c, i) over all cells; parallel over slices of the slowest axis for large grids (each cell is
-// independent, so the result does not depend on the split).
-template <int D, typename F>
-void forCells(const IVec<D>& res, const F& f) {
-  std::size_t slice = 1;
-  for (int a = 0; a + 1 < D; ++a) slice *= static_cast<std::size_t>(res[a]);
-  const std::size_t n = slice * static_cast<std::size_t>(res[D - 1]);
-  if (n < (1u << 15)) {
-    forSlices<D>(res, slice, 0, res[D - 1], f);
-    return;
-  }
-  const int grain = static_cast<int>(std::max<std::size_t>(1, (1u << 13) / slice));
-  tbb::parallel_for(tbb::blocked_range<int>(0, res[D - 1], grain),
-                    [&](const tbb::blocked_range<int>& r) { forSlices<D>(res, slice, r.begin(), r.end(), f); });
-}
-
 }  // namespace
 
 template <int D>
@@ -145,13 +129,41 @@ void GridPoissonQpOperator<D>::computeNormBound() {
 
 template <int D>
 void GridPoissonQpOperator<D>::apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
-  forCells<D>(res_, [&](const IVec<D>& c, std::size_t i) {
-    double s = diagonal_[i] * x[i];
-    for (int a = 0; a < D; ++a) {
-      if (c[a] > 0) s -= lower_[a][i] * x[i - stride_[a]];
-      if (c[a] + 1 < res_[a]) s -= lower_[a][i + stride_[a]] * x[i + stride_[a]];
+  // Row by row (x rows): whether a row has neighbours across the other axes is the same along
+  // it, so each term is one pass over the row with plain indexing. Every entry still takes the
+  // diagonal term, then per axis the lower and the upper neighbour, in that order.
+  const int nx = res_[0];
+  const std::size_t rows = static_cast<std::size_t>(diagonal_.size()) / static_cast<std::size_t>(nx);
+  const double* xv = x.data();
+  double* yv = y.data();
+  auto row = [&](std::size_t r) {
+    const std::size_t base = r * static_cast<std::size_t>(nx);
+    const double* d = diagonal_.data() + base;
+    const double* w0 = lower_[0].data() + base;
+    const double* xr = xv + base;
+    double* out = yv + base;
+    for (int i = 0; i < nx; ++i) out[i] = d[i] * xr[i];
+    for (int i = 1; i < nx; ++i) out[i] -= w0[i] * xr[i - 1];
+    for (int i = 0; i + 1 < nx; ++i) out[i] -= w0[i + 1] * xr[i + 1];
+    std::size_t rest = r;  // the row's coordinates along axes 1..D-1
+    for (int a = 1; a < D; ++a) {
+      const int c = static_cast<int>(rest % static_cast<std::size_t>(res_[a]));
+      rest /= static_cast<std::size_t>(res_[a]);
+      const std::size_t st = stride_[a];
+      const double* w = lower_[a].data() + base;
+      if (c > 0)
+        for (int i = 0; i < nx; ++i) out[i] -= w[i] * xr[i - static_cast<std::ptrdiff_t>(st)];
+      if (c + 1 < res_[a])
+        for (int i = 0; i < nx; ++i) out[i] -= w[i + st] * xr[i + st];
     }
-    y[i] = s;
+  };
+  if (diagonal_.size() < (1u << 15)) {
+    for (std::size_t r = 0; r < rows; ++r) row(r);
+    return;
+  }
+  const std::size_t grain = std::max<std::size_t>(1, (1u << 13) / static_cast<std::size_t>(nx));
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows, grain), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t k = r.begin(); k != r.end(); ++k) row(k);
   });
 }
 
