@@ -102,6 +102,22 @@ void forRows(const IVec3& n, const F& f) {
   });
 }
 
+// For the lattice row (y, z) of component c's samples: f(link, plus, row) for each face row they
+// read, plus: the faces q - link.plus (read with +), else q - link.minus (read with -); row maps
+// sample x to face index row.base + x for x in [row.x0, row.x1). In link order, plus first.
+template <typename F>
+void forEachFaceRowOfSamples(const std::array<FaceLinks, 2>& links, int count, const IVec3& lattice,
+                             const FaceField& faces, int y, int z, const F& f) {
+  for (int e = 0; e < count; ++e) {
+    const FaceLinks& l = links[static_cast<std::size_t>(e)];
+    const IVec3 n = faces.size(l.faceAxis);
+    for (const bool plus : {true, false}) {
+      ShiftedRow r;
+      if (shiftRow(lattice, n, plus ? IVec3(-l.plus) : IVec3(-l.minus), y, z, r)) f(l, plus, r);
+    }
+  }
+}
+
 }  // namespace
 
 // The three passes below run row by row: along a row the samples a face reads (and the faces a
@@ -141,21 +157,16 @@ void divergenceTranspose(const StressComponent& c, const FaceField& u, double dx
   const int count = faceLinks(c, links);
   forRows(lattice, [&](int y, int z, std::size_t row) {
     double* o = out.data() + row;
-    // Sample q reads +u on face q - plus and -u on face q - minus (masked faces count as 0).
-    for (int e = 0; e < count; ++e) {
-      const FaceLinks& l = links[static_cast<std::size_t>(e)];
-      const IVec3 n = u.size(l.faceAxis);
+    // Masked faces count as 0.
+    forEachFaceRowOfSamples(links, count, lattice, u, y, z, [&](const FaceLinks& l, bool plus, const ShiftedRow& r) {
       const double* v = u.values[l.faceAxis].data();
       const double* m = mask.values[l.faceAxis].data();
-      for (const auto& [delta, sign] : {std::pair{l.plus, 1.0}, std::pair{l.minus, -1.0}}) {
-        ShiftedRow r;
-        if (!shiftRow(lattice, n, -delta, y, z, r)) continue;
-        for (int x = r.x0; x < r.x1; ++x) {
-          const std::size_t f = static_cast<std::size_t>(r.base + x);
-          if (m[f] != 0.0) o[x] += sign * v[f];
-        }
+      const double sign = plus ? 1.0 : -1.0;
+      for (int x = r.x0; x < r.x1; ++x) {
+        const std::size_t f = static_cast<std::size_t>(r.base + x);
+        if (m[f] != 0.0) o[x] += sign * v[f];
       }
-    }
+    });
     for (int x = 0; x < lattice[0]; ++x) o[x] *= k;
   });
 }
@@ -171,9 +182,8 @@ void poissonStencil(const StressComponent& c, const FaceField& weight, double dx
   const int linkCount = faceLinks(c, links);
   forRows(lattice, [&](int y, int z, std::size_t row) {
     double* d = diagonal.data() + row;
-    for (int e = 0; e < linkCount; ++e) {
-      const FaceLinks& l = links[static_cast<std::size_t>(e)];
-      const IVec3 n = weight.size(l.faceAxis);
+    forEachFaceRowOfSamples(links, linkCount, lattice, weight, y, z,
+                            [&](const FaceLinks& l, bool plus, const ShiftedRow& r) {
       const double* w = weight.values[l.faceAxis].data();
       const double* m = mask.values[l.faceAxis].data();
       // The upper sample of a pair links to its lower neighbour across face q - plus (not on the
@@ -181,18 +191,14 @@ void poissonStencil(const StressComponent& c, const FaceField& weight, double dx
       const int yz[3] = {0, y, z};
       double* lower = lowerWeight[l.lowerAxis].data() + row;
       const int firstX = l.lowerAxis == 0 ? 1 : 0;
-      const bool rowLinks = l.lowerAxis == 0 || yz[l.lowerAxis] > 0;
-      for (const auto& [delta, plus] : {std::pair{l.plus, true}, std::pair{l.minus, false}}) {
-        ShiftedRow r;
-        if (!shiftRow(lattice, n, -delta, y, z, r)) continue;
-        for (int x = r.x0; x < r.x1; ++x) {
-          const std::size_t f = static_cast<std::size_t>(r.base + x);
-          const double wf = m[f] != 0.0 ? w[f] * k : 0.0;
-          d[x] += wf;
-          if (plus && rowLinks && x >= firstX) lower[x] = wf;
-        }
+      const bool setsLower = plus && (l.lowerAxis == 0 || yz[l.lowerAxis] > 0);
+      for (int x = r.x0; x < r.x1; ++x) {
+        const std::size_t f = static_cast<std::size_t>(r.base + x);
+        const double wf = m[f] != 0.0 ? w[f] * k : 0.0;
+        d[x] += wf;
+        if (setsLower && x >= firstX) lower[x] = wf;
       }
-    }
+    });
     for (int x = 0; x < lattice[0]; ++x)
       if (!(d[x] > 0.0)) d[x] = isolated;
   });
