@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <span>
+#include <utility>
 
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>
@@ -19,9 +20,21 @@ constexpr int kRelaxSweeps = 50;
 
 // Largest radius and speed over the initial agents and every agent an inflow will create.
 void extremes(const Agents& agents, const std::vector<Inflow>& inflows, float& radius, float& speed) {
-  // Parallel: the time step asks for the fastest agent every step.
-  radius = static_cast<float>(parallelMax(agents.size(), [&](std::size_t i) { return agents.radius[i]; }));
-  speed = static_cast<float>(parallelMax(agents.size(), [&](std::size_t i) { return agents.maxSpeed[i]; }));
+  // One parallel pass: the time step asks for the fastest agent every step.
+  const auto largest = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, agents.size(), 1 << 14), std::pair{0.0f, 0.0f},
+      [&](const tbb::blocked_range<std::size_t>& r, std::pair<float, float> m) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+          m.first = std::max(m.first, agents.radius[i]);
+          m.second = std::max(m.second, agents.maxSpeed[i]);
+        }
+        return m;
+      },
+      [](std::pair<float, float> a, const std::pair<float, float>& b) {
+        return std::pair{std::max(a.first, b.first), std::max(a.second, b.second)};
+      });
+  radius = largest.first;
+  speed = largest.second;
   for (const Inflow& f : inflows) {
     radius = std::max(radius, f.agent.radius);
     speed = std::max(speed, f.agent.maxSpeed);

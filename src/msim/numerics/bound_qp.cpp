@@ -90,9 +90,8 @@ void BoundQpSolver::precondition(QpFacePreconditioner* preconditioner) {
     preconditioner->apply(g_, z_);
     return;
   }
-  // For a diagonal M, M_FF^{-1} = (M^{-1})_FF: Jacobi needs no refactoring when the face changes.
   forBlocks(g_.size(), [&](Eigen::Index begin, Eigen::Index end) {
-    for (Eigen::Index i = begin; i < end; ++i) z_[i] = free_[i] ? (jacobi_ ? g_[i] * invDiagonal_[i] : g_[i]) : 0.0;
+    for (Eigen::Index i = begin; i < end; ++i) z_[i] = diagonallyPreconditioned(i);
   });
 }
 
@@ -190,8 +189,7 @@ BoundQpResult BoundQpSolver::solveBox(const QpOperator& A, const Eigen::VectorXd
     forBlocks(n, [&](Eigen::Index begin, Eigen::Index end) {
       for (Eigen::Index i = begin; i < end; ++i) {
         free_[i] = p[i] > lo(i) && p[i] < hi(i) ? 1 : 0;
-        z_[i] = free_[i] ? (jacobi_ ? g_[i] * invDiagonal_[i] : g_[i]) : 0.0;
-        d_[i] = z_[i];
+        d_[i] = z_[i] = diagonallyPreconditioned(i);
       }
     });
   };

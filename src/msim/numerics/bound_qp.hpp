@@ -134,6 +134,11 @@ class BoundQpSolver {
   void setFace(const Eigen::VectorXd& p, QpFacePreconditioner* preconditioner);
   double chopped(Eigen::Index i, double pi, double gi) const;
   void precondition(QpFacePreconditioner* preconditioner);  // z_ from g_ on the current face
+  // z_i without a face preconditioner: Jacobi (or none) on the face, 0 off it. For a diagonal M,
+  // M_FF^{-1} = (M^{-1})_FF, so it needs no refactoring when the face changes.
+  double diagonallyPreconditioned(Eigen::Index i) const {
+    return free_[static_cast<std::size_t>(i)] ? (jacobi_ ? g_[i] * invDiagonal_[i] : g_[i]) : 0.0;
+  }
   double dot(const Eigen::VectorXd& x, const Eigen::VectorXd& y);  // blocked, deterministic
 
   bool jacobi_ = false;  // built-in Jacobi (no preconditioner passed, Jacobi requested)
