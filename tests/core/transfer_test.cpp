@@ -2,6 +2,7 @@
 // bitwise determinism across thread counts.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstring>
 
@@ -241,6 +242,76 @@ TEST(Transfer, SplatIsBitwiseIdenticalAcrossThreadCounts) {
     ASSERT_EQ(serial.size(), parallel.size());
     EXPECT_EQ(std::memcmp(serial.data(), parallel.data(), serial.size() * sizeof(float)), 0);
   }
+}
+
+// A fused splat of several quantities must be exactly what separate splats give, for every
+// kernel, on cells and on each face layout (the granular transfer relies on it).
+TEST(Transfer, FusedSumsEqualSeparateSplatsBitwise) {
+  Rng rng(7);
+  const GridSpec<3> spec = testSpec<3>(12);
+  const auto positions = randomPositions(spec, 20000, 1.5, rng);
+  std::array<std::vector<float>, 3> values;
+  for (auto& v : values) {
+    v.resize(positions.size());
+    for (float& x : v) x = float(rng.uniform(-2.0, 3.0));
+  }
+  for (TransferKernel kernel : kKernels) {
+    MacGrid<3> faces(spec);
+    std::vector<Grid<float, 3>> layouts{Grid<float, 3>(spec)};
+    for (int a = 0; a < 3; ++a) layouts.push_back(faces.component(a));
+    for (const Grid<float, 3>& layout : layouts) {
+      Splatter<3> splatter;
+      std::array<Grid<float, 3>, 3> separate{layout, layout, layout}, fused{layout, layout, layout};
+      for (int q = 0; q < 3; ++q) {
+        separate[q].fill(0.5f);  // Sum adds onto what is there
+        fused[q].fill(0.5f);
+        splatter.splat(positions, values[q], separate[q], kernel);
+      }
+      splatter.splatSums<3>(positions, {values[0], values[1], values[2]}, {&fused[0], &fused[1], &fused[2]}, kernel);
+      for (int q = 0; q < 3; ++q) {
+        ASSERT_EQ(separate[q].count(), fused[q].count());
+        EXPECT_EQ(std::memcmp(separate[q].data().data(), fused[q].data().data(), fused[q].count() * sizeof(float)), 0)
+            << "quantity " << q;
+        EXPECT_GT(std::abs(sumOf(fused[q]) - 0.5 * fused[q].count()), 1.0);  // something was splatted
+      }
+    }
+  }
+}
+
+TEST(Transfer, FusedMacGatherEqualsSeparateGathersBitwise) {
+  Rng rng(8);
+  const GridSpec<3> spec = testSpec<3>(10);
+  const auto positions = randomPositions(spec, 5000, 1.5, rng);
+  MacGrid<3> u(spec), v(spec);
+  for (MacGrid<3>* g : {&u, &v})
+    for (int a = 0; a < 3; ++a)
+      for (float& x : g->component(a).data()) x = float(rng.uniform(-1.0, 1.0));
+  for (TransferKernel kernel : kKernels) {
+    std::vector<Vecf<3>> su(positions.size()), sv(positions.size()), fu(positions.size()), fv(positions.size());
+    gather<3>(u, positions, kernel, su);
+    gather<3>(v, positions, kernel, sv);
+    gather<3, 2>({&u, &v}, positions, kernel, {fu, fv});
+    EXPECT_EQ(std::memcmp(su.data(), fu.data(), su.size() * sizeof(Vecf<3>)), 0);
+    EXPECT_EQ(std::memcmp(sv.data(), fv.data(), sv.size() * sizeof(Vecf<3>)), 0);
+    EXPECT_NE(std::memcmp(fu.data(), fv.data(), fu.size() * sizeof(Vecf<3>)), 0);
+  }
+  MacGrid<3> other(testSpec<3>(11));
+  std::vector<Vecf<3>> a(positions.size()), b(positions.size());
+  EXPECT_THROW((gather<3, 2>({&u, &other}, positions, TransferKernel::Linear, {a, b})), std::invalid_argument);
+}
+
+TEST(Transfer, FusedSumsRejectDifferentLayouts) {
+  const GridSpec<3> spec = testSpec<3>(6);
+  MacGrid<3> faces(spec);
+  Grid<float, 3> cells(spec);
+  const std::vector<Vecf<3>> positions(3, Vecf<3>::Zero());
+  const std::vector<float> values(3, 1.0f), short_(2, 1.0f);
+  Splatter<3> splatter;
+  EXPECT_THROW(splatter.splatSums<2>(positions, {values, values}, {&cells, &faces.component(0)}, TransferKernel::Linear),
+               std::invalid_argument);
+  Grid<float, 3> other(spec);
+  EXPECT_THROW(splatter.splatSums<2>(positions, {values, short_}, {&cells, &other}, TransferKernel::Linear),
+               std::invalid_argument);
 }
 
 TEST(Transfer, RejectsMismatchedSizes) {

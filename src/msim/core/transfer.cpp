@@ -1,6 +1,7 @@
 #include "msim/core/transfer.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -102,20 +103,26 @@ void Splatter<D>::bucketBySlab(std::span<const Vecf<D>> positions, const Grid<fl
 }
 
 template <int D>
-template <typename Kernel, typename ValueOf>
-void Splatter<D>::splatWith(std::span<const Vecf<D>> positions, const ValueOf& valueOf, Grid<float, D>& target,
-                            SplatMode mode, float emptyValue) {
+template <typename Kernel, std::size_t N, typename ValueOf>
+void Splatter<D>::splatWith(std::span<const Vecf<D>> positions, const ValueOf& valueOf,
+                            const std::array<Grid<float, D>*, N>& targets, SplatMode mode, float emptyValue) {
   static_assert(Kernel::kSupport - 1 <= kSlabWidth, "slabs of one colour must not share samples");
+  const Grid<float, D>& layout = *targets[0];
+  for (const Grid<float, D>* t : targets)
+    if (t->size() != layout.size() || t->offset() != layout.offset() || t->spec().dx != layout.spec().dx ||
+        t->spec().origin != layout.spec().origin)
+      throw std::invalid_argument("splat: the grids of one splat must share their layout");
   const bool normalized = mode == SplatMode::Normalized;
-  const std::size_t samples = target.count();
-  weightedSum_.resize(samples);
+  const std::size_t samples = layout.count();
+  // The N sums of a sample lie side by side, so a tap touches one cache line for all of them.
+  weightedSum_.resize(samples * N);
   weightSum_.resize(normalized ? samples : 0);
   parallelFor(0, samples, [&](std::size_t i) {
-    weightedSum_[i] = 0.0;
+    for (std::size_t q = 0; q < N; ++q) weightedSum_[i * N + q] = 0.0;
     if (normalized) weightSum_[i] = 0.0;
   }, 1 << 14);
 
-  bucketBySlab<Kernel>(positions, target);
+  bucketBySlab<Kernel>(positions, layout);
 
   const std::size_t slabs = buckets_.buckets();
   const std::span<const std::uint32_t> order = buckets_.order();
@@ -127,26 +134,40 @@ void Splatter<D>::splatWith(std::span<const Vecf<D>> positions, const ValueOf& v
       const std::size_t slab = 2 * j + colour;
       for (std::size_t k = buckets_.begin(slab); k < buckets_.begin(slab + 1); ++k) {
         const std::uint32_t p = order[k];
-        const double v = valueOf(p);
-        const Stencil<Kernel, D> stencil(target, positions[p]);
-        if (normalized)
-          stencil.forEachTap([&](std::ptrdiff_t at, double w) {
-            sum[at] += w * v;
-            weight[at] += w;
-          });
-        else
-          stencil.forEachTap([&](std::ptrdiff_t at, double w) { sum[at] += w * v; });
+        double v[N];
+        for (std::size_t q = 0; q < N; ++q) v[q] = valueOf(p, q);
+        const Stencil<Kernel, D> stencil(layout, positions[p]);
+        stencil.forEachTap([&](std::ptrdiff_t at, double w) {
+          for (std::size_t q = 0; q < N; ++q) sum[at * N + q] += w * v[q];
+          if (normalized) weight[at] += w;
+        });
       }
     });
   }
 
-  float* out = target.data().data();
-  if (normalized)
-    parallelFor(0, samples, [&](std::size_t i) {
-      out[i] = weight[i] > 0.0 ? static_cast<float>(sum[i] / weight[i]) : emptyValue;
-    }, 1 << 14);
-  else
-    parallelFor(0, samples, [&](std::size_t i) { out[i] = static_cast<float>(out[i] + sum[i]); }, 1 << 14);
+  for (std::size_t q = 0; q < N; ++q) {
+    float* out = targets[q]->data().data();
+    if (normalized)
+      parallelFor(0, samples, [&](std::size_t i) {
+        out[i] = weight[i] > 0.0 ? static_cast<float>(sum[i * N + q] / weight[i]) : emptyValue;
+      }, 1 << 14);
+    else
+      parallelFor(0, samples, [&](std::size_t i) { out[i] = static_cast<float>(out[i] + sum[i * N + q]); }, 1 << 14);
+  }
+}
+
+template <int D>
+template <std::size_t N>
+void Splatter<D>::splatSums(std::span<const Vecf<D>> positions, const std::array<std::span<const float>, N>& values,
+                            const std::array<Grid<float, D>*, N>& targets, TransferKernel kernel) {
+  for (const std::span<const float>& v : values)
+    if (v.size() != positions.size())
+      throw std::invalid_argument("splat: " + std::to_string(v.size()) + " values for " +
+                                  std::to_string(positions.size()) + " positions");
+  withKernel(kernel, [&](auto k) {
+    splatWith<decltype(k), N>(
+        positions, [&](std::size_t p, std::size_t q) { return values[q][p]; }, targets, SplatMode::Sum, 0.0f);
+  });
 }
 
 template <int D>
@@ -156,7 +177,8 @@ void Splatter<D>::splat(std::span<const Vecf<D>> positions, std::span<const floa
     throw std::invalid_argument("splat: " + std::to_string(values.size()) + " values for " +
                                 std::to_string(positions.size()) + " positions");
   withKernel(kernel, [&](auto k) {
-    splatWith<decltype(k)>(positions, [&](std::size_t p) { return values[p]; }, target, mode, emptyValue);
+    splatWith<decltype(k), 1>(
+        positions, [&](std::size_t p, std::size_t) { return values[p]; }, {&target}, mode, emptyValue);
   });
 }
 
@@ -168,8 +190,9 @@ void Splatter<D>::splat(std::span<const Vecf<D>> positions, std::span<const Vecf
                                 std::to_string(positions.size()) + " positions");
   withKernel(kernel, [&](auto k) {
     for (int a = 0; a < D; ++a)
-      splatWith<decltype(k)>(positions, [&](std::size_t p) { return values[p][a]; }, target.component(a), mode,
-                             emptyValue);
+      splatWith<decltype(k), 1>(
+          positions, [&](std::size_t p, std::size_t) { return values[p][a]; }, {&target.component(a)}, mode,
+          emptyValue);
   });
 }
 
@@ -212,35 +235,54 @@ std::vector<float> gather(const Grid<float, D>& grid, std::type_identity_t<std::
   return out;
 }
 
-template <int D>
-void gather(const MacGrid<D>& grid, std::type_identity_t<std::span<const Vecf<D>>> positions, TransferKernel kernel,
-            std::type_identity_t<std::span<Vecf<D>>> out) {
-  if (out.size() != positions.size())
-    throw std::invalid_argument("gather: output holds " + std::to_string(out.size()) + " values for " +
-                                std::to_string(positions.size()) + " positions");
+template <int D, std::size_t N>
+void gather(const std::array<const MacGrid<D>*, N>& grids, std::type_identity_t<std::span<const Vecf<D>>> positions,
+            TransferKernel kernel, const std::array<std::span<Vecf<D>>, N>& out) {
+  for (std::size_t q = 0; q < N; ++q) {
+    if (out[q].size() != positions.size())
+      throw std::invalid_argument("gather: output holds " + std::to_string(out[q].size()) + " values for " +
+                                  std::to_string(positions.size()) + " positions");
+    if (grids[q]->spec().res != grids[0]->spec().res || grids[q]->spec().dx != grids[0]->spec().dx ||
+        grids[q]->spec().origin != grids[0]->spec().origin)
+      throw std::invalid_argument("gather: the MAC grids of one gather must share their layout");
+  }
   withKernel(kernel, [&](auto k) {
     for (int a = 0; a < D; ++a) {
-      const float* data = grid.component(a).data().data();
+      const Grid<float, D>& layout = grids[0]->component(a);
       parallelFor(0, positions.size(), [&](std::size_t p) {
-        double value = 0.0;
-        Stencil<decltype(k), D>(grid.component(a), positions[p]).forEachTap([&](std::ptrdiff_t at, double w) {
-          value += w * data[at];
-        });
-        out[p][a] = static_cast<float>(value);
+        const Stencil<decltype(k), D> stencil(layout, positions[p]);
+        for (std::size_t q = 0; q < N; ++q) {
+          const float* data = grids[q]->component(a).data().data();
+          double value = 0.0;
+          stencil.forEachTap([&](std::ptrdiff_t at, double w) { value += w * data[at]; });
+          out[q][p][a] = static_cast<float>(value);
+        }
       });
     }
   });
 }
 
+template <int D>
+void gather(const MacGrid<D>& grid, std::type_identity_t<std::span<const Vecf<D>>> positions, TransferKernel kernel,
+            std::type_identity_t<std::span<Vecf<D>>> out) {
+  gather<D, 1>({&grid}, positions, kernel, {out});
+}
+
 #define MSIM_INSTANTIATE_TRANSFER(D)                                                                                \
   template class Splatter<D>;                                                                                       \
+  template void Splatter<D>::splatSums<2>(std::span<const Vecf<D>>, const std::array<std::span<const float>, 2>&,   \
+                                          const std::array<Grid<float, D>*, 2>&, TransferKernel);                   \
+  template void Splatter<D>::splatSums<3>(std::span<const Vecf<D>>, const std::array<std::span<const float>, 3>&,   \
+                                          const std::array<Grid<float, D>*, 3>&, TransferKernel);                   \
   template void splat<D>(std::span<const Vecf<D>>, std::span<const float>, Grid<float, D>&, TransferKernel,        \
                          SplatMode, float);                                                                         \
   template void splat<D>(std::span<const Vecf<D>>, std::span<const Vecf<D>>, MacGrid<D>&, TransferKernel,          \
                          SplatMode, float);                                                                         \
   template void gather<D>(const Grid<float, D>&, std::span<const Vecf<D>>, TransferKernel, std::span<float>);      \
   template std::vector<float> gather<D>(const Grid<float, D>&, std::span<const Vecf<D>>, TransferKernel);          \
-  template void gather<D>(const MacGrid<D>&, std::span<const Vecf<D>>, TransferKernel, std::span<Vecf<D>>);
+  template void gather<D>(const MacGrid<D>&, std::span<const Vecf<D>>, TransferKernel, std::span<Vecf<D>>);       \
+  template void gather<D, 2>(const std::array<const MacGrid<D>*, 2>&, std::span<const Vecf<D>>, TransferKernel,    \
+                             const std::array<std::span<Vecf<D>>, 2>&);
 
 MSIM_INSTANTIATE_TRANSFER(2)
 MSIM_INSTANTIATE_TRANSFER(3)

@@ -20,6 +20,7 @@
 // than a stencil, so they never write the same sample, and within a slab particles are added in
 // input order. Every sample therefore sums its contributions in the same order whatever the
 // thread count, and the result is bitwise reproducible. Sums are accumulated in double.
+#include <array>
 #include <cstdint>
 #include <span>
 #include <type_traits>
@@ -53,14 +54,24 @@ class Splatter {
   void splat(std::span<const Vecf<D>> positions, std::span<const Vecf<D>> values, MacGrid<D>& target,
              TransferKernel kernel, SplatMode mode = SplatMode::Sum, float emptyValue = 0.0f);
 
+  // N Sum splats onto grids of one layout in one pass: values[q] onto *targets[q]. One bucketing
+  // and one stencil per particle serve all N (a transfer that splats several quantities pays for
+  // them once); every sample adds its contributions in the same order and arithmetic as N
+  // separate splat() calls, so the result is bitwise the same. std::invalid_argument if the grids'
+  // layouts differ or a value span's length is not the number of positions. N = 2, 3.
+  template <std::size_t N>
+  void splatSums(std::span<const Vecf<D>> positions, const std::array<std::span<const float>, N>& values,
+                 const std::array<Grid<float, D>*, N>& targets, TransferKernel kernel);
+
  private:
-  template <typename Kernel, typename ValueOf>
-  void splatWith(std::span<const Vecf<D>> positions, const ValueOf& valueOf, Grid<float, D>& target, SplatMode mode,
-                 float emptyValue);
+  // valueOf(p, q): particle p's value for target q.
+  template <typename Kernel, std::size_t N, typename ValueOf>
+  void splatWith(std::span<const Vecf<D>> positions, const ValueOf& valueOf,
+                 const std::array<Grid<float, D>*, N>& targets, SplatMode mode, float emptyValue);
   template <typename Kernel>
   void bucketBySlab(std::span<const Vecf<D>> positions, const Grid<float, D>& target);
 
-  std::vector<double> weightedSum_;  // sum of w*v per sample
+  std::vector<double> weightedSum_;  // sum of w*v per sample (N interleaved per sample)
   std::vector<double> weightSum_;    // sum of w per sample (Normalized only)
   BucketSort buckets_;  // particle indices grouped by slab, stable
 };
@@ -85,5 +96,12 @@ std::vector<float> gather(const Grid<float, D>& grid, std::type_identity_t<std::
 template <int D>
 void gather(const MacGrid<D>& grid, std::type_identity_t<std::span<const Vecf<D>>> positions, TransferKernel kernel,
             std::type_identity_t<std::span<Vecf<D>>> out);
+// Vector gathers from N MAC grids of one layout at the same positions, out[q] from *grids[q]: one
+// stencil per position and component serves all N (bitwise what N separate gathers give).
+// std::invalid_argument if the layouts differ or an output's length is not the number of positions.
+// N = 2.
+template <int D, std::size_t N>
+void gather(const std::array<const MacGrid<D>*, N>& grids, std::type_identity_t<std::span<const Vecf<D>>> positions,
+            TransferKernel kernel, const std::array<std::span<Vecf<D>>, N>& out);
 
 }  // namespace msim

@@ -21,15 +21,17 @@ void ParticleGridTransfer::toGrid(const GranularParticles& particles, std::span<
 
   volume_.resize(n);
   volumeFriction_.resize(n);
-  momentum_.resize(n);
+  for (std::vector<float>& m : momentum_) m.resize(n);
   parallelFor(0, n, [&](std::size_t i) {
     const GranularMaterial& material = materials[particles.material[i]];
     const double v = particles.mass[i] / material.density;
     volume_[i] = static_cast<float>(v);
     volumeFriction_[i] = static_cast<float>(v * material.friction);
-    momentum_[i] = particles.mass[i] * particles.velocity[i];
+    const Vecf<3> momentum = particles.mass[i] * particles.velocity[i];
+    for (int a = 0; a < 3; ++a) momentum_[a][i] = momentum[a];
   });
 
+  // Each grid layout in one pass: the cell centres, then the faces of each axis.
   const std::span<const Vecf<3>> x = particles.position;
   constexpr auto kLinear = TransferKernel::Linear;
   out.mass.fill(0.0f);
@@ -38,14 +40,12 @@ void ParticleGridTransfer::toGrid(const GranularParticles& particles, std::span<
   out.momentum.fill(0.0f);
   out.faceMass.fill(0.0f);
   out.faceVolume.fill(0.0f);
-  splatter_.splat(x, particles.mass, out.mass, kLinear);
-  splatter_.splat(x, volume_, out.volume, kLinear);
-  splatter_.splat(x, volumeFriction_, out.friction, kLinear);  // sum w V alpha, normalised below
-  splatter_.splat(x, momentum_, out.momentum, kLinear);
-  for (int a = 0; a < 3; ++a) {
-    splatter_.splat(x, particles.mass, out.faceMass.component(a), kLinear);
-    splatter_.splat(x, volume_, out.faceVolume.component(a), kLinear);
-  }
+  splatter_.splatSums<3>(x, {particles.mass, volume_, volumeFriction_},  // sum w V alpha, normalised below
+                         {&out.mass, &out.volume, &out.friction}, kLinear);
+  for (int a = 0; a < 3; ++a)
+    splatter_.splatSums<3>(x, {momentum_[a], particles.mass, volume_},
+                           {&out.momentum.component(a), &out.faceMass.component(a), &out.faceVolume.component(a)},
+                           kLinear);
 
   parallelFor(0, out.friction.count(), [&](std::size_t c) {
     const float v = out.volume[c];
@@ -66,8 +66,7 @@ void ParticleGridTransfer::toParticles(const MacGrid<3>& oldVelocity, const MacG
   const std::size_t n = particles.size();
   oldAt_.resize(n);
   newAt_.resize(n);
-  gather<3>(oldVelocity, particles.position, TransferKernel::Linear, oldAt_);
-  gather<3>(newVelocity, particles.position, TransferKernel::Linear, newAt_);
+  gather<3, 2>({&oldVelocity, &newVelocity}, particles.position, TransferKernel::Linear, {oldAt_, newAt_});
   const float flip = static_cast<float>(flipRatio);
   parallelFor(0, n, [&](std::size_t i) {
     const Vecf<3> flipped = particles.velocity[i] + (newAt_[i] - oldAt_[i]);

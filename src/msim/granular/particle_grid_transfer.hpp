@@ -4,6 +4,7 @@
 // samples with trilinear weights (core/transfer.hpp, Linear kernel, Sum splats: mass and momentum
 // are conserved to round-off); after the continuum solve the particle velocities take the change
 // of the grid velocity (FLIP, Brackbill and Ruppel 1986; Zhu and Bridson 2005).
+#include <array>
 #include <span>
 #include <vector>
 
@@ -52,8 +53,10 @@ class ParticleGridTransfer {
 
  private:
   Splatter<3> splatter_;
-  std::vector<float> volume_, volumeFriction_;      // per particle: m/rho_max and that times alpha
-  std::vector<Vecf<3>> momentum_, oldAt_, newAt_;  // per particle: m v, gathered grid velocities
+  // Per particle: m / rho_max, that times alpha, and the components of m v.
+  std::vector<float> volume_, volumeFriction_;
+  std::array<std::vector<float>, 3> momentum_;
+  std::vector<Vecf<3>> oldAt_, newAt_;  // per particle: gathered grid velocities
 };
 
 }  // namespace msim::granular
