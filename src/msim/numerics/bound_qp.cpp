@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -98,7 +99,7 @@ void BoundQpSolver::precondition(QpFacePreconditioner* preconditioner) {
 double BoundQpSolver::dot(const Eigen::VectorXd& x, const Eigen::VectorXd& y) {
   return reduceBlocks<1>(x.size(), partial_, {0.0}, [&](Eigen::Index begin, Eigen::Index end, auto& acc) {
     double s = 0.0;
-    for (Eigen::Index i = begin; i < end; ++i) s += x[i] * y[i];
+    for (Eigen::Index i = begin; i < end; ++i) s = std::fma(x[i], y[i], s);
     acc[0] = s;
   }, kAdd)[0];
 }
@@ -196,26 +197,32 @@ BoundQpResult BoundQpSolver::solveBox(const QpOperator& A, const Eigen::VectorXd
   updateGradient();
   restart();
 
+  // Free gradient phi (g on F), chopped gradient beta (min(g, 0) at a lower bound, max(g, 0) at
+  // an upper one), and the reduced free gradient phi~_i = min((p_i - l_i) / alphaBar, phi_i)
+  // (max((p_i - u_i) / alphaBar, phi_i) when phi_i < 0), whose product with phi measures how far
+  // a fixed-length projected step along phi can go before it is cut by the bounds: entry i's
+  // share of ||phi||^2, ||beta||^2 and phi~^T phi.
+  auto addGradientSums = [&](Eigen::Index i, double& phi2, double& beta2, double& reduced) {
+    const double gi = g_[i];
+    if (free_[i]) {
+      phi2 += gi * gi;
+      reduced += (gi > 0.0 ? std::min((p[i] - lo(i)) / alphaBar, gi) : std::max((p[i] - hi(i)) / alphaBar, gi)) * gi;
+    } else {
+      const double beta = chopped(i, p[i], gi);
+      beta2 += beta * beta;
+    }
+  };
+  // The sums of the current iterate, when the last step computed them in one of its own passes.
+  std::optional<std::array<double, 3>> nextSums;
   while (true) {
-    // Free gradient phi (g on F), chopped gradient beta (min(g, 0) at a lower bound, max(g, 0) at
-    // an upper one), and the reduced free gradient phi~_i = min((p_i - l_i) / alphaBar, phi_i)
-    // (max((p_i - u_i) / alphaBar, phi_i) when phi_i < 0), whose product with phi measures how far
-    // a fixed-length projected step along phi can go before it is cut by the bounds.
-    const auto sums = reduceBlocks<3>(n, partial_, {0.0, 0.0, 0.0},
-                                      [&](Eigen::Index begin, Eigen::Index end, auto& acc) {
-      double phi2 = 0.0, beta2 = 0.0, reduced = 0.0;
-      for (Eigen::Index i = begin; i < end; ++i) {
-        const double gi = g_[i];
-        const double beta = chopped(i, p[i], gi);
-        if (free_[i]) {
-          phi2 += gi * gi;
-          reduced += (gi > 0.0 ? std::min((p[i] - lo(i)) / alphaBar, gi) : std::max((p[i] - hi(i)) / alphaBar, gi)) * gi;
-        } else {
-          beta2 += beta * beta;
-        }
-      }
-      acc = {phi2, beta2, reduced};
-    }, kAdd);
+    const std::array<double, 3> sums =
+        nextSums ? *nextSums
+                 : reduceBlocks<3>(n, partial_, {0.0, 0.0, 0.0}, [&](Eigen::Index begin, Eigen::Index end, auto& acc) {
+                     double phi2 = 0.0, beta2 = 0.0, reduced = 0.0;
+                     for (Eigen::Index i = begin; i < end; ++i) addGradientSums(i, phi2, beta2, reduced);
+                     acc = {phi2, beta2, reduced};
+                   }, kAdd);
+    nextSums.reset();
     const double phi2 = sums[0], beta2 = sums[1], reducedPhi = sums[2];
     result.projectedGradientNorm = std::sqrt(phi2 + beta2);
     if (result.iterations == 0 && bNorm == 0.0) threshold = settings.tolerance * result.projectedGradientNorm;
@@ -249,18 +256,41 @@ BoundQpResult BoundQpSolver::solveBox(const QpOperator& A, const Eigen::VectorXd
 
       if (alphaCg <= alphaFeasible) {
         // The clamp only removes round-off when alphaCg is within an ulp of alphaFeasible.
-        forBlocks(n, [&](Eigen::Index begin, Eigen::Index end) {
+        auto advance = [&](Eigen::Index i) {
+          p[i] = std::clamp(p[i] - alphaCg * d_[i], lo(i), hi(i));
+          g_[i] -= alphaCg * Ad_[i];
+        };
+        // Next direction A-conjugate to the previous one (Dostál & Schöberl 2005, CG step):
+        // d = z - (z^T A d / d^T A d) d. Without a face preconditioner z is entrywise, so the step,
+        // z and z^T A d take one pass, and the new direction and the next iteration's gradient
+        // sums another (the same sums, block by block, as separate passes: bitwise equal).
+        double zAd;
+        if (preconditioner) {
+          forBlocks(n, [&](Eigen::Index begin, Eigen::Index end) {
+            for (Eigen::Index i = begin; i < end; ++i) advance(i);
+          });
+          precondition(preconditioner);
+          zAd = dot(z_, Ad_);
+        } else {
+          zAd = reduceBlocks<1>(n, partial_, {0.0}, [&](Eigen::Index begin, Eigen::Index end, auto& acc) {
+            double sum = 0.0;
+            for (Eigen::Index i = begin; i < end; ++i) {
+              advance(i);
+              z_[i] = diagonallyPreconditioned(i);
+              sum = std::fma(z_[i], Ad_[i], sum);
+            }
+            acc[0] = sum;
+          }, kAdd)[0];
+        }
+        const double conj = zAd / dAd;
+        nextSums = reduceBlocks<3>(n, partial_, {0.0, 0.0, 0.0}, [&](Eigen::Index begin, Eigen::Index end, auto& acc) {
+          double phi2 = 0.0, beta2 = 0.0, reduced = 0.0;
           for (Eigen::Index i = begin; i < end; ++i) {
-            p[i] = std::clamp(p[i] - alphaCg * d_[i], lo(i), hi(i));
-            g_[i] -= alphaCg * Ad_[i];
+            d_[i] = z_[i] - conj * d_[i];
+            addGradientSums(i, phi2, beta2, reduced);
           }
-        });
-        precondition(preconditioner);
-        // Next direction A-conjugate to the previous one (Dostál & Schöberl 2005, CG step).
-        const double conj = dot(z_, Ad_) / dAd;
-        forBlocks(n, [&](Eigen::Index begin, Eigen::Index end) {
-          for (Eigen::Index i = begin; i < end; ++i) d_[i] = z_[i] - conj * d_[i];
-        });
+          acc = {phi2, beta2, reduced};
+        }, kAdd);
         ++result.cgSteps;
       } else {
         // Expansion: the largest feasible step along d, then a fixed-length step alphaBar along
