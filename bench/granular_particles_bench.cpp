@@ -79,8 +79,10 @@ BENCHMARK(BM_GridToParticles)->Unit(benchmark::kMillisecond)->UseRealTime();
 void BM_AdvectWithShapes(benchmark::State& state) {
   GranularParticles p = seeded();
   const MacGrid<3> velocity = shearingFlow(), displacement(kGrid, 0.0f);
+  std::vector<Vec3> correction;
   for (auto _ : state) {
-    advectParticles(p, velocity, kDt, &displacement);
+    sampleCorrection(p, displacement, correction);
+    advectParticles(p, velocity, kDt, correction);
     benchmark::DoNotOptimize(p.position.data());
   }
   perParticle(state, p.size());
@@ -151,7 +153,7 @@ void BM_RenderPointStep(benchmark::State& state) {
     state.PauseTiming();
     p = start;
     points = startPoints;
-    advectParticles(p, solved, kDt, nullptr, &motion);
+    advectParticles(p, solved, kDt, {}, &motion);
     state.ResumeTiming();
     escaped += static_cast<double>(points.carry(motion, kDt, kGrid, p, {}));
   }

@@ -112,7 +112,9 @@ TEST(GranularAdvection, PositionsMoveByCorrectionThenVelocityAndStayInTheDomain)
   p.append(Vecf<3>(0.99f, 0.0f, 0.0f), Vecf<3>::Zero(), 1.0f, toShape(1e-4 * Eigen::Matrix3d::Identity()), 0);
   const double dt = 0.1;
   std::vector<ParticleMotion> motion;
-  advectParticles(p, velocity, dt, &displacement, &motion);
+  std::vector<Vec3> correction;
+  sampleCorrection(p, displacement, correction);
+  advectParticles(p, velocity, dt, correction, &motion);
   const Vec3 corrected = x0 + Vec3::Constant(0.05);
   EXPECT_LE((p.position[0].cast<double>() - (corrected + dt * (g * corrected + b))).norm(), 1e-6);
   // The second one is pushed through x = 1: it stops just inside.

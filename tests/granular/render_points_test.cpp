@@ -69,7 +69,7 @@ TEST(GranularRenderPoints, FollowTheFlowInsideTheirParticlesThroughSplits) {
   std::size_t resampledWithoutSplits = 0;
   for (int step = 0; step < 10; ++step) {
     const std::vector<Vecf<3>> before(points.positions().begin(), points.positions().end());
-    advectParticles(p, velocity, dt, nullptr, &motion);
+    advectParticles(p, velocity, dt, {}, &motion);
     resampledWithoutSplits += points.carry(motion, dt, velocity.spec(), p, {});
     for (std::size_t k = 0; k < points.size(); ++k) {
       const Vec3 x = before[k].cast<double>();
@@ -81,7 +81,7 @@ TEST(GranularRenderPoints, FollowTheFlowInsideTheirParticlesThroughSplits) {
   SplitMerge splitMerge(defaultParticleRadius(kDx));
   std::size_t splits = 0, resampled = 0;
   for (int step = 0; step < 20; ++step) {
-    advectParticles(p, velocity, dt, nullptr, &motion);
+    advectParticles(p, velocity, dt, {}, &motion);
     splits += splitMerge.apply(p).splits;
     resampled += points.carry(motion, dt, velocity.spec(), p, splitMerge.successors());
     ASSERT_LE(worstDistance(points, p), 1.0 + kEscapeMargin);

@@ -238,10 +238,8 @@ void GranularSimulation::removeVelocityAgainstCorrection() {
   // pushed back by dx keeps no velocity component against dx. Without this, grains resting on a
   // packed surface (whose cells never read as full under the trilinear splat, so the pressure
   // never holds them) keep falling in velocity while the correction puts them back every step.
-  correctionAt_.resize(particles_.size());
-  gather(displacement_, particles_.position, TransferKernel::Linear, correctionAt_);
   parallelFor(0, particles_.size(), [&](std::size_t i) {
-    const Vecf<3> d = correctionAt_[i];
+    const Vecf<3> d = correctionAt_[i].cast<float>();
     const float d2 = d.squaredNorm();
     if (!(d2 > 0.0f)) return;
     const float vd = particles_.velocity[i].dot(d);
@@ -291,8 +289,13 @@ void GranularSimulation::step(double dt) {
   {
     ScopedTimer t(times_.particles);
     transfer_.toParticles(fields_.velocity, velocityNew_, particles_, settings_.flipRatio);
-    if (corrected) removeVelocityAgainstCorrection();
-    advectParticles(particles_, velocityNew_, dt, corrected ? &displacement_ : nullptr, renderPoints_ ? &motion_ : nullptr);
+    // The correction displacement at each particle, for its velocity and its advection.
+    if (corrected) {
+      sampleCorrection(particles_, displacement_, correctionAt_);
+      removeVelocityAgainstCorrection();
+    }
+    advectParticles(particles_, velocityNew_, dt, corrected ? std::span<const Vec3>(correctionAt_) : std::span<const Vec3>{},
+                    renderPoints_ ? &motion_ : nullptr);
     pushOutOfSolids();
     if (settings_.splitMerge) splitMergeStats_ = splitMerge_.apply(particles_);
     if (renderPoints_)

@@ -126,7 +126,7 @@ class GranularSimulation {
   std::vector<CoupledBody> bodies_;
   std::vector<int> bodyIndex_;  // world index of each coupled body
   MacGrid<3> velocityNew_, displacement_;
-  std::vector<Vecf<3>> correctionAt_;  // the correction displacement at each particle
+  std::vector<Vec3> correctionAt_;  // the correction displacement at each particle
   std::vector<ParticleMotion> motion_;  // each particle's last step, for its render points
   std::vector<turbulence::TurbulentWind<3>> winds_;
   std::vector<float> windScratch_;  // the summed winds on one face component

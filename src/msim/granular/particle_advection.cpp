@@ -1,6 +1,8 @@
 #include "msim/granular/particle_advection.hpp"
 
 #include <algorithm>
+#include <stdexcept>
+#include <string>
 
 #include "msim/core/interpolation.hpp"
 #include "msim/core/parallel.hpp"
@@ -50,23 +52,23 @@ Eigen::Matrix3d deformShape(const Eigen::Matrix3d& a, const Eigen::Matrix3d& jac
   return f * a * f.transpose();
 }
 
-namespace {
-
-// The position after the density correction, before the velocity step.
-Vec3 corrected(const Vecf<3>& x, const GridSpec<3>& domain, const MacGrid<3>* displacement) {
-  const Vec3 p = x.cast<double>();
-  return displacement ? clampIntoDomain(domain, p + sampleLinear<3>(*displacement, p)) : p;
+void sampleCorrection(const GranularParticles& particles, const MacGrid<3>& displacement, std::vector<Vec3>& out) {
+  out.resize(particles.size());
+  parallelFor(0, particles.size(), [&](std::size_t i) {
+    out[i] = sampleLinear<3>(displacement, particles.position[i].cast<double>());
+  });
 }
 
-}  // namespace
-
 void advectParticles(GranularParticles& particles, const MacGrid<3>& velocity, double dt,
-                     const MacGrid<3>* displacement, std::vector<ParticleMotion>* motion) {
+                     std::span<const Vec3> displacement, std::vector<ParticleMotion>* motion) {
   const GridSpec<3>& domain = velocity.spec();
+  if (!displacement.empty() && displacement.size() != particles.size())
+    throw std::invalid_argument("advectParticles: " + std::to_string(displacement.size()) +
+                                " correction displacements for " + std::to_string(particles.size()) + " particles");
   if (motion) motion->resize(particles.size());
   parallelFor(0, particles.size(), [&](std::size_t i) {
     const Vec3 start = particles.position[i].cast<double>();
-    const Vec3 x = corrected(particles.position[i], domain, displacement);
+    const Vec3 x = displacement.empty() ? start : clampIntoDomain(domain, start + displacement[i]);
     const VelocitySample v = sampleVelocityAndJacobian(velocity, x);
     particles.shape[i] = toShape(deformShape(shapeMatrix(particles.shape[i]), v.jacobian, dt));
     particles.position[i] = clampIntoDomain(domain, x + dt * v.value).cast<float>();

@@ -46,12 +46,16 @@ struct ParticleMotion {
   Eigen::Matrix3d jacobian;
 };
 
-// x <- clamp(x + dx_corr(x)); then A <- F A F^T with F = I + dt J_v(x) and x <- clamp(x + dt v(x)),
-// v and J_v interpolated trilinearly at the corrected position. `displacement` (optional) is the
-// density-correction displacement on a MAC grid of the same domain [m]. `motion` (optional)
-// receives each particle's ParticleMotion. Parallel.
+// x <- clamp(x + dx_corr); then A <- F A F^T with F = I + dt J_v(x) and x <- clamp(x + dt v(x)),
+// v and J_v interpolated trilinearly at the corrected position. `displacement` (empty: none) is
+// each particle's density-correction displacement dx_corr [m], as sampleCorrection gives it.
+// `motion` (optional) receives each particle's ParticleMotion. Parallel.
 void advectParticles(GranularParticles& particles, const MacGrid<3>& velocity, double dt,
-                     const MacGrid<3>* displacement = nullptr, std::vector<ParticleMotion>* motion = nullptr);
+                     std::span<const Vec3> displacement = {}, std::vector<ParticleMotion>* motion = nullptr);
+
+// The density-correction displacement (a MAC grid of the particles' domain) interpolated
+// trilinearly at each particle (sampleLinear), into `out`. Parallel.
+void sampleCorrection(const GranularParticles& particles, const MacGrid<3>& displacement, std::vector<Vec3>& out);
 
 // A point carried by a particle (render points, ch. 5.6) after the particle's step `m`:
 // clamp(x + dx_p + dt (v_p + J_p (x - x_p))), the first-order expansion of the grid motion about

@@ -24,6 +24,19 @@ Vec3 squaredSemiAxes(const Eigen::Matrix3d& a) {
   return solver.eigenvalues();
 }
 
+// Whether every eigenvalue of the symmetric a lies strictly inside (lo, hi), by Sylvester's
+// criterion on a - lo I and hi I - a (their leading principal minors positive): a few products
+// instead of the closed-form eigenvalues' acos and cos. Callers pass a band shrunk by a relative
+// 1e-6, far beyond the rounding of either method, so a shape it accepts is one the eigenvalues
+// accept too; shapes near the band's edges go to the eigenvalues.
+bool eigenvaluesWithin(const Eigen::Matrix3d& a, double lo, double hi) {
+  auto positiveDefinite = [](const Eigen::Matrix3d& m) {
+    return m(0, 0) > 0.0 && m(0, 0) * m(1, 1) - m(0, 1) * m(0, 1) > 0.0 && m.determinant() > 0.0;
+  };
+  const Eigen::Matrix3d identity = Eigen::Matrix3d::Identity();
+  return positiveDefinite(a - lo * identity) && positiveDefinite(hi * identity - a);
+}
+
 }  // namespace
 
 bool isValidShape(const Eigen::Matrix3d& a, double radius) {
@@ -70,6 +83,12 @@ void SplitMerge::classify(const GranularParticles& particles) {
   const double r2 = radius_ * radius_;
   parallelFor(0, n, [&](std::size_t i) {
     const Eigen::Matrix3d a = shapeMatrix(particles.shape[i]);
+    // Most particles are well inside the valid band (squared semi-axes in [r^2 / 2, 2 r^2]).
+    if (eigenvaluesWithin(a, 0.5 * r2 * (1.0 + 1e-6), 2.0 * r2 * (1.0 - 1e-6))) {
+      depth_[i] = 0;
+      plan_[i] = Plan::Keep;
+      return;
+    }
     const Vec3 l = squaredSemiAxes(a);
     const int depth = l[2] > 2.0 * r2 ? splitDepth(a) : 0;
     depth_[i] = static_cast<std::uint8_t>(depth);
