@@ -89,16 +89,20 @@ bool shiftRow(const IVec3& n, const IVec3& m, const IVec3& delta, int y, int z, 
   return r.x0 < r.x1;
 }
 
-// f(y, z, index of the row's first element) for every x-row of a grid of size n, in parallel
-// (rows are independent; about 4096 elements per task).
+// f(y, z, index of the row's first element) for every x-row of a grid of size n that crosses
+// `box` (a box of that grid), in parallel (rows are independent; about 4096 elements per task).
 template <typename F>
-void forRows(const IVec3& n, const F& f) {
-  const std::size_t rows = static_cast<std::size_t>(n[1]) * n[2];
-  const std::size_t grain = std::max<std::size_t>(1, 4096 / std::max(1, n[0]));
+void forRows(const IVec3& n, const LatticeBox& box, const F& f) {
+  if (box.empty()) return;
+  const int ny = box.last[1] - box.first[1] + 1, nz = box.last[2] - box.first[2] + 1;
+  const std::size_t rows = static_cast<std::size_t>(ny) * static_cast<std::size_t>(nz);
+  const std::size_t grain = std::max<std::size_t>(1, 4096 / std::max(1, box.last[0] - box.first[0] + 1));
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows, grain), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t row = r.begin(); row != r.end(); ++row)
-      f(static_cast<int>(row % static_cast<std::size_t>(n[1])), static_cast<int>(row / static_cast<std::size_t>(n[1])),
-        row * static_cast<std::size_t>(n[0]));
+    for (std::size_t row = r.begin(); row != r.end(); ++row) {
+      const int y = box.first[1] + static_cast<int>(row % static_cast<std::size_t>(ny));
+      const int z = box.first[2] + static_cast<int>(row / static_cast<std::size_t>(ny));
+      f(y, z, (static_cast<std::size_t>(z) * n[1] + y) * static_cast<std::size_t>(n[0]));
+    }
   });
 }
 
@@ -120,10 +124,31 @@ void forEachFaceRowOfSamples(const std::array<FaceLinks, 2>& links, int count, c
 
 }  // namespace
 
+LatticeBox facesReading(const StressComponent& c, const LatticeBox& samples, const IVec3& cells, int axis) {
+  std::array<FaceLinks, 2> links;
+  const int count = faceLinks(c, links);
+  for (int e = 0; e < count; ++e) {
+    const FaceLinks& l = links[static_cast<std::size_t>(e)];
+    if (l.faceAxis != axis || samples.empty()) continue;
+    // Face f reads the samples f + plus and f + minus.
+    IVec3 size = cells;
+    size[axis] += 1;
+    const LatticeBox faces{(samples.first - l.plus.cwiseMax(l.minus)).cwiseMax(IVec3::Zero()),
+                           (samples.last - l.plus.cwiseMin(l.minus)).cwiseMin(size - IVec3::Ones())};
+    return faces;
+  }
+  return {};
+}
+
 // The three passes below run row by row: along a row the samples a face reads (and the faces a
 // sample touches) sit at fixed offsets, so the inner loops only index arrays.
 void addDivergence(const StressComponent& c, const std::vector<double>& s, double scale, double dx,
                    const FaceField& mask, FaceField& force) {
+  addDivergence(c, s, scale, dx, mask, force, LatticeBox::whole(latticeSize(c, force.res)));
+}
+
+void addDivergence(const StressComponent& c, const std::vector<double>& s, double scale, double dx,
+                   const FaceField& mask, FaceField& force, const LatticeBox& samples) {
   // Gather form (each face reads the samples around it), so the faces can be written in parallel.
   const IVec3 lattice = latticeSize(c, force.res);
   const double k = scale / dx;
@@ -132,13 +157,16 @@ void addDivergence(const StressComponent& c, const std::vector<double>& s, doubl
   for (int e = 0; e < count; ++e) {
     const FaceLinks& l = links[static_cast<std::size_t>(e)];
     const IVec3 n = force.size(l.faceAxis);
+    const LatticeBox faces = facesReading(c, samples, force.res, l.faceAxis);
     double* out = force.values[l.faceAxis].data();
     const double* m = mask.values[l.faceAxis].data();
-    forRows(n, [&](int y, int z, std::size_t row) {
+    forRows(n, faces, [&](int y, int z, std::size_t row) {
       ShiftedRow hi, lo;
       if (!shiftRow(n, lattice, l.plus, y, z, hi)) hi.x0 = hi.x1 = 0;
       if (!shiftRow(n, lattice, l.minus, y, z, lo)) lo.x0 = lo.x1 = 0;
-      for (int x = std::min(hi.x0, lo.x0); x < std::max(hi.x1, lo.x1); ++x) {
+      const int x0 = std::max(std::min(hi.x0, lo.x0), faces.first[0]);
+      const int x1 = std::min(std::max(hi.x1, lo.x1), faces.last[0] + 1);
+      for (int x = x0; x < x1; ++x) {
         if (m[row + x] == 0.0) continue;
         const double up = x >= hi.x0 && x < hi.x1 ? s[static_cast<std::size_t>(hi.base + x)] : 0.0;
         const double down = x >= lo.x0 && x < lo.x1 ? s[static_cast<std::size_t>(lo.base + x)] : 0.0;
@@ -151,23 +179,32 @@ void addDivergence(const StressComponent& c, const std::vector<double>& s, doubl
 void divergenceTranspose(const StressComponent& c, const FaceField& u, double dx, const FaceField& mask,
                          std::vector<double>& out) {
   const IVec3 lattice = latticeSize(c, u.res);
-  out.assign(static_cast<std::size_t>(lattice[0]) * lattice[1] * lattice[2], 0.0);
+  out.assign(static_cast<std::size_t>(lattice.prod()), 0.0);
+  divergenceTranspose(c, u, dx, mask, out, LatticeBox::whole(lattice));
+}
+
+void divergenceTranspose(const StressComponent& c, const FaceField& u, double dx, const FaceField& mask,
+                         std::vector<double>& out, const LatticeBox& samples) {
+  const IVec3 lattice = latticeSize(c, u.res);
+  out.resize(static_cast<std::size_t>(lattice.prod()));
   const double k = 1.0 / dx;
   std::array<FaceLinks, 2> links;
   const int count = faceLinks(c, links);
-  forRows(lattice, [&](int y, int z, std::size_t row) {
+  const int x0 = samples.first[0], x1 = samples.last[0] + 1;
+  forRows(lattice, samples, [&](int y, int z, std::size_t row) {
     double* o = out.data() + row;
+    for (int x = x0; x < x1; ++x) o[x] = 0.0;
     // Masked faces count as 0.
     forEachFaceRowOfSamples(links, count, lattice, u, y, z, [&](const FaceLinks& l, bool plus, const ShiftedRow& r) {
       const double* v = u.values[l.faceAxis].data();
       const double* m = mask.values[l.faceAxis].data();
       const double sign = plus ? 1.0 : -1.0;
-      for (int x = r.x0; x < r.x1; ++x) {
+      for (int x = std::max(r.x0, x0); x < std::min(r.x1, x1); ++x) {
         const std::size_t f = static_cast<std::size_t>(r.base + x);
         if (m[f] != 0.0) o[x] += sign * v[f];
       }
     });
-    for (int x = 0; x < lattice[0]; ++x) o[x] *= k;
+    for (int x = x0; x < x1; ++x) o[x] *= k;
   });
 }
 
@@ -180,7 +217,7 @@ void poissonStencil(const StressComponent& c, const FaceField& weight, double dx
   const double k = 1.0 / (dx * dx);
   std::array<FaceLinks, 2> links;
   const int linkCount = faceLinks(c, links);
-  forRows(lattice, [&](int y, int z, std::size_t row) {
+  forRows(lattice, LatticeBox::whole(lattice), [&](int y, int z, std::size_t row) {
     double* d = diagonal.data() + row;
     forEachFaceRowOfSamples(links, linkCount, lattice, weight, y, z,
                             [&](const FaceLinks& l, bool plus, const ShiftedRow& r) {

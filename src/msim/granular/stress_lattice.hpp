@@ -51,6 +51,24 @@ struct StressComponent {
 // Samples of a component's lattice along each axis for a grid of `cells`.
 IVec3 latticeSize(const StressComponent& c, const IVec3& cells);
 
+// An axis-aligned box of lattice samples (or faces), first..last inclusive; empty when last < first
+// on some axis. The solver tracks where each stress component may be nonzero with one, so that the
+// bookkeeping around a friction solve touches only that part of the grid.
+struct LatticeBox {
+  IVec3 first = IVec3::Zero(), last = IVec3::Constant(-1);
+  static LatticeBox whole(const IVec3& size) { return {IVec3::Zero(), size - IVec3::Ones()}; }
+  bool empty() const { return (last.array() < first.array()).any(); }
+  LatticeBox unite(const LatticeBox& o) const {
+    if (empty()) return o;
+    if (o.empty()) return *this;
+    return {first.cwiseMin(o.first), last.cwiseMax(o.last)};
+  }
+};
+
+// The faces of `axis` (in the face grid of `cells`) whose divergence of c reads a sample in
+// `samples`: empty if c does not act on faces of that axis.
+LatticeBox facesReading(const StressComponent& c, const LatticeBox& samples, const IVec3& cells, int axis);
+
 // Calls f(sample index, sign) for the (at most two) samples of component c whose difference
 // gives div(s) on face-`faceAxis` f (D_c's row of that face, times dx): nothing if the component
 // does not act on faces of that axis.
@@ -61,9 +79,17 @@ void forEachFaceSample(const StressComponent& c, const IVec3& lattice, int faceA
 // entry is 0 (walls) are left untouched.
 void addDivergence(const StressComponent& c, const std::vector<double>& s, double scale, double dx,
                    const FaceField& mask, FaceField& force);
+// The same for an s that is 0 outside `samples`: only the faces reading those samples are visited
+// (bitwise what the whole pass gives, which adds 0 elsewhere).
+void addDivergence(const StressComponent& c, const std::vector<double>& s, double scale, double dx,
+                   const FaceField& mask, FaceField& force, const LatticeBox& samples);
 // out = D_c^T u (u on faces; masked faces count as 0). out is resized to the lattice.
 void divergenceTranspose(const StressComponent& c, const FaceField& u, double dx, const FaceField& mask,
                          std::vector<double>& out);
+// The same for the samples in `samples` only (out is resized to the lattice; its other entries are
+// left as they were). It reads u on facesReading(c, samples, ...) only.
+void divergenceTranspose(const StressComponent& c, const FaceField& u, double dx, const FaceField& mask,
+                         std::vector<double>& out, const LatticeBox& samples);
 
 // The Poisson form of D_c^T W D_c for face weights W (>= 0; masked faces count as 0): for each
 // lattice axis the weight of the link between sample q and q - e_axis, and the diagonal. Samples

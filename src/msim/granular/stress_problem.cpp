@@ -64,36 +64,40 @@ void StressProblem::bodyColumns(const GranularGridState& st, const CoupledBody& 
   }
 }
 
-int StressProblem::solve(numerics::BoundQpSettings settings, double absoluteFloor) {
-  // The bounding box and the number of the samples with room, one slice of the slowest axis per task.
-  struct Box {
-    IVec3 first, last;
-    std::size_t free = 0;
-  };
-  const Box none{lattice, IVec3::Constant(-1)};
-  const Box found = tbb::parallel_reduce(
+StressProblem::FreeSamples StressProblem::freeSamples() const {
+  // One slice of the slowest axis per task.
+  const FreeSamples none{LatticeBox{lattice, IVec3::Constant(-1)}, 0};
+  return tbb::parallel_reduce(
       tbb::blocked_range<int>(0, lattice[2]), none,
-      [&](const tbb::blocked_range<int>& r, Box box) {
+      [&](const tbb::blocked_range<int>& r, FreeSamples found) {
         for (int k = r.begin(); k != r.end(); ++k)
           for (int j = 0; j < lattice[1]; ++j)
             for (int i = 0; i < lattice[0]; ++i) {
               const Eigen::Index q = (static_cast<Eigen::Index>(k) * lattice[1] + j) * lattice[0] + i;
               if (!(lo[q] < hi[q])) continue;
-              box.first = box.first.cwiseMin(IVec3(i, j, k));
-              box.last = box.last.cwiseMax(IVec3(i, j, k));
-              ++box.free;
+              found.box.first = found.box.first.cwiseMin(IVec3(i, j, k));
+              found.box.last = found.box.last.cwiseMax(IVec3(i, j, k));
+              ++found.count;
             }
-        return box;
+        return found;
       },
-      [](const Box& a, const Box& b) {
-        return Box{a.first.cwiseMin(b.first), a.last.cwiseMax(b.last), a.free + b.free};
+      [](const FreeSamples& a, const FreeSamples& b) {
+        return FreeSamples{LatticeBox{a.box.first.cwiseMin(b.box.first), a.box.last.cwiseMax(b.box.last)},
+                           a.count + b.count};
       });
+}
+
+int StressProblem::solve(numerics::BoundQpSettings settings, double absoluteFloor) {
+  return solve(freeSamples(), settings, absoluteFloor);
+}
+
+int StressProblem::solve(const FreeSamples& found, numerics::BoundQpSettings settings, double absoluteFloor) {
   x = x.cwiseMax(lo).cwiseMin(hi);
-  if ((found.last.array() < 0).any()) return 0;
-  const double boxSize = (found.last - found.first + IVec3::Ones()).cast<double>().prod();
+  if (found.box.empty()) return 0;
+  const double boxSize = (found.box.last - found.box.first + IVec3::Ones()).cast<double>().prod();
   // The box's structured stencil is cheaper per sample than the listed rows (no indirection).
-  if (static_cast<double>(found.free) < 0.5 * boxSize) return solveOnFreeSamples(found.free, settings, absoluteFloor);
-  return solveOnBox(found.first, found.last, found.free, settings, absoluteFloor);
+  if (static_cast<double>(found.count) < 0.5 * boxSize) return solveOnFreeSamples(found.count, settings, absoluteFloor);
+  return solveOnBox(found.box.first, found.box.last, found.count, settings, absoluteFloor);
 }
 
 void StressProblem::applyFloor(numerics::BoundQpSettings& settings, double absoluteFloor, std::size_t n, double bNorm) {
@@ -303,14 +307,45 @@ void addTerms(const std::vector<StressTerm>& terms, const std::vector<double>& x
   for (const StressTerm& t : terms) addDivergence(t.c, x, scale * t.sign, dx, mask, force);
 }
 
+void addTerms(const std::vector<StressTerm>& terms, const std::vector<double>& x, double scale, double dx,
+              const FaceField& mask, FaceField& force, const LatticeBox& samples) {
+  for (const StressTerm& t : terms) addDivergence(t.c, x, scale * t.sign, dx, mask, force, samples);
+}
+
 void transposeTerms(const std::vector<StressTerm>& terms, const FaceField& u, double dx, const FaceField& mask,
                     std::vector<double>& out, std::vector<double>& tmp) {
-  out.clear();
+  out.assign(static_cast<std::size_t>(latticeSize(terms.front().c, u.res).prod()), 0.0);
+  transposeTerms(terms, u, dx, mask, out, tmp, LatticeBox::whole(latticeSize(terms.front().c, u.res)));
+}
+
+void transposeTerms(const std::vector<StressTerm>& terms, const FaceField& u, double dx, const FaceField& mask,
+                    std::vector<double>& out, std::vector<double>& tmp, const LatticeBox& samples) {
+  const IVec3 lattice = latticeSize(terms.front().c, u.res);
+  out.resize(static_cast<std::size_t>(lattice.prod()));
+  if (samples.empty()) return;
+  auto forBoxRows = [&](const auto& f) {  // f(first index of a row of the box, its length)
+    const int width = samples.last[0] - samples.first[0] + 1;
+    parallelFor(0, static_cast<std::size_t>(samples.last[2] - samples.first[2] + 1), [&](std::size_t dz) {
+      for (int y = samples.first[1]; y <= samples.last[1]; ++y)
+        f((static_cast<std::size_t>(samples.first[2] + static_cast<int>(dz)) * lattice[1] + y) * lattice[0] +
+              samples.first[0],
+          width);
+    }, 1);
+  };
+  forBoxRows([&](std::size_t row, int width) { std::fill(out.begin() + row, out.begin() + row + width, 0.0); });
   for (const StressTerm& t : terms) {
-    divergenceTranspose(t.c, u, dx, mask, tmp);
-    if (out.empty()) out.assign(tmp.size(), 0.0);
-    for (std::size_t i = 0; i < tmp.size(); ++i) out[i] += t.sign * tmp[i];
+    divergenceTranspose(t.c, u, dx, mask, tmp, samples);
+    forBoxRows([&](std::size_t row, int width) {
+      for (std::size_t i = row; i < row + static_cast<std::size_t>(width); ++i) out[i] += t.sign * tmp[i];
+    });
   }
+}
+
+std::array<LatticeBox, 3> termFaces(const std::vector<StressTerm>& terms, const LatticeBox& samples, const IVec3& cells) {
+  std::array<LatticeBox, 3> faces;
+  for (const StressTerm& t : terms)
+    for (int a = 0; a < 3; ++a) faces[static_cast<std::size_t>(a)] = faces[static_cast<std::size_t>(a)].unite(facesReading(t.c, samples, cells, a));
+  return faces;
 }
 
 }  // namespace msim::granular

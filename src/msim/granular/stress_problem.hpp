@@ -125,6 +125,15 @@ struct StressProblem {
   // absoluteFloor: a projected-gradient norm per sqrt(free sample) below which the solve stops
   // even if the relative tolerance is not met (0: relative only). Returns the MPRGP iterations.
   int solve(numerics::BoundQpSettings settings, double absoluteFloor = 0.0);
+  // The samples with room (lo < hi): their bounding box and their number. A solve sets x to its
+  // bounds outside the box (0 for the friction) and reads b only inside it.
+  struct FreeSamples {
+    LatticeBox box;
+    std::size_t count = 0;
+  };
+  FreeSamples freeSamples() const;
+  // solve() with the free samples already found (freeSamples() of the current bounds).
+  int solve(const FreeSamples& found, numerics::BoundQpSettings settings, double absoluteFloor = 0.0);
 
  private:
   int solveOnBox(const IVec3& first, const IVec3& last, std::size_t freeCount, numerics::BoundQpSettings settings,
@@ -137,8 +146,17 @@ struct StressProblem {
 // Sum over terms of sign * D_term x, added into force (per unit volume).
 void addTerms(const std::vector<StressTerm>& terms, const std::vector<double>& x, double scale, double dx,
               const FaceField& mask, FaceField& force);
+// The same for an x that is 0 outside `samples`: only the faces reading those samples change.
+void addTerms(const std::vector<StressTerm>& terms, const std::vector<double>& x, double scale, double dx,
+              const FaceField& mask, FaceField& force, const LatticeBox& samples);
 // out = sum over terms of sign * D_term^T u (tmp: scratch).
 void transposeTerms(const std::vector<StressTerm>& terms, const FaceField& u, double dx, const FaceField& mask,
                     std::vector<double>& out, std::vector<double>& tmp);
+// The same for the samples in `samples` only (out sized to the lattice, its other entries left
+// as they were); reads u on the faces of termFaces(terms, samples, ...) only.
+void transposeTerms(const std::vector<StressTerm>& terms, const FaceField& u, double dx, const FaceField& mask,
+                    std::vector<double>& out, std::vector<double>& tmp, const LatticeBox& samples);
+// Per axis, the faces whose divergence of the terms reads a sample in `samples`.
+std::array<LatticeBox, 3> termFaces(const std::vector<StressTerm>& terms, const LatticeBox& samples, const IVec3& cells);
 
 }  // namespace msim::granular

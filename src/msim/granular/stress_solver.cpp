@@ -129,7 +129,10 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
                                                 StressComponent::OffDiagonal(0, 2), StressComponent::OffDiagonal(1, 2)};
   for (std::size_t k = 0; k < 6; ++k) {
     const std::size_t n = static_cast<std::size_t>(latticeSize(comps[k], st.spec.res).prod());
-    if (s_[k].size() != n || !settings_.friction) s_[k].assign(n, 0.0);
+    if (s_[k].size() != n || !settings_.friction) {
+      s_[k].assign(n, 0.0);
+      sBox_[k] = {};
+    }
   }
   // The storage of each friction problem's variable: up, the pair (a, c), xy, yz, xz.
   const std::array<std::size_t, 5> slot = {static_cast<std::size_t>(up), static_cast<std::size_t>(pa), 3, 5, 4};
@@ -143,13 +146,29 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
   // velocity is v0 + dt kappa F and each body's V0 + dt V_c M^-1 sum_f phi_s G_f F_f (eq. 5.23).
   // A problem removes its own variable's share of F, solves, and adds the new share back.
   addTerms(m.pressure.terms, p_, 1.0, dx, st.open, m.force);
-  for (std::size_t k = 0; k < 3; ++k) addDivergence(comps[k], s_[k], 1.0, dx, st.open, m.force);
-  for (std::size_t k = 3; k < 6; ++k) addDivergence(comps[k], s_[k], 1.0, dx, st.open, m.force);
+  for (std::size_t k = 0; k < 6; ++k) addDivergence(comps[k], s_[k], 1.0, dx, st.open, m.force, sBox_[k]);
   auto grainVelocity = [&] {
     for (int a = 0; a < 3; ++a)
       parallelFor(0, velocity.values[a].size(), [&](std::size_t i) {
         velocity.values[a][i] = m.velocity0.values[a][i] + dt * m.kappa.values[a][i] * m.force.values[a][i];
       }, 4096);
+  };
+  // The same, times the face weights w, into m.flux, on the faces `faces` only (per axis).
+  auto weightedGrainVelocity = [&](const FaceField& w, const std::array<LatticeBox, 3>& faces) {
+    for (int a = 0; a < 3; ++a) {
+      const LatticeBox& box = faces[static_cast<std::size_t>(a)];
+      if (box.empty()) continue;
+      const IVec3 n = velocity.size(a);
+      parallelFor(0, static_cast<std::size_t>(box.last[2] - box.first[2] + 1), [&](std::size_t dz) {
+        for (int y = box.first[1]; y <= box.last[1]; ++y) {
+          const std::size_t row = (static_cast<std::size_t>(box.first[2] + static_cast<int>(dz)) * n[1] + y) * n[0];
+          for (std::size_t i = row + box.first[0]; i <= row + box.last[0]; ++i) {
+            velocity.values[a][i] = m.velocity0.values[a][i] + dt * m.kappa.values[a][i] * m.force.values[a][i];
+            m.flux.values[a][i] = w.values[a][i] * velocity.values[a][i];
+          }
+        }
+      }, 1);
+    }
   };
   // Each body's faces: phi_s G_f (G_f = [e_a; r_f x e_a]).
   m.bodyFaces.resize(bodies.size());
@@ -197,34 +216,6 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
       for (std::size_t k = 0; k < m.friction.size(); ++k) {
         StressProblem& pr = m.friction[k];
         const std::vector<double>& sUp = s_[static_cast<std::size_t>(up)];
-        // Remove this variable's share of F (v~|_{s_c = 0} of eq. 5.46). The pair removes both
-        // its components and puts back their trace-free part -s_up / 2 for the current s_up.
-        if (k == 1) {
-          for (int axis : {pa, pc}) {
-            std::vector<double>& s = s_[static_cast<std::size_t>(axis)];
-            parallelFor(0, cells, [&](std::size_t i) { m.cellScratch[i] = -0.5 * sUp[i] - s[i]; }, 4096);
-            addDivergence(StressComponent::Diagonal(axis), m.cellScratch, 1.0, dx, st.open, m.force);
-          }
-          var.resize(cells);
-          parallelFor(0, cells, [&](std::size_t i) {
-            var[i] = 0.5 * (s_[static_cast<std::size_t>(pa)][i] - s_[static_cast<std::size_t>(pc)][i]);
-          }, 4096);
-        } else {
-          var = s_[slot[k]];
-          addTerms(pr.terms, var, -1.0, dx, st.open, m.force);
-        }
-        grainVelocity();
-        bodyVelocities();
-        // Linear term dt (D^T phi (1 - phi_s) v~ + J^T V~) (eqs. 5.19, 5.26, 5.50), negated for
-        // the solver's 1/2 x^T A x - b^T x.
-        weightedFaces(m.weightB, velocity, m.flux);
-        transposeTerms(pr.terms, m.flux, dx, st.open, m.tmp, m.tmp2);
-        pr.b = -dt * Eigen::Map<const Eigen::VectorXd>(m.tmp.data(), static_cast<Eigen::Index>(m.tmp.size()));
-        for (std::size_t b = 0; b < bodies.size(); ++b) {
-          const BodyColumns& bc = pr.bodies[b];
-          for (std::size_t j = 0; j < bc.sample.size(); ++j)
-            pr.b[static_cast<Eigen::Index>(bc.sample[j])] -= dt * bc.column[j].dot(m.bodyVelocity[b]);
-        }
         // Bounds |s_ij| <= alpha p (eq. 5.15); the pair keeps s_a and s_c within them given s_up.
         parallelFor(0, cells, [&](std::size_t i) { m.cellScratch[i] = st.alpha[i] * p_[i]; }, 4096);
         toLattice(pr.terms.front().c, st.spec.res, m.cellScratch, m.smax);
@@ -232,28 +223,64 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
         const Eigen::Index n = static_cast<Eigen::Index>(m.smax.size());
         pr.lo.resize(n);
         pr.hi.resize(n);
-        pr.x.resize(n);
         parallelFor(0, static_cast<std::size_t>(n), [&](std::size_t i) {
           const double half = k == 1 ? 0.5 * std::abs(sUp[i]) : 0.0;
           const double bound = std::max(0.0, m.smax[i] - half);
-          const Eigen::Index e = static_cast<Eigen::Index>(i);
-          pr.lo[e] = -bound;
-          pr.hi[e] = bound;
-          pr.x[e] = var[i];
+          pr.lo[static_cast<Eigen::Index>(i)] = -bound;
+          pr.hi[static_cast<Eigen::Index>(i)] = bound;
         }, 4096);
+        // The new variable lives on the samples with room (the others are held at 0), so only
+        // the faces reading those samples, or the old ones, take part in the bookkeeping below.
+        const StressProblem::FreeSamples found = pr.freeSamples();
+        const std::size_t pa_ = static_cast<std::size_t>(pa), pc_ = static_cast<std::size_t>(pc);
+        // Remove this variable's share of F (v~|_{s_c = 0} of eq. 5.46). The pair removes both
+        // its components and puts back their trace-free part -s_up / 2 for the current s_up.
+        if (k == 1) {
+          const LatticeBox old = sBox_[static_cast<std::size_t>(up)].unite(sBox_[pa_]).unite(sBox_[pc_]);
+          for (int axis : {pa, pc}) {
+            std::vector<double>& s = s_[static_cast<std::size_t>(axis)];
+            parallelFor(0, cells, [&](std::size_t i) { m.cellScratch[i] = -0.5 * sUp[i] - s[i]; }, 4096);
+            addDivergence(StressComponent::Diagonal(axis), m.cellScratch, 1.0, dx, st.open, m.force, old);
+          }
+          var.resize(cells);
+          parallelFor(0, cells, [&](std::size_t i) { var[i] = 0.5 * (s_[pa_][i] - s_[pc_][i]); }, 4096);
+        } else {
+          var = s_[slot[k]];
+          addTerms(pr.terms, var, -1.0, dx, st.open, m.force, sBox_[slot[k]]);
+        }
+        bodyVelocities();
+        // Linear term dt (D^T phi (1 - phi_s) v~ + J^T V~) (eqs. 5.19, 5.26, 5.50), negated for
+        // the solver's 1/2 x^T A x - b^T x, on the free samples (the solve reads no other).
+        weightedGrainVelocity(m.weightB, termFaces(pr.terms, found.box, st.spec.res));
+        transposeTerms(pr.terms, m.flux, dx, st.open, m.tmp, m.tmp2, found.box);
+        pr.b.resize(n);
+        if (!found.box.empty())
+          parallelForCells<3>(found.box.last - found.box.first + IVec3::Ones(), [&](const IVec3& q, std::size_t) {
+            const IVec3 at = q + found.box.first;
+            const std::size_t i = (static_cast<std::size_t>(at[2]) * pr.lattice[1] + at[1]) * pr.lattice[0] + at[0];
+            pr.b[static_cast<Eigen::Index>(i)] = -dt * m.tmp[i];
+          });
+        for (std::size_t b = 0; b < bodies.size(); ++b) {
+          const BodyColumns& bc = pr.bodies[b];
+          for (std::size_t j = 0; j < bc.sample.size(); ++j)
+            pr.b[static_cast<Eigen::Index>(bc.sample[j])] -= dt * bc.column[j].dot(m.bodyVelocity[b]);
+        }
+        pr.x = Eigen::Map<const Eigen::VectorXd>(var.data(), n);
         // A friction gradient of dt / dx * delta_v per sample is a velocity error of about
         // delta_v: below velocityTolerance the solve has nothing left worth removing (at rest the
         // relative tolerance would chase particle noise to ever smaller absolute levels).
-        stats_.frictionIterations += pr.solve(qp, dt / dx * settings_.velocityTolerance);
+        stats_.frictionIterations += pr.solve(found, qp, dt / dx * settings_.velocityTolerance);
         var.assign(pr.x.data(), pr.x.data() + pr.x.size());
-        addTerms(pr.terms, var, 1.0, dx, st.open, m.force);
+        addTerms(pr.terms, var, 1.0, dx, st.open, m.force, found.box);
         if (k == 1) {
           parallelFor(0, cells, [&](std::size_t i) {
-            s_[static_cast<std::size_t>(pa)][i] = -0.5 * sUp[i] + var[i];
-            s_[static_cast<std::size_t>(pc)][i] = -0.5 * sUp[i] - var[i];
+            s_[pa_][i] = -0.5 * sUp[i] + var[i];
+            s_[pc_][i] = -0.5 * sUp[i] - var[i];
           }, 4096);
+          sBox_[pa_] = sBox_[pc_] = sBox_[static_cast<std::size_t>(up)].unite(found.box);
         } else {
           s_[slot[k]] = var;
+          sBox_[slot[k]] = found.box;
         }
       }
     }

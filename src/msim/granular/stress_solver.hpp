@@ -79,6 +79,9 @@ class StressSolver {
   StressSolverStats stats_;
   std::vector<double> p_;
   std::array<std::vector<double>, 6> s_;  // xx, yy, zz, xy, xz, yz
+  // Where each component of s_ may be nonzero (empty: nowhere), so the friction's bookkeeping can
+  // skip the rest of the grid.
+  std::array<LatticeBox, 6> sBox_;
   std::vector<Eigen::Matrix<double, 6, 1>> impulses_;
   FaceField displacement_;
 };
