@@ -111,3 +111,52 @@ TEST(GranularStressLattice, PoissonStencilIsTheTransposeTimesWeightsTimesTheDive
     EXPECT_LT(isolated, static_cast<int>(x.size()) / 4);
   }
 }
+
+// The friction's bookkeeping runs the passes on a box of samples. For values that vanish outside
+// the box, the boxed divergence must be exactly the whole one, and it must visit the faces that
+// read the box and no others; the boxed transpose must match the whole one inside the box and
+// leave the rest of its output alone.
+TEST(GranularStressLattice, BoxedPassesMatchTheWholeOnes) {
+  std::mt19937 rng(11);
+  const LatticeBox boxes[] = {{IVec3(1, 1, 2), IVec3(3, 2, 4)}, {IVec3(0, 0, 0), IVec3(0, 3, 1)}, {}};
+  for (const StressComponent& c : allComponents())
+    for (const LatticeBox& box : boxes) {
+      const IVec3 lattice = latticeSize(c, kCells);
+      FaceField u, mask;
+      randomFaces(rng, u, mask);
+      std::vector<double> s = randomSamples(rng, c);
+      for (int z = 0; z < lattice[2]; ++z)
+        for (int y = 0; y < lattice[1]; ++y)
+          for (int x = 0; x < lattice[0]; ++x) {
+            const IVec3 q(x, y, z);
+            const bool inside = !box.empty() && (q.array() >= box.first.array()).all() && (q.array() <= box.last.array()).all();
+            if (!inside) s[(static_cast<std::size_t>(z) * lattice[1] + y) * lattice[0] + x] = 0.0;
+          }
+      FaceField whole = u, boxed = u;  // start from nonzero values: both add onto them
+      addDivergence(c, s, 1.3, kDx, mask, whole);
+      addDivergence(c, s, 1.3, kDx, mask, boxed, box);
+      for (int a = 0; a < 3; ++a) {
+        EXPECT_EQ(whole.values[a], boxed.values[a]) << "axis " << a;
+        // Every face the whole pass changed lies in facesReading.
+        const LatticeBox faces = facesReading(c, box, kCells, a);
+        const IVec3 n = u.size(a);
+        for (std::size_t i = 0; i < u.values[a].size(); ++i) {
+          if (whole.values[a][i] == u.values[a][i]) continue;
+          const IVec3 f(static_cast<int>(i % n[0]), static_cast<int>(i / n[0] % n[1]), static_cast<int>(i / n[0] / n[1]));
+          EXPECT_TRUE(!faces.empty() && (f.array() >= faces.first.array()).all() && (f.array() <= faces.last.array()).all())
+              << "axis " << a << " face " << i;
+        }
+      }
+      std::vector<double> full, part(s.size(), 7.0);
+      divergenceTranspose(c, u, kDx, mask, full);
+      divergenceTranspose(c, u, kDx, mask, part, box);
+      for (int z = 0; z < lattice[2]; ++z)
+        for (int y = 0; y < lattice[1]; ++y)
+          for (int x = 0; x < lattice[0]; ++x) {
+            const IVec3 q(x, y, z);
+            const std::size_t i = (static_cast<std::size_t>(z) * lattice[1] + y) * lattice[0] + x;
+            const bool inside = !box.empty() && (q.array() >= box.first.array()).all() && (q.array() <= box.last.array()).all();
+            EXPECT_EQ(part[i], inside ? full[i] : 7.0) << "sample " << i;
+          }
+    }
+}

@@ -180,6 +180,7 @@ void GranularSimulation::rasterizeBodies(double dt) {
           any |= f > 0.0;
         }
     if (!any) continue;
+    c.cells = LatticeBox{lo, hi};
     // Face fractions, the mean of the two cells: nonzero only on the faces of the box's cells.
     c.faceFraction = FaceField(g.res);
     for (int a = 0; a < 3; ++a) {

@@ -58,6 +58,7 @@ struct LatticeBox {
   IVec3 first = IVec3::Zero(), last = IVec3::Constant(-1);
   static LatticeBox whole(const IVec3& size) { return {IVec3::Zero(), size - IVec3::Ones()}; }
   bool empty() const { return (last.array() < first.array()).any(); }
+  LatticeBox intersect(const LatticeBox& o) const { return {first.cwiseMax(o.first), last.cwiseMin(o.last)}; }
   LatticeBox unite(const LatticeBox& o) const {
     if (empty()) return o;
     if (o.empty()) return *this;

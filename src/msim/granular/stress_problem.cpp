@@ -17,21 +17,26 @@ void StressProblem::build(const GranularGridState& st, const FaceField& weight, 
                           const std::vector<const CoupledBody*>& coupled) {
   lattice = latticeSize(terms.front().c, st.spec.res);
   const std::size_t n = static_cast<std::size_t>(lattice.prod());
-  for (auto& l : lower) l.assign(n, 0.0);
-  diagonal.assign(n, 0.0);
-  for (const StressTerm& t : terms) {
-    poissonStencil(t.c, weight, st.spec.dx, st.open, 0.0, part, partDiagonal);
-    for (int a = 0; a < 3; ++a)
-      for (std::size_t i = 0; i < n; ++i) lower[a][i] += part[a][i];
-    for (std::size_t i = 0; i < n; ++i) diagonal[i] += partDiagonal[i];
+  // dt^2 (sum over terms of the stencils): the first term's straight into place, the next ones
+  // added (the pair has two), then scaled, in one pass.
+  poissonStencil(terms.front().c, weight, st.spec.dx, st.open, 0.0, lower, diagonal);
+  for (std::size_t t = 1; t < terms.size(); ++t) {
+    poissonStencil(terms[t].c, weight, st.spec.dx, st.open, 0.0, part, partDiagonal);
+    parallelFor(0, n, [&](std::size_t i) {
+      for (int a = 0; a < 3; ++a) lower[a][i] += part[a][i];
+      diagonal[i] += partDiagonal[i];
+    }, 4096);
   }
   const double dt2 = dt * dt;
-  for (auto& l : lower)
-    for (double& w : l) w *= dt2;
   // Samples no material reaches decouple (hourglass: with a placeholder diagonal of 1 instead,
   // a thousand MPRGP steps and more per friction solve instead of about ten).
-  for (double& d : diagonal) d *= dt2;
-  numerics::setDecoupledDiagonals(diagonal, [&](std::size_t i) { return !(diagonal[i] > 0.0); });
+  parallelFor(0, n, [&](std::size_t i) {
+    for (int a = 0; a < 3; ++a) lower[a][i] *= dt2;
+    diagonal[i] *= dt2;
+  }, 4096);
+  decoupled.resize(n);
+  parallelFor(0, n, [&](std::size_t i) { decoupled[i] = diagonal[i] > 0.0 ? 0 : 1; }, 4096);
+  numerics::setDecoupledDiagonals(diagonal, [&](std::size_t i) { return decoupled[i] != 0; });
   op.setBodyWeight(dt2 * st.spec.cellVolume());
   compact.bodyWeight = dt2 * st.spec.cellVolume();
   bodies.resize(coupled.size());
@@ -44,11 +49,9 @@ void StressProblem::bodyColumns(const GranularGridState& st, const CoupledBody& 
   out.column.clear();
   const double invDx = 1.0 / st.spec.dx;
   for (int a = 0; a < 3; ++a) {
-    const IVec3 n = st.open.size(a);
     const std::vector<double>& frac = body.faceFraction.values[a];
-    for (std::size_t i = 0; i < frac.size(); ++i) {
-      if (frac[i] <= 0.0 || st.open.values[a][i] == 0.0) continue;
-      const IVec3 f(static_cast<int>(i % n[0]), static_cast<int>(i / n[0] % n[1]), static_cast<int>(i / n[0] / n[1]));
+    forEachInBox(body.faces(a, st.spec.res), st.open.size(a), [&](std::size_t i, const IVec3& f) {
+      if (frac[i] <= 0.0 || st.open.values[a][i] == 0.0) return;
       Vec3 x = st.spec.origin + (f.cast<double>().array() + 0.5).matrix() * st.spec.dx;
       x[a] -= 0.5 * st.spec.dx;
       Vec6 g;
@@ -60,7 +63,7 @@ void StressProblem::bodyColumns(const GranularGridState& st, const CoupledBody& 
           out.sample.push_back(q);
           out.column.push_back(t.sign * sign * g);
         });
-    }
+    });
   }
 }
 
@@ -91,16 +94,31 @@ int StressProblem::solve(numerics::BoundQpSettings settings, double absoluteFloo
   return solve(freeSamples(), settings, absoluteFloor);
 }
 
-int StressProblem::solve(const FreeSamples& found, numerics::BoundQpSettings settings, double absoluteFloor) {
+int StressProblem::solve(const FreeSamples& found, numerics::BoundQpSettings settings, double absoluteFloor,
+                         double referenceNorm) {
   x = x.cwiseMax(lo).cwiseMin(hi);
   if (found.box.empty()) return 0;
+  referenceNorm_ = referenceNorm;
   const double boxSize = (found.box.last - found.box.first + IVec3::Ones()).cast<double>().prod();
   // The box's structured stencil is cheaper per sample than the listed rows (no indirection).
   if (static_cast<double>(found.count) < 0.5 * boxSize) return solveOnFreeSamples(found.count, settings, absoluteFloor);
   return solveOnBox(found.box.first, found.box.last, found.count, settings, absoluteFloor);
 }
 
-void StressProblem::applyFloor(numerics::BoundQpSettings& settings, double absoluteFloor, std::size_t n, double bNorm) {
+void StressProblem::holdInertSamples() {
+  const std::size_t n = static_cast<std::size_t>(lattice.prod());
+  bodySample_.assign(n, 0);
+  for (const BodyColumns& body : bodies)
+    for (std::size_t q : body.sample) bodySample_[q] = 1;
+  parallelFor(0, n, [&](std::size_t i) {
+    const Eigen::Index e = static_cast<Eigen::Index>(i);
+    if (decoupled[i] && !bodySample_[i] && lo[e] == 0.0 && b[e] <= 0.0) hi[e] = 0.0;
+  }, 4096);
+}
+
+void StressProblem::applyFloor(numerics::BoundQpSettings& settings, double absoluteFloor, std::size_t n,
+                               double bNorm) const {
+  if (referenceNorm_ > 0.0 && bNorm > 0.0) settings.tolerance *= referenceNorm_ / bNorm;
   if (absoluteFloor > 0.0 && bNorm > 0.0)
     settings.tolerance = std::max(settings.tolerance, absoluteFloor * std::sqrt(static_cast<double>(n)) / bNorm);
 }

@@ -99,6 +99,7 @@ struct StressProblem {
   IVec3 lattice = IVec3::Zero();
   std::array<std::vector<double>, 3> lower, part;  // the whole lattice's stencil
   std::vector<double> diagonal, partDiagonal;
+  std::vector<std::uint8_t> decoupled;  // per sample: no face weight reaches it (from build)
   std::vector<BodyColumns> bodies;  // J of each body, in whole-lattice sample indices
   Eigen::VectorXd b, lo, hi, x;     // whole lattice
   // The solve runs on a box of the lattice or on the list of its free samples (see solve()).
@@ -133,14 +134,25 @@ struct StressProblem {
   };
   FreeSamples freeSamples() const;
   // solve() with the free samples already found (freeSamples() of the current bounds).
-  int solve(const FreeSamples& found, numerics::BoundQpSettings settings, double absoluteFloor = 0.0);
+  // referenceNorm > 0: the relative tolerance refers to this norm of b instead of the norm over
+  // the samples solved for (holdInertSamples keeps the threshold of the whole grid so).
+  int solve(const FreeSamples& found, numerics::BoundQpSettings settings, double absoluteFloor = 0.0,
+            double referenceNorm = 0.0);
+  // Holds at 0 the samples whose solution is 0 whatever the others do: decoupled (no face weight,
+  // no body), lower bound 0 and b <= 0 (their own term 1/2 d x^2 - b x is least at 0 on x >= 0).
+  // In the pressure problems these are the cells without material around them, most of the grid
+  // in a splash or a collapsing column; the solve then runs on the rest.
+  void holdInertSamples();
 
  private:
   int solveOnBox(const IVec3& first, const IVec3& last, std::size_t freeCount, numerics::BoundQpSettings settings,
                  double absoluteFloor);
   int solveOnFreeSamples(std::size_t freeCount, numerics::BoundQpSettings settings, double absoluteFloor);
-  // The relative tolerance raised to the absolute floor for n free samples (see solve()).
-  static void applyFloor(numerics::BoundQpSettings& settings, double absoluteFloor, std::size_t n, double bNorm);
+  // The relative tolerance referred to referenceNorm_ (if set) and raised to the absolute floor for
+  // n free samples (see solve()); bNorm: the norm of the restricted problem's b.
+  void applyFloor(numerics::BoundQpSettings& settings, double absoluteFloor, std::size_t n, double bNorm) const;
+  double referenceNorm_ = 0.0;           // of the solve under way (solve())
+  std::vector<std::uint8_t> bodySample_;  // holdInertSamples scratch
 };
 
 // Sum over terms of sign * D_term x, added into force (per unit volume).
