@@ -67,15 +67,18 @@ void StressProblem::bodyColumns(const GranularGridState& st, const CoupledBody& 
   }
 }
 
-StressProblem::FreeSamples StressProblem::freeSamples() const {
+StressProblem::FreeSamples StressProblem::freeSamples() const { return freeSamples(LatticeBox::whole(lattice)); }
+
+StressProblem::FreeSamples StressProblem::freeSamples(const LatticeBox& within) const {
   // One slice of the slowest axis per task.
   const FreeSamples none{LatticeBox{lattice, IVec3::Constant(-1)}, 0};
+  if (within.empty()) return none;
   return tbb::parallel_reduce(
-      tbb::blocked_range<int>(0, lattice[2]), none,
+      tbb::blocked_range<int>(within.first[2], within.last[2] + 1), none,
       [&](const tbb::blocked_range<int>& r, FreeSamples found) {
         for (int k = r.begin(); k != r.end(); ++k)
-          for (int j = 0; j < lattice[1]; ++j)
-            for (int i = 0; i < lattice[0]; ++i) {
+          for (int j = within.first[1]; j <= within.last[1]; ++j)
+            for (int i = within.first[0]; i <= within.last[0]; ++i) {
               const Eigen::Index q = (static_cast<Eigen::Index>(k) * lattice[1] + j) * lattice[0] + i;
               if (!(lo[q] < hi[q])) continue;
               found.box.first = found.box.first.cwiseMin(IVec3(i, j, k));

@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 
+#include "msim/core/parallel.hpp"
 #include "msim/granular/grid_state.hpp"
 #include "msim/granular/stress_lattice.hpp"
 #include "msim/numerics/bound_qp.hpp"
@@ -133,6 +134,14 @@ struct StressProblem {
     std::size_t count = 0;
   };
   FreeSamples freeSamples() const;
+  // The same when every sample with room lies in `within`.
+  FreeSamples freeSamples(const LatticeBox& within) const;
+  // Symmetric bounds -bound(i, q) <= x_i <= bound(i, q) for the samples q (index i) in `box`, 0
+  // elsewhere (the friction's, eq. 5.15). Only the box and the last call's box are visited.
+  template <typename Bound>
+  void setBounds(const LatticeBox& box, const Bound& bound);
+  // Where the last setBounds may have left nonzero bounds.
+  const LatticeBox& boundsBox() const { return boundsBox_; }
   // solve() with the free samples already found (freeSamples() of the current bounds).
   // referenceNorm > 0: the relative tolerance refers to this norm of b instead of the norm over
   // the samples solved for (holdInertSamples keeps the threshold of the whole grid so).
@@ -152,8 +161,36 @@ struct StressProblem {
   // n free samples (see solve()); bNorm: the norm of the restricted problem's b.
   void applyFloor(numerics::BoundQpSettings& settings, double absoluteFloor, std::size_t n, double bNorm) const;
   double referenceNorm_ = 0.0;           // of the solve under way (solve())
+  LatticeBox boundsBox_;                  // setBounds
   std::vector<std::uint8_t> bodySample_;  // holdInertSamples scratch
 };
+
+template <typename Bound>
+void StressProblem::setBounds(const LatticeBox& box, const Bound& bound) {
+  const Eigen::Index n = static_cast<Eigen::Index>(lattice.prod());
+  if (lo.size() != n || hi.size() != n) {
+    lo = Eigen::VectorXd::Zero(n);
+    hi = Eigen::VectorXd::Zero(n);
+    boundsBox_ = {};
+  }
+  // One z slice of a box per task.
+  auto forBox = [&](const LatticeBox& b, const auto& f) {
+    if (b.empty()) return;
+    parallelFor(0, static_cast<std::size_t>(b.last[2] - b.first[2] + 1), [&](std::size_t dz) {
+      const int z = b.first[2] + static_cast<int>(dz);
+      for (int y = b.first[1]; y <= b.last[1]; ++y)
+        for (int x = b.first[0]; x <= b.last[0]; ++x)
+          f((static_cast<std::size_t>(z) * lattice[1] + y) * lattice[0] + x, IVec3(x, y, z));
+    }, 1);
+  };
+  forBox(boundsBox_, [&](std::size_t i, const IVec3&) { lo[static_cast<Eigen::Index>(i)] = hi[static_cast<Eigen::Index>(i)] = 0.0; });
+  forBox(box, [&](std::size_t i, const IVec3& q) {
+    const double b = bound(i, q);
+    lo[static_cast<Eigen::Index>(i)] = -b;
+    hi[static_cast<Eigen::Index>(i)] = b;
+  });
+  boundsBox_ = box;
+}
 
 // Sum over terms of sign * D_term x, added into force (per unit volume).
 void addTerms(const std::vector<StressTerm>& terms, const std::vector<double>& x, double scale, double dx,

@@ -7,6 +7,9 @@
 
 #include <Eigen/Geometry>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
 #include "msim/core/parallel.hpp"
 #include "msim/core/timer.hpp"
 
@@ -16,7 +19,7 @@ struct StressSolver::Impl {
   StressProblem pressure;
   std::array<StressProblem, 5> friction;  // up diagonal, the other pair, and the three off-diagonals
   FaceField kappa, weightP, weightS, weightB, force, flux, velocity0;
-  std::vector<double> tmp, tmp2, smax, var, cellScratch;
+  std::vector<double> tmp, tmp2, var, cellScratch, cellBound;
   struct BodyFace {
     int axis;
     std::size_t index;
@@ -47,38 +50,42 @@ const std::vector<double>& StressSolver::stress(const StressComponent& c) const 
 namespace {
 
 // Cell value averaged onto the samples of a component's lattice (the cells around an edge).
-void toLattice(const StressComponent& c, const IVec3& cells, const std::vector<double>& cell, std::vector<double>& out) {
-  const IVec3 n = latticeSize(c, cells);
-  out.resize(static_cast<std::size_t>(n.prod()));
-  if (c.diagonal()) {
-    std::copy(cell.begin(), cell.end(), out.begin());
-    return;
-  }
-  parallelForCells<3>(n, [&](const IVec3& q, std::size_t i) {
-    double sum = 0.0;
-    int count = 0;
-    for (int da = -1; da <= 0; ++da)
-      for (int db = -1; db <= 0; ++db) {
-        IVec3 k = q;
-        k[c.a] += da;
-        k[c.b] += db;
-        if (k[c.a] < 0 || k[c.b] < 0 || k[c.a] >= cells[c.a] || k[c.b] >= cells[c.b]) continue;
-        sum += cell[(static_cast<std::size_t>(k[2]) * cells[1] + k[1]) * cells[0] + k[0]];
-        ++count;
-      }
-    out[i] = count ? sum / count : 0.0;
-  });
+// The friction bound of sample q of component c (eq. 5.15) from the cell bounds alpha p: a
+// diagonal sample is its cell; an edge sample takes the mean over the cells around it. Slip walls:
+// the edges on a domain wall normal to a slip axis carry the wall's tangential friction (the
+// off-diagonal components there act only on the faces beside the wall); their bound is 0.
+double sampleBound(const StressComponent& c, const IVec3& cells, const std::vector<double>& cell, const IVec3& q,
+                   unsigned slipWalls) {
+  if (c.diagonal()) return cell[(static_cast<std::size_t>(q[2]) * cells[1] + q[1]) * cells[0] + q[0]];
+  for (int w : {c.a, c.b})
+    if ((slipWalls >> w & 1u) != 0 && (q[w] == 0 || q[w] == cells[w])) return 0.0;
+  double sum = 0.0;
+  int count = 0;
+  for (int da = -1; da <= 0; ++da)
+    for (int db = -1; db <= 0; ++db) {
+      IVec3 k = q;
+      k[c.a] += da;
+      k[c.b] += db;
+      if (k[c.a] < 0 || k[c.b] < 0 || k[c.a] >= cells[c.a] || k[c.b] >= cells[c.b]) continue;
+      sum += cell[(static_cast<std::size_t>(k[2]) * cells[1] + k[1]) * cells[0] + k[0]];
+      ++count;
+    }
+  return count ? sum / count : 0.0;
 }
 
-// Slip walls: the edges on a domain wall normal to a slip axis carry the wall's tangential friction
-// (the off-diagonal components there act only on the faces beside the wall); their bound is 0.
-void removeWallFriction(const StressComponent& c, const IVec3& cells, unsigned slipWalls, std::vector<double>& smax) {
-  if (c.diagonal()) return;
-  const IVec3 n = latticeSize(c, cells);
-  parallelForCells<3>(n, [&](const IVec3& q, std::size_t i) {
-    for (int w : {c.a, c.b})
-      if ((slipWalls >> w & 1u) != 0 && (q[w] == 0 || q[w] == cells[w])) smax[i] = 0.0;
-  });
+// The box of the cells where v is positive (empty if none), one slice of z per task.
+LatticeBox positiveCells(const std::vector<double>& v, const IVec3& cells) {
+  return tbb::parallel_reduce(
+      tbb::blocked_range<int>(0, cells[2]), LatticeBox{},
+      [&](const tbb::blocked_range<int>& r, LatticeBox box) {
+        for (int z = r.begin(); z != r.end(); ++z)
+          for (int y = 0; y < cells[1]; ++y)
+            for (int x = 0; x < cells[0]; ++x)
+              if (v[(static_cast<std::size_t>(z) * cells[1] + y) * cells[0] + x] > 0.0)
+                box = box.unite(LatticeBox{IVec3(x, y, z), IVec3(x, y, z)});
+        return box;
+      },
+      [](const LatticeBox& a, const LatticeBox& b) { return a.unite(b); });
 }
 
 // out = w * v, face by face.
@@ -211,25 +218,29 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
   for (int iteration = 0; iteration < settings_.staggeredIterations; ++iteration) {
     if (settings_.friction) {
       ScopedTimer t(stats_.frictionSeconds);
+      // Bounds |s_ij| <= alpha p (eq. 5.15): the cells' alpha p, and the box of the cells where
+      // it is positive; no friction sample outside what reads that box has room.
+      m.cellBound.resize(cells);
+      parallelFor(0, cells, [&](std::size_t i) { m.cellBound[i] = st.alpha[i] * p_[i]; }, 4096);
+      const LatticeBox pressed = positiveCells(m.cellBound, st.spec.res);
       for (std::size_t k = 0; k < m.friction.size(); ++k) {
         StressProblem& pr = m.friction[k];
         const std::vector<double>& sUp = s_[static_cast<std::size_t>(up)];
-        // Bounds |s_ij| <= alpha p (eq. 5.15); the pair keeps s_a and s_c within them given s_up.
-        parallelFor(0, cells, [&](std::size_t i) { m.cellScratch[i] = st.alpha[i] * p_[i]; }, 4096);
-        toLattice(pr.terms.front().c, st.spec.res, m.cellScratch, m.smax);
-        if (settings_.slipWalls != 0) removeWallFriction(pr.terms.front().c, st.spec.res, settings_.slipWalls, m.smax);
-        const Eigen::Index n = static_cast<Eigen::Index>(m.smax.size());
-        pr.lo.resize(n);
-        pr.hi.resize(n);
-        parallelFor(0, static_cast<std::size_t>(n), [&](std::size_t i) {
+        // The pair keeps s_a and s_c within the bounds given s_up.
+        const StressComponent& c = pr.terms.front().c;
+        LatticeBox room = pressed;
+        if (!c.diagonal() && !room.empty()) {
+          room.last[c.a] += 1;  // an edge reads the cells below it along a and b too
+          room.last[c.b] += 1;
+        }
+        pr.setBounds(room.intersect(LatticeBox::whole(pr.lattice)), [&](std::size_t i, const IVec3& q) {
           const double half = k == 1 ? 0.5 * std::abs(sUp[i]) : 0.0;
-          const double bound = std::max(0.0, m.smax[i] - half);
-          pr.lo[static_cast<Eigen::Index>(i)] = -bound;
-          pr.hi[static_cast<Eigen::Index>(i)] = bound;
-        }, 4096);
+          return std::max(0.0, sampleBound(c, st.spec.res, m.cellBound, q, settings_.slipWalls) - half);
+        });
+        const Eigen::Index n = pr.lo.size();
         // The new variable lives on the samples with room (the others are held at 0), so only
         // the faces reading those samples, or the old ones, take part in the bookkeeping below.
-        const StressProblem::FreeSamples found = pr.freeSamples();
+        const StressProblem::FreeSamples found = pr.freeSamples(pr.boundsBox());
         const std::size_t pa_ = static_cast<std::size_t>(pa), pc_ = static_cast<std::size_t>(pc);
         // Remove this variable's share of F (v~|_{s_c = 0} of eq. 5.46). The pair removes both
         // its components and puts back their trace-free part -s_up / 2 for the current s_up.
@@ -243,9 +254,10 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
           var.resize(cells);
           parallelFor(0, cells, [&](std::size_t i) { var[i] = 0.5 * (s_[pa_][i] - s_[pc_][i]); }, 4096);
         } else {
-          var = s_[slot[k]];
-          addTerms(pr.terms, var, -1.0, dx, st.open, m.force, sBox_[slot[k]]);
+          addTerms(pr.terms, s_[slot[k]], -1.0, dx, st.open, m.force, sBox_[slot[k]]);
         }
+        // The variable: the pair's d, or the component itself (solved in place).
+        std::vector<double>& variable = k == 1 ? var : s_[slot[k]];
         bodyVelocities();
         // Linear term dt (D^T phi (1 - phi_s) v~ + J^T V~) (eqs. 5.19, 5.26, 5.50), negated for
         // the solver's 1/2 x^T A x - b^T x, on the free samples (the solve reads no other).
@@ -263,13 +275,13 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
           for (std::size_t j = 0; j < bc.sample.size(); ++j)
             pr.b[static_cast<Eigen::Index>(bc.sample[j])] -= dt * bc.column[j].dot(m.bodyVelocity[b]);
         }
-        pr.x = Eigen::Map<const Eigen::VectorXd>(var.data(), n);
+        pr.x = Eigen::Map<const Eigen::VectorXd>(variable.data(), n);
         // A friction gradient of dt / dx * delta_v per sample is a velocity error of about
         // delta_v: below velocityTolerance the solve has nothing left worth removing (at rest the
         // relative tolerance would chase particle noise to ever smaller absolute levels).
         stats_.frictionIterations += pr.solve(found, qp, dt / dx * settings_.velocityTolerance);
-        var.assign(pr.x.data(), pr.x.data() + pr.x.size());
-        addTerms(pr.terms, var, 1.0, dx, st.open, m.force, found.box);
+        variable.assign(pr.x.data(), pr.x.data() + pr.x.size());
+        addTerms(pr.terms, variable, 1.0, dx, st.open, m.force, found.box);
         if (k == 1) {
           parallelFor(0, cells, [&](std::size_t i) {
             s_[pa_][i] = -0.5 * sUp[i] + var[i];
@@ -277,7 +289,6 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
           }, 4096);
           sBox_[pa_] = sBox_[pc_] = sBox_[static_cast<std::size_t>(up)].unite(found.box);
         } else {
-          s_[slot[k]] = var;
           sBox_[slot[k]] = found.box;
         }
       }
