@@ -126,6 +126,32 @@ TEST(GranularSplitMerge, DivergingCloudIsSplitStaysValidAndConserves) {
   EXPECT_GT(total.splits, initial / 2);
 }
 
+// A particle stretched along one axis every step (as in a shear layer that persists) splits only
+// while its children stay at or above the minimum mass, and the total mass is kept exactly.
+TEST(GranularSplitMerge, NoSplitBelowTheMinimumChildMass) {
+  GranularParticles p;
+  p.append(Vecf<3>(1.0f, 1.0f, 1.0f), Vecf<3>::Zero(), 1.0f, toShape(kR * kR * Eigen::Matrix3d::Identity()), 0);
+  SplitMerge splitMerge(kR);
+  splitMerge.setMinimumChildMass(1.0 / 16.0);
+  for (int step = 0; step < 12; ++step) {
+    // Stretch every particle twofold along x.
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      Eigen::Matrix3d a = shapeMatrix(p.shape[i]);
+      a(0, 0) *= 4.0;
+      p.shape[i] = toShape(a);
+    }
+    splitMerge.apply(p);
+  }
+  double mass = 0.0, lightest = 1.0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    mass += p.mass[i];
+    lightest = std::min(lightest, static_cast<double>(p.mass[i]));
+  }
+  EXPECT_EQ(mass, 1.0);
+  EXPECT_EQ(lightest, 1.0 / 16.0);  // four halvings, then no more
+  EXPECT_EQ(p.size(), 16u);
+}
+
 TEST(GranularSplitMerge, CompressedCloudMergesValidlyAndConserves) {
   // Uniaxial compression v = (-k (x - c), 0, 0): ellipsoids flatten along x and merge with their
   // (now close) neighbours along x.

@@ -71,6 +71,10 @@ GranularSimulation::GranularSimulation(GranularSettings settings, std::vector<Gr
     });
   }
   if (settings_.renderPointsPerParticle > 0) renderPoints_.emplace(settings_.renderPointsPerParticle);
+  // No split below 1/256 of a fully packed seeded particle of the lightest material (8 halvings).
+  double lightest = materials_.front().density;
+  for (const GranularMaterial& m : materials_) lightest = std::min(lightest, m.density);
+  splitMerge_.setMinimumChildMass(lightest * settings_.grid.cellVolume() / 8.0 / 256.0);
 }
 
 void GranularSimulation::addStaticSolid(std::shared_ptr<const geometry::Shape<3>> solid) {

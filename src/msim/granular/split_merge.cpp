@@ -90,7 +90,8 @@ void SplitMerge::classify(const GranularParticles& particles) {
       return;
     }
     const Vec3 l = squaredSemiAxes(a);
-    const int depth = l[2] > 2.0 * r2 ? splitDepth(a) : 0;
+    int depth = l[2] > 2.0 * r2 ? splitDepth(a) : 0;
+    if (depth > 0 && std::ldexp(static_cast<double>(particles.mass[i]), -depth) < minimumChildMass_) depth = 0;
     depth_[i] = static_cast<std::uint8_t>(depth);
     plan_[i] = depth > 0 ? Plan::Split : (l[0] < 0.5 * r2 ? Plan::MergeCandidate : Plan::Keep);
   });
