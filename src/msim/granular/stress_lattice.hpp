@@ -21,6 +21,8 @@
 #include <cstddef>
 #include <vector>
 
+#include <tbb/parallel_for.h>
+
 #include "msim/core/vec.hpp"
 
 namespace msim::granular {
@@ -65,6 +67,19 @@ struct LatticeBox {
     return {first.cwiseMin(o.first), last.cwiseMax(o.last)};
   }
 };
+
+// f(index of the row's first element, y, z) for each x-row of `box` in a grid of size n (the row
+// spans box.first[0]..box.last[0]), the z slices in parallel. Nothing for an empty box.
+template <typename F>
+void forBoxRows(const LatticeBox& box, const IVec3& n, const F& f) {
+  if (box.empty()) return;
+  const std::size_t slices = static_cast<std::size_t>(box.last[2] - box.first[2] + 1);
+  tbb::parallel_for(std::size_t(0), slices, [&](std::size_t dz) {
+    const int z = box.first[2] + static_cast<int>(dz);
+    for (int y = box.first[1]; y <= box.last[1]; ++y)
+      f((static_cast<std::size_t>(z) * n[1] + y) * n[0] + box.first[0], y, z);
+  });
+}
 
 // The faces of `axis` (in the face grid of `cells`) whose divergence of c reads a sample in
 // `samples`: empty if c does not act on faces of that axis.

@@ -344,20 +344,12 @@ void transposeTerms(const std::vector<StressTerm>& terms, const FaceField& u, do
   const IVec3 lattice = latticeSize(terms.front().c, u.res);
   out.resize(static_cast<std::size_t>(lattice.prod()));
   if (samples.empty()) return;
-  auto forBoxRows = [&](const auto& f) {  // f(first index of a row of the box, its length)
-    const int width = samples.last[0] - samples.first[0] + 1;
-    parallelFor(0, static_cast<std::size_t>(samples.last[2] - samples.first[2] + 1), [&](std::size_t dz) {
-      for (int y = samples.first[1]; y <= samples.last[1]; ++y)
-        f((static_cast<std::size_t>(samples.first[2] + static_cast<int>(dz)) * lattice[1] + y) * lattice[0] +
-              samples.first[0],
-          width);
-    }, 1);
-  };
-  forBoxRows([&](std::size_t row, int width) { std::fill(out.begin() + row, out.begin() + row + width, 0.0); });
+  const std::size_t width = static_cast<std::size_t>(samples.last[0] - samples.first[0] + 1);
+  forBoxRows(samples, lattice, [&](std::size_t row, int, int) { std::fill_n(out.begin() + row, width, 0.0); });
   for (const StressTerm& t : terms) {
     divergenceTranspose(t.c, u, dx, mask, tmp, samples);
-    forBoxRows([&](std::size_t row, int width) {
-      for (std::size_t i = row; i < row + static_cast<std::size_t>(width); ++i) out[i] += t.sign * tmp[i];
+    forBoxRows(samples, lattice, [&](std::size_t row, int, int) {
+      for (std::size_t i = row; i < row + width; ++i) out[i] += t.sign * tmp[i];
     });
   }
 }

@@ -4,13 +4,13 @@
 // dt^2 (D^T W D + V sum_bodies J^T M^-1 J), bounds, and its MPRGP solve on the box of the samples
 // that can move, or on the list of those samples when they fill less than half of the box. The
 // staggered sequence of these problems is stress_solver.hpp.
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
 
-#include "msim/core/parallel.hpp"
 #include "msim/granular/grid_state.hpp"
 #include "msim/granular/stress_lattice.hpp"
 #include "msim/numerics/bound_qp.hpp"
@@ -173,21 +173,17 @@ void StressProblem::setBounds(const LatticeBox& box, const Bound& bound) {
     hi = Eigen::VectorXd::Zero(n);
     boundsBox_ = {};
   }
-  // One z slice of a box per task.
-  auto forBox = [&](const LatticeBox& b, const auto& f) {
-    if (b.empty()) return;
-    parallelFor(0, static_cast<std::size_t>(b.last[2] - b.first[2] + 1), [&](std::size_t dz) {
-      const int z = b.first[2] + static_cast<int>(dz);
-      for (int y = b.first[1]; y <= b.last[1]; ++y)
-        for (int x = b.first[0]; x <= b.last[0]; ++x)
-          f((static_cast<std::size_t>(z) * lattice[1] + y) * lattice[0] + x, IVec3(x, y, z));
-    }, 1);
-  };
-  forBox(boundsBox_, [&](std::size_t i, const IVec3&) { lo[static_cast<Eigen::Index>(i)] = hi[static_cast<Eigen::Index>(i)] = 0.0; });
-  forBox(box, [&](std::size_t i, const IVec3& q) {
-    const double b = bound(i, q);
-    lo[static_cast<Eigen::Index>(i)] = -b;
-    hi[static_cast<Eigen::Index>(i)] = b;
+  const std::size_t width = static_cast<std::size_t>(std::max(0, box.last[0] - box.first[0] + 1));
+  forBoxRows(boundsBox_, lattice, [&](std::size_t row, int, int) {
+    const std::size_t oldWidth = static_cast<std::size_t>(boundsBox_.last[0] - boundsBox_.first[0] + 1);
+    for (std::size_t i = row; i < row + oldWidth; ++i) lo[static_cast<Eigen::Index>(i)] = hi[static_cast<Eigen::Index>(i)] = 0.0;
+  });
+  forBoxRows(box, lattice, [&](std::size_t row, int y, int z) {
+    for (std::size_t k = 0; k < width; ++k) {
+      const double b = bound(row + k, IVec3(box.first[0] + static_cast<int>(k), y, z));
+      lo[static_cast<Eigen::Index>(row + k)] = -b;
+      hi[static_cast<Eigen::Index>(row + k)] = b;
+    }
   });
   boundsBox_ = box;
 }

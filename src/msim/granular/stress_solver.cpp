@@ -49,7 +49,6 @@ const std::vector<double>& StressSolver::stress(const StressComponent& c) const 
 
 namespace {
 
-// Cell value averaged onto the samples of a component's lattice (the cells around an edge).
 // The friction bound of sample q of component c (eq. 5.15) from the cell bounds alpha p: a
 // diagonal sample is its cell; an edge sample takes the mean over the cells around it. Slip walls:
 // the edges on a domain wall normal to a slip axis carry the wall's tangential friction (the
@@ -164,19 +163,16 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
   auto weightedGrainVelocity = [&](const FaceField& w, const std::array<LatticeBox, 3>& faces) {
     for (int a = 0; a < 3; ++a) {
       const LatticeBox& box = faces[static_cast<std::size_t>(a)];
-      if (box.empty()) continue;
-      const IVec3 n = velocity.size(a);
-      parallelFor(0, static_cast<std::size_t>(box.last[2] - box.first[2] + 1), [&](std::size_t dz) {
-        for (int y = box.first[1]; y <= box.last[1]; ++y) {
-          const std::size_t row = (static_cast<std::size_t>(box.first[2] + static_cast<int>(dz)) * n[1] + y) * n[0];
-          for (std::size_t i = row + box.first[0]; i <= row + box.last[0]; ++i) {
-            velocity.values[a][i] = m.velocity0.values[a][i] + dt * m.kappa.values[a][i] * m.force.values[a][i];
-            m.flux.values[a][i] = w.values[a][i] * velocity.values[a][i];
-          }
+      const std::size_t width = static_cast<std::size_t>(box.last[0] - box.first[0] + 1);
+      forBoxRows(box, velocity.size(a), [&](std::size_t row, int, int) {
+        for (std::size_t i = row; i < row + width; ++i) {
+          velocity.values[a][i] = m.velocity0.values[a][i] + dt * m.kappa.values[a][i] * m.force.values[a][i];
+          m.flux.values[a][i] = w.values[a][i] * velocity.values[a][i];
         }
-      }, 1);
+      });
     }
   };
+
   // Each body's faces: phi_s G_f (G_f = [e_a; r_f x e_a]).
   m.bodyFaces.resize(bodies.size());
   for (std::size_t k = 0; k < bodies.size(); ++k) {
