@@ -18,10 +18,14 @@ class ParticleCellHash {
   // bounds the memory for sparse clouds; queries stay exact for radii <= cellSize either way.
   void build(std::span<const Vecf<3>> positions, double cellSize);
 
-  // f(j) for every built point j in the 3x3x3 cells around x: a superset of the points within
-  // cellSize of x, in cell order and input order within a cell (deterministic).
-  template <typename F>
-  void forEachNear(const Vec3& x, F&& f) const;
+  // f(j) for the built points j in the 3x3x3 cells around x (a superset of the points within
+  // cellSize of x), for nearest-point searches: x's own cell first, then the others in cell
+  // order, input order within a cell (deterministic), skipping a cell all of whose box lies
+  // farther from x than sqrt(bound2()) (read before each cell, so f may lower it as it finds
+  // closer points). Every point at squared distance <= bound2() is still visited, so the nearest
+  // one, ties included, is found as by visiting all 27 cells.
+  template <typename Bound, typename F>
+  void forEachNearWithin(const Vec3& x, const Bound& bound2, F&& f) const;
 
  private:
   IVec3 cellOf(const Vec3& x) const {
@@ -40,16 +44,28 @@ class ParticleCellHash {
   BucketSort sort_;
 };
 
-template <typename F>
-void ParticleCellHash::forEachNear(const Vec3& x, F&& f) const {
+template <typename Bound, typename F>
+void ParticleCellHash::forEachNearWithin(const Vec3& x, const Bound& bound2, F&& f) const {
   const IVec3 c = cellOf(x);
   const std::span<const std::uint32_t> order = sort_.order();
+  auto visit = [&](const IVec3& q) {
+    const std::size_t cell = linear(q);
+    for (std::size_t k = sort_.begin(cell); k < sort_.begin(cell + 1); ++k) f(order[k]);
+  };
+  visit(c);
   IVec3 q;
   for (q[2] = std::max(c[2] - 1, 0); q[2] <= std::min(c[2] + 1, cells_[2] - 1); ++q[2])
     for (q[1] = std::max(c[1] - 1, 0); q[1] <= std::min(c[1] + 1, cells_[1] - 1); ++q[1])
       for (q[0] = std::max(c[0] - 1, 0); q[0] <= std::min(c[0] + 1, cells_[0] - 1); ++q[0]) {
-        const std::size_t cell = linear(q);
-        for (std::size_t k = sort_.begin(cell); k < sort_.begin(cell + 1); ++k) f(order[k]);
+        if (q == c) continue;
+        double gap2 = 0.0;  // squared distance from x to the cell's box
+        for (int a = 0; a < 3; ++a) {
+          const double lo = origin_[a] + q[a] * side_, hi = lo + side_;
+          const double gap = std::max({0.0, lo - x[a], x[a] - hi});
+          gap2 += gap * gap;
+        }
+        if (gap2 > bound2()) continue;
+        visit(q);
       }
 }
 

@@ -112,7 +112,7 @@ void SplitMerge::proposeMerges(const GranularParticles& particles) {
     const Vec3 xi = particles.position[i].cast<double>();
     std::uint32_t best = kNone;
     double bestDistance2 = reach * reach;
-    cells_.forEachNear(xi, [&](std::uint32_t j) {
+    cells_.forEachNearWithin(xi, [&] { return bestDistance2; }, [&](std::uint32_t j) {
       if (j == i || particles.material[j] != particles.material[i] || plan_[j] == Plan::Split) return;
       const double d2 = (particles.position[j].cast<double>() - xi).squaredNorm();
       if (d2 < bestDistance2 || (d2 == bestDistance2 && j < best)) {
