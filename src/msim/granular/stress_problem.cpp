@@ -101,11 +101,10 @@ int StressProblem::solve(const FreeSamples& found, numerics::BoundQpSettings set
                          double referenceNorm) {
   x = x.cwiseMax(lo).cwiseMin(hi);
   if (found.box.empty()) return 0;
-  referenceNorm_ = referenceNorm;
   const double boxSize = (found.box.last - found.box.first + IVec3::Ones()).cast<double>().prod();
   // The box's structured stencil is cheaper per sample than the listed rows (no indirection).
-  if (static_cast<double>(found.count) < 0.5 * boxSize) return solveOnFreeSamples(found.count, settings, absoluteFloor);
-  return solveOnBox(found.box.first, found.box.last, found.count, settings, absoluteFloor);
+  if (static_cast<double>(found.count) < 0.5 * boxSize) return solveOnFreeSamples(found.count, settings, absoluteFloor, referenceNorm);
+  return solveOnBox(found.box.first, found.box.last, found.count, settings, absoluteFloor, referenceNorm);
 }
 
 void StressProblem::holdInertSamples() {
@@ -119,15 +118,15 @@ void StressProblem::holdInertSamples() {
   }, 4096);
 }
 
-void StressProblem::applyFloor(numerics::BoundQpSettings& settings, double absoluteFloor, std::size_t n,
-                               double bNorm) const {
-  if (referenceNorm_ > 0.0 && bNorm > 0.0) settings.tolerance *= referenceNorm_ / bNorm;
+void StressProblem::applyFloor(numerics::BoundQpSettings& settings, double absoluteFloor, double referenceNorm,
+                               std::size_t n, double bNorm) {
+  if (referenceNorm > 0.0 && bNorm > 0.0) settings.tolerance *= referenceNorm / bNorm;
   if (absoluteFloor > 0.0 && bNorm > 0.0)
     settings.tolerance = std::max(settings.tolerance, absoluteFloor * std::sqrt(static_cast<double>(n)) / bNorm);
 }
 
 int StressProblem::solveOnBox(const IVec3& first, const IVec3& last, std::size_t freeCount,
-                              numerics::BoundQpSettings settings, double absoluteFloor) {
+                              numerics::BoundQpSettings settings, double absoluteFloor, double referenceNorm) {
   const IVec3 box = last - first + IVec3::Ones();
   const std::size_t m = static_cast<std::size_t>(box.prod());
   for (auto& l : boxLower) l.resize(m);
@@ -166,7 +165,7 @@ int StressProblem::solveOnBox(const IVec3& first, const IVec3& last, std::size_t
       boxed.column.push_back(bodies[body].column[j]);
     }
   }
-  applyFloor(settings, absoluteFloor, freeCount, subB.norm());
+  applyFloor(settings, absoluteFloor, referenceNorm, freeCount, subB.norm());
   // MPRGP's built-in Jacobi preconditioning: MIC(0) in face (numerics/bound_qp_mic0) takes about
   // as many iterations here, and the box bounds change the face so often that its sequential
   // refactorisations made the friction solves 4x slower (sand bed 25 x 50 x 25: 1.25 -> 0.32 s).
@@ -175,7 +174,8 @@ int StressProblem::solveOnBox(const IVec3& first, const IVec3& last, std::size_t
   return r.iterations;
 }
 
-int StressProblem::solveOnFreeSamples(std::size_t freeCount, numerics::BoundQpSettings settings, double absoluteFloor) {
+int StressProblem::solveOnFreeSamples(std::size_t freeCount, numerics::BoundQpSettings settings, double absoluteFloor,
+                                      double referenceNorm) {
   const std::size_t n = static_cast<std::size_t>(lattice.prod());
   // Number the free samples in lattice order (a sequential scan: the numbering must not depend on
   // the thread count).
@@ -249,7 +249,7 @@ int StressProblem::solveOnFreeSamples(std::size_t freeCount, numerics::BoundQpSe
     for (std::size_t k = 0; k < listed.sample.size(); ++k)
       subB[static_cast<Eigen::Index>(listed.sample[k])] -= listed.column[k].dot(f);
   }
-  applyFloor(settings, absoluteFloor, freeCount, subB.norm());
+  applyFloor(settings, absoluteFloor, referenceNorm, freeCount, subB.norm());
   const auto r = solver.solve(compact, subB, subLo, subHi, subX, settings);
   parallelFor(0, freeCount, [&](std::size_t i) {
     x[static_cast<Eigen::Index>(freeToLattice[i])] = subX[static_cast<Eigen::Index>(i)];

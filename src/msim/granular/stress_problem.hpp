@@ -155,12 +155,13 @@ struct StressProblem {
 
  private:
   int solveOnBox(const IVec3& first, const IVec3& last, std::size_t freeCount, numerics::BoundQpSettings settings,
-                 double absoluteFloor);
-  int solveOnFreeSamples(std::size_t freeCount, numerics::BoundQpSettings settings, double absoluteFloor);
-  // The relative tolerance referred to referenceNorm_ (if set) and raised to the absolute floor for
+                 double absoluteFloor, double referenceNorm);
+  int solveOnFreeSamples(std::size_t freeCount, numerics::BoundQpSettings settings, double absoluteFloor,
+                         double referenceNorm);
+  // The relative tolerance referred to referenceNorm (if > 0) and raised to the absolute floor for
   // n free samples (see solve()); bNorm: the norm of the restricted problem's b.
-  void applyFloor(numerics::BoundQpSettings& settings, double absoluteFloor, std::size_t n, double bNorm) const;
-  double referenceNorm_ = 0.0;           // of the solve under way (solve())
+  static void applyFloor(numerics::BoundQpSettings& settings, double absoluteFloor, double referenceNorm, std::size_t n,
+                         double bNorm);
   LatticeBox boundsBox_;                  // setBounds
   std::vector<std::uint8_t> bodySample_;  // holdInertSamples scratch
 };
