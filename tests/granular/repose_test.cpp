@@ -87,7 +87,9 @@ TEST(GranularRepose, SlopesStandBelowThePredictedAngleAndFlowAbove) {
                 above, flows);
     EXPECT_NEAR(stands, below, 1.5) << "alpha " << alpha << ": a slope at " << below << " deg did not stand";
     EXPECT_LT(flows, above - 3.0) << "alpha " << alpha << ": a slope at " << above << " deg did not flow";
-    EXPECT_GT(flows, predicted - 15.0) << "alpha " << alpha << ": collapsed far below the predicted angle";
+    // A collapsing slope overshoots theta_r (it decelerates only below it), so this is a sanity
+    // bound, not the prediction: it keeps more than half of it.
+    EXPECT_GT(flows, 0.5 * predicted) << "alpha " << alpha << ": collapsed far below the predicted angle";
     EXPECT_GT(flows, lastFlowed) << "alpha " << alpha << ": the collapsed slope is not steeper than with less friction";
     lastFlowed = flows;
   }

@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 
 #include "granular_test_support.hpp"
 #include "msim/granular/particle_advection.hpp"
@@ -174,7 +175,7 @@ TEST(GranularSplitMerge, CompressedCloudMergesValidlyAndConserves) {
     const std::size_t n = p.size();
     const SplitMergeStats s = splitMerge.apply(p);
     merges += s.merges;
-    EXPECT_EQ(p.size(), n - s.merges + s.children - s.splits);
+    EXPECT_EQ(p.size(), n - s.mergedAway + s.children - s.splits);
     expectConserved(before, test::totals(p), 1.0);
     // Every merged particle is valid; the successors map both members to it.
     for (std::size_t i = 0; i < n; ++i) EXPECT_LT(splitMerge.successors()[i].begin, p.size());
@@ -199,6 +200,107 @@ TEST(GranularSplitMerge, OnlyParticlesOfTheSameMaterialMerge) {
   EXPECT_EQ(splitMerge.successors()[1].begin, 0u);
   EXPECT_NEAR(q.position[0][0], 0.5 * kR, 1e-8);
   EXPECT_EQ(q.mass[0], 2.0f);
+  expectAllValid(q);
+}
+
+TEST(GranularSplitMerge, MergesWithTheNearestPartnerThatGivesAValidParticle) {
+  // Particle 0 is too thin along y (semi-axis r/2). Its nearest neighbour, 0.8 r away along x, is as
+  // thin, so merging the two leaves the thin axis (r/2): invalid. The next one, a round particle
+  // 1.2 r above, gives a valid merge (semi-axes squared r^2 and 0.985 r^2 by eq. 5.43).
+  const double r2 = kR * kR;
+  const Eigen::Matrix3d thin = Vec3(r2, 0.25 * r2, r2).asDiagonal(), round = Eigen::Matrix3d::Identity() * r2;
+  GranularParticles p;
+  p.append(Vecf<3>(0, 0, 0), Vecf<3>(1, 0, 0), 1.0f, toShape(thin), 0);
+  p.append(Vecf<3>(float(0.8 * kR), 0, 0), Vecf<3>::Zero(), 1.0f, toShape(thin), 0);
+  p.append(Vecf<3>(0, float(1.2 * kR), 0), Vecf<3>::Zero(), 1.0f, toShape(round), 0);
+  const MergedParticle withNearest = mergeParticles(Vec3::Zero(), Vec3::Zero(), 1.0, thin, Vec3(0.8 * kR, 0, 0),
+                                                    Vec3::Zero(), 1.0, thin);
+  ASSERT_FALSE(isValidShape(withNearest.shape, kR));
+  const test::Totals before = test::totals(p);
+  SplitMerge splitMerge(kR);
+  EXPECT_EQ(splitMerge.apply(p).merges, 1u);
+  ASSERT_EQ(p.size(), 2u);
+  // 0 and 2 became the particle at slot 0; 1 (whose partners 0 and 2 were taken) waits.
+  EXPECT_EQ(splitMerge.successors()[0].begin, 0u);
+  EXPECT_EQ(splitMerge.successors()[2].begin, 0u);
+  EXPECT_NEAR(p.position[0][1], 0.6 * kR, 1e-7);
+  EXPECT_NEAR(p.velocity[0][0], 0.5, 1e-7);
+  expectConserved(before, test::totals(p), kR);
+  const Vec3 axes = semiAxesOverR(p.shape[0]);
+  EXPECT_NEAR(axes[0] * axes[0], 0.985, 1e-5);
+  EXPECT_NEAR(axes[2] * axes[2], 1.0, 1e-5);
+}
+
+TEST(GranularSplitMerge, ParticlesSquashedInEveryDirectionMergeAsAGroup) {
+  // Seven particles of semi-axes 0.59 r (A = 0.35 r^2 I, too small along every axis): one at the
+  // origin and six 0.9 r away along +-x, +-y, +-z. A merge grows the shape only along the
+  // separation, so no pair is valid (eq. 5.43: 0.35 + 0.81 / 4 along it, 0.35 across); the seven
+  // together are, A = (0.35 + 2 * 0.81 / 7) r^2 I.
+  const double r2 = kR * kR, d = 0.9 * kR;
+  const Eigen::Matrix3d small = Eigen::Matrix3d::Identity() * 0.35 * r2;
+  GranularParticles p;
+  p.append(Vecf<3>::Zero(), Vecf<3>(0, 0, 0.7f), 1.0f, toShape(small), 0);
+  for (int a = 0; a < 3; ++a)
+    for (const double sign : {1.0, -1.0}) {
+      Vecf<3> x = Vecf<3>::Zero();
+      x[a] = static_cast<float>(sign * d);
+      p.append(x, Vecf<3>::Zero(), 1.0f, toShape(small), 0);
+    }
+  const test::Totals before = test::totals(p);
+  SplitMerge splitMerge(kR);
+  const SplitMergeStats stats = splitMerge.apply(p);
+  EXPECT_EQ(stats.merges, 1u);
+  EXPECT_EQ(stats.mergedAway, 6u);
+  ASSERT_EQ(p.size(), 1u);
+  for (const auto& s : splitMerge.successors()) EXPECT_EQ(s.begin, 0u);
+  expectConserved(before, test::totals(p), kR);
+  const Eigen::Matrix3d expected = Eigen::Matrix3d::Identity() * (0.35 + 2.0 * 0.81 / 7.0) * r2;
+  EXPECT_LT((shapeMatrix(p.shape[0]) - expected).norm() / expected.norm(), 1e-6);
+  expectAllValid(p);
+}
+
+TEST(GranularSplitMerge, ParticleNoSplitOrMergeCanFixIsBroughtIntoTheBand) {
+  // A sheared particle, too long (2 r) and too thin (0.45 r) at once, axes rotated off the grid: its
+  // split children would be as thin, and it has no neighbour to merge with. It keeps its mass,
+  // velocity, position and axes; its semi-axes are clamped into [0.8 r, 1.25 r].
+  const double r2 = kR * kR;
+  const Eigen::Matrix3d axes = Eigen::AngleAxisd(0.4, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  const Eigen::Matrix3d sheared = axes * Vec3(4.0 * r2, 0.2 * r2, r2).asDiagonal() * axes.transpose();
+  GranularParticles p;
+  p.append(Vecf<3>(0.1f, 0.2f, 0.3f), Vecf<3>(1, -2, 3), 0.5f, toShape(sheared), 0);
+  const GranularParticles before = p;
+  SplitMerge splitMerge(kR);
+  const SplitMergeStats stats = splitMerge.apply(p);
+  EXPECT_EQ(stats.splits + stats.merges, 0u);
+  EXPECT_EQ(stats.regularized, 1u);
+  ASSERT_EQ(p.size(), 1u);
+  EXPECT_EQ(p.position[0], before.position[0]);
+  EXPECT_EQ(p.velocity[0], before.velocity[0]);
+  EXPECT_EQ(p.mass[0], before.mass[0]);
+  const Eigen::Matrix3d expected = axes * Vec3(1.5625 * r2, 0.64 * r2, r2).asDiagonal() * axes.transpose();
+  EXPECT_LT((shapeMatrix(p.shape[0]) - expected).norm() / expected.norm(), 1e-5);
+  expectAllValid(p);
+}
+
+TEST(GranularSplitMerge, NoMergeAboveTheMaximumMass) {
+  // Two too-thin particles whose pair is valid (as in OnlyParticlesOfTheSameMaterialMerge), mass
+  // 1 each: merged under a limit of 2 (float masses at exactly the limit pass), regularized in place
+  // under 1.5.
+  const Eigen::Matrix3d thin = Vec3(0.3 * kR * kR, kR * kR, kR * kR).asDiagonal();
+  GranularParticles p;
+  p.append(Vecf<3>(0, 0, 0), Vecf<3>::Zero(), 1.0f, toShape(thin), 0);
+  p.append(Vecf<3>(float(kR), 0, 0), Vecf<3>::Zero(), 1.0f, toShape(thin), 0);
+  GranularParticles q = p;
+  SplitMerge atLimit(kR);
+  atLimit.setMaximumMergedMass({2.0});
+  EXPECT_EQ(atLimit.apply(p).merges, 1u);
+  EXPECT_EQ(p.size(), 1u);
+  SplitMerge belowLimit(kR);
+  belowLimit.setMaximumMergedMass({1.5});
+  const SplitMergeStats stats = belowLimit.apply(q);
+  EXPECT_EQ(stats.merges, 0u);
+  EXPECT_EQ(stats.regularized, 2u);
+  ASSERT_EQ(q.size(), 2u);
   expectAllValid(q);
 }
 

@@ -9,6 +9,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
 
+#include "msim/core/interpolation.hpp"
 #include "msim/core/parallel.hpp"
 #include "msim/core/timer.hpp"
 #include "msim/granular/particle_advection.hpp"
@@ -77,6 +78,10 @@ GranularSimulation::GranularSimulation(GranularSettings settings, std::vector<Gr
   double lightest = materials_.front().density;
   for (const GranularMaterial& m : materials_) lightest = std::min(lightest, m.density);
   splitMerge_.setMinimumChildMass(lightest * settings_.grid.cellVolume() / 8.0 / 256.0);
+  // No merge above twice a fully packed seeded particle of its material.
+  std::vector<double> maximumMass;
+  for (const GranularMaterial& m : materials_) maximumMass.push_back(2.0 * m.density * settings_.grid.cellVolume() / 8.0);
+  splitMerge_.setMaximumMergedMass(std::move(maximumMass));
 }
 
 void GranularSimulation::addStaticSolid(std::shared_ptr<const geometry::Shape<3>> solid) {
@@ -264,15 +269,23 @@ void GranularSimulation::pushOutOfSolids() {
 void GranularSimulation::removeVelocityAgainstCorrection() {
   // The density correction resolves overlaps the way a contact does, so like a contact (and like
   // the inelastic pressure of eq. 5.9) it also removes the velocity into the overlap: a particle
-  // pushed back by dx keeps no velocity component against dx. Without this, grains resting on a
-  // packed surface (whose cells never read as full under the trilinear splat, so the pressure
-  // never holds them) keep falling in velocity while the correction puts them back every step.
+  // pushed back by dx keeps no velocity against dx relative to the material it is pushed away
+  // from, whose velocity is the new grid velocity half a cell behind it along dx. Without this,
+  // grains resting on a packed surface (whose cells never read as full under the trilinear splat,
+  // so the pressure never holds them) keep falling in velocity while the correction puts them back
+  // every step. Relative, because packed material moving as a whole (a falling block, whose
+  // seeding's jitter the correction evens out) is not in contact with anything: removing its
+  // absolute velocity against dx held the top of a falling block in mid-air.
+  const double reach = 0.5 * settings_.grid.dx;
   parallelFor(0, particles_.size(), [&](std::size_t i) {
-    const Vecf<3> d = correctionAt_[i].cast<float>();
-    const float d2 = d.squaredNorm();
-    if (!(d2 > 0.0f)) return;
-    const float vd = particles_.velocity[i].dot(d);
-    if (vd < 0.0f) particles_.velocity[i] -= (vd / d2) * d;
+    const Vec3& d = correctionAt_[i];
+    const double d2 = d.squaredNorm();
+    if (!(d2 > 0.0)) return;
+    const Vec3 x = particles_.position[i].cast<double>();
+    const Vec3 behind = sampleLinear<3>(velocityNew_, clampIntoDomain(settings_.grid, x - (reach / std::sqrt(d2)) * d));
+    const Vec3 v = particles_.velocity[i].cast<double>();
+    const double vd = (v - behind).dot(d);
+    if (vd < 0.0) particles_.velocity[i] = (v - (vd / d2) * d).cast<float>();
   });
 }
 
@@ -309,6 +322,7 @@ void GranularSimulation::step(double dt) {
     for (double v : velocity.values[a])
       if (!std::isfinite(v))
         throw std::runtime_error(fmt::format("granular: non-finite grid velocity at t = {:.6g} s (step {:.3g} s)", time_, dt));
+  releaseSeparatingWalls(velocity);
   toMac(velocity, velocityNew_);
   {
     ScopedTimer t(times_.bodies);
@@ -326,12 +340,45 @@ void GranularSimulation::step(double dt) {
     advectParticles(particles_, velocityNew_, dt, corrected ? std::span<const Vec3>(correctionAt_) : std::span<const Vec3>{},
                     renderPoints_ ? &motion_ : nullptr);
     pushOutOfSolids();
-    if (settings_.splitMerge) splitMergeStats_ = splitMerge_.apply(particles_);
+    if (settings_.splitMerge) {
+      splitMergeStats_ = splitMerge_.apply(particles_);
+      // A child of a split lies up to (sqrt3/2) of its parent's semi-axis away from it, which can be
+      // beyond a wall; it is put back inside like an advected particle.
+      if (splitMergeStats_.splits > 0)
+        parallelFor(0, particles_.size(), [&](std::size_t i) {
+          particles_.position[i] = clampIntoDomain(settings_.grid, particles_.position[i].cast<double>()).cast<float>();
+        });
+    }
     if (renderPoints_)
       renderPoints_->carry(motion_, dt, settings_.grid, particles_,
                            settings_.splitMerge ? splitMerge_.successors() : std::span<const SplitMerge::Successors>{});
   }
   time_ += dt;
+}
+
+// The seed closes the domain with ghost cells held full (phi = 1, line 1192), so a wall is a
+// unilateral contact like the pressure: it stops flow into it but not material leaving it. The
+// solve keeps closed faces at rest, which is right for material pressed against them; where the
+// solved flow next to a closed face moves away from it, the face takes that velocity instead, so
+// grains thrown against the ceiling fall again and a pile can lift off a wall (with the faces at
+// rest they hung there: the particles in the cell beside the wall read mostly its zero velocity).
+// The cell between the two faces then translates instead of expanding, so phi <= 1 still holds.
+// A closed face with separating flow on both sides (a solid thinner than a cell) stays at rest.
+void GranularSimulation::releaseSeparatingWalls(FaceField& velocity) const {
+  for (int a = 0; a < 3; ++a) {
+    const IVec3 n = wallFaces_.size(a);
+    const std::size_t stride = a == 0 ? 1 : (a == 1 ? static_cast<std::size_t>(n[0]) : static_cast<std::size_t>(n[0]) * n[1]);
+    const std::vector<double>& open = wallFaces_.values[a];
+    const std::vector<double>& rho = state_.rhoFace.values[a];
+    std::vector<double>& v = velocity.values[a];
+    parallelForCells<3>(n, [&](const IVec3& q, std::size_t i) {
+      if (open[i] != 0.0) return;
+      // The open neighbour on the side of increasing index separates when its velocity is > 0.
+      const bool up = q[a] + 1 < n[a] && open[i + stride] != 0.0 && rho[i + stride] > 0.0 && v[i + stride] > 0.0;
+      const bool down = q[a] > 0 && open[i - stride] != 0.0 && rho[i - stride] > 0.0 && v[i - stride] < 0.0;
+      if (up != down) v[i] = up ? v[i + stride] : v[i - stride];
+    });
+  }
 }
 
 // Drag towards the winds, dv/dt = (1 - phi) (u_air - v) / tau, integrated exactly over the step

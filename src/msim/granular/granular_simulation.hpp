@@ -108,6 +108,7 @@ class GranularSimulation {
   void removeVelocityAgainstCorrection();
   void initialiseRenderPoints();
   void applyWinds(double dt, FaceField& velocity);
+  void releaseSeparatingWalls(FaceField& velocity) const;
 
   GranularSettings settings_;
   std::vector<GranularMaterial> materials_;

@@ -1,6 +1,7 @@
 #include "msim/granular/split_merge.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -45,15 +46,25 @@ bool isValidShape(const Eigen::Matrix3d& a, double radius) {
   return l[0] >= 0.5 * r2 && l[2] <= 2.0 * r2;
 }
 
+void MergeAccumulator::add(const Vec3& x, const Vec3& v, double m, const Eigen::Matrix3d& a) {
+  const Vec3 y = x - origin_;
+  mass_ += m;
+  first_ += m * y;
+  momentum_ += m * v;
+  second_ += m * (a + y * y.transpose());
+}
+
+MergedParticle MergeAccumulator::result() const {
+  const Vec3 c = first_ / mass_;
+  return {origin_ + c, momentum_ / mass_, mass_, second_ / mass_ - c * c.transpose()};
+}
+
 MergedParticle mergeParticles(const Vec3& xi, const Vec3& vi, double mi, const Eigen::Matrix3d& ai, const Vec3& xj,
                               const Vec3& vj, double mj, const Eigen::Matrix3d& aj) {
-  MergedParticle k;
-  k.mass = mi + mj;
-  k.position = (mi * xi + mj * xj) / k.mass;
-  k.velocity = (mi * vi + mj * vj) / k.mass;
-  const Vec3 di = xi - k.position, dj = xj - k.position;
-  k.shape = (mi * (ai + di * di.transpose()) + mj * (aj + dj * dj.transpose())) / k.mass;
-  return k;
+  MergeAccumulator k(xi);
+  k.add(xi, vi, mi, ai);
+  k.add(xj, vj, mj, aj);
+  return k.result();
 }
 
 SplitMerge::SplitMerge(double radius, int maxSplitDepth) : radius_(radius), maxSplitDepth_(maxSplitDepth) {
@@ -61,6 +72,40 @@ SplitMerge::SplitMerge(double radius, int maxSplitDepth) : radius_(radius), maxS
     throw std::invalid_argument("split/merge: particle radius must be a finite number > 0, got " + std::to_string(radius));
   if (maxSplitDepth < 1 || maxSplitDepth > 3)
     throw std::invalid_argument("split/merge: split depth must lie in [1, 3], got " + std::to_string(maxSplitDepth));
+}
+
+double SplitMerge::maximumMergedMass(std::uint16_t material) const {
+  // Widened by a relative 1e-6: masses are stored in float, so two particles of exactly half the
+  // limit must not fail it by rounding.
+  return material < maximumMergedMass_.size() ? maximumMergedMass_[material] * (1.0 + 1e-6)
+                                              : std::numeric_limits<double>::infinity();
+}
+
+bool SplitMerge::surelyValid(const Eigen::Matrix3d& a) const {
+  // Squared semi-axes in [r^2 / 2, 2 r^2], the band narrowed by a relative 1e-6.
+  const double r2 = radius_ * radius_;
+  return eigenvaluesWithin(a, 0.5 * r2 * (1.0 + 1e-6), 2.0 * r2 * (1.0 - 1e-6));
+}
+
+bool SplitMerge::valid(const Eigen::Matrix3d& a) const {
+  // A diagonal entry is a Rayleigh quotient, so one outside the band puts an eigenvalue outside
+  // it too: the common rejection (material squashed along a grid axis) without eigenvalues.
+  const double r2 = radius_ * radius_;
+  const Vec3 d = a.diagonal();
+  if (d.minCoeff() < 0.5 * r2 || d.maxCoeff() > 2.0 * r2) return false;
+  return surelyValid(a) || isValidShape(a, radius_);
+}
+
+Eigen::Matrix3d SplitMerge::regularized(const Eigen::Matrix3d& a) const {
+  // The semi-axes clamped into [0.8 r, 1.25 r], the axes kept: well inside the valid band
+  // [r / sqrt2, sqrt2 r], so that the next steps' deformation does not make it invalid again at
+  // once (clamped to the band's edge, a particle in sustained shear left it again every step and
+  // searched for merge partners every step). The accurate solver: near-equal and near-zero
+  // eigenvalues are common here.
+  const double r2 = radius_ * radius_;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(a);
+  const Vec3 l = solver.eigenvalues().cwiseMax(0.64 * r2).cwiseMin(1.5625 * r2);
+  return solver.eigenvectors() * l.asDiagonal() * solver.eigenvectors().transpose();
 }
 
 int SplitMerge::splitDepth(const Eigen::Matrix3d& a) const {
@@ -83,8 +128,8 @@ void SplitMerge::classify(const GranularParticles& particles) {
   const double r2 = radius_ * radius_;
   parallelFor(0, n, [&](std::size_t i) {
     const Eigen::Matrix3d a = shapeMatrix(particles.shape[i]);
-    // Most particles are well inside the valid band (squared semi-axes in [r^2 / 2, 2 r^2]).
-    if (eigenvaluesWithin(a, 0.5 * r2 * (1.0 + 1e-6), 2.0 * r2 * (1.0 - 1e-6))) {
+    // Most particles are well inside the valid band.
+    if (surelyValid(a)) {
       depth_[i] = 0;
       plan_[i] = Plan::Keep;
       return;
@@ -93,7 +138,10 @@ void SplitMerge::classify(const GranularParticles& particles) {
     int depth = l[2] > 2.0 * r2 ? splitDepth(a) : 0;
     if (depth > 0 && std::ldexp(static_cast<double>(particles.mass[i]), -depth) < minimumChildMass_) depth = 0;
     depth_[i] = static_cast<std::uint8_t>(depth);
-    plan_[i] = depth > 0 ? Plan::Split : (l[0] < 0.5 * r2 ? Plan::MergeCandidate : Plan::Keep);
+    // Too long with no valid split (children too thin or too light): no merge makes it shorter
+    // either, so its shape is brought into the band.
+    const bool mayMerge = l[0] < 0.5 * r2 && particles.mass[i] < maximumMergedMass(particles.material[i]);
+    plan_[i] = depth > 0 ? Plan::Split : (mayMerge ? Plan::MergeCandidate : Plan::Regularize);
   });
   candidates_.clear();
   for (std::size_t i = 0; i < n; ++i)
@@ -101,50 +149,87 @@ void SplitMerge::classify(const GranularParticles& particles) {
 }
 
 void SplitMerge::proposeMerges(const GranularParticles& particles) {
-  proposal_.resize(candidates_.size());
+  groups_.resize(candidates_.size());
   if (candidates_.empty()) return;
   // Two equal particles at distance d merge into one of semi-axis at least d/2 along their
   // separation, so no valid merge partner is farther than 2 sqrt2 r.
-  const double reach = 2.0 * std::sqrt(2.0) * radius_;
+  const double reach = 2.0 * std::sqrt(2.0) * radius_, reach2 = reach * reach;
   cells_.build(particles.position, reach);
   parallelFor(0, candidates_.size(), [&](std::size_t c) {
     const std::uint32_t i = candidates_[c];
     const Vec3 xi = particles.position[i].cast<double>();
-    std::uint32_t best = kNone;
-    double bestDistance2 = reach * reach;
-    cells_.forEachNearWithin(xi, [&] { return bestDistance2; }, [&](std::uint32_t j) {
+    // The kMergePartners nearest partners within reach, ordered by (distance, index): the set
+    // does not depend on the order the cells are visited in.
+    std::array<std::pair<double, std::uint32_t>, kMergePartners> nearest;
+    int found = 0;
+    const auto bound2 = [&] { return found < kMergePartners ? reach2 : nearest[kMergePartners - 1].first; };
+    cells_.forEachNearWithin(xi, bound2, [&](std::uint32_t j) {
       if (j == i || particles.material[j] != particles.material[i] || plan_[j] == Plan::Split) return;
-      const double d2 = (particles.position[j].cast<double>() - xi).squaredNorm();
-      if (d2 < bestDistance2 || (d2 == bestDistance2 && j < best)) {
-        bestDistance2 = d2;
-        best = j;
-      }
+      const std::pair<double, std::uint32_t> key{(particles.position[j].cast<double>() - xi).squaredNorm(), j};
+      if (key.first > reach2 || (found == kMergePartners && !(key < nearest[kMergePartners - 1]))) return;
+      int at = found < kMergePartners ? found++ : kMergePartners - 1;
+      for (; at > 0 && key < nearest[at - 1]; --at) nearest[at] = nearest[at - 1];
+      nearest[at] = key;
     });
-    if (best != kNone) {
-      const MergedParticle k = mergeParticles(
-          xi, particles.velocity[i].cast<double>(), particles.mass[i], shapeMatrix(particles.shape[i]),
-          particles.position[best].cast<double>(), particles.velocity[best].cast<double>(), particles.mass[best],
-          shapeMatrix(particles.shape[best]));
-      if (!isValidShape(k.shape, radius_)) best = kNone;
+    MergeGroup& group = groups_[c];
+    group.size = 0;
+    const double maximumMass = maximumMergedMass(particles.material[i]), mi = particles.mass[i];
+    auto add = [&](MergeAccumulator& k, std::uint32_t j) {
+      k.add(particles.position[j].cast<double>(), particles.velocity[j].cast<double>(), particles.mass[j],
+            shapeMatrix(particles.shape[j]));
+    };
+    // A pair first, the nearest partner that makes one valid particle.
+    for (int k = 0; k < found; ++k) {
+      if (mi + particles.mass[nearest[k].second] > maximumMass) continue;
+      MergeAccumulator pair(xi);
+      add(pair, i);
+      add(pair, nearest[k].second);
+      if (valid(pair.result().shape)) {
+        group.size = 1;
+        group.members[0] = nearest[k].second;
+        return;
+      }
     }
-    proposal_[c] = best;
+    // Then the nearest partners together: a particle squashed along more than one axis (a landed
+    // cloud) grows by a merge only along the separation, so no pair can make it valid.
+    MergeAccumulator all(xi);
+    add(all, i);
+    double mass = mi;
+    for (int k = 0; k < found; ++k) {
+      mass += particles.mass[nearest[k].second];
+      if (mass > maximumMass) return;
+      add(all, nearest[k].second);
+      if (k > 0 && valid(all.result().shape)) {
+        group.size = static_cast<std::uint8_t>(k + 1);
+        for (int m = 0; m <= k; ++m) group.members[m] = nearest[m].second;
+        return;
+      }
+    }
   }, 64);
 }
 
 std::size_t SplitMerge::acceptMerges() {
-  // Serial, in candidate order, so that the pairing is deterministic: a proposal is accepted when
-  // neither particle is already in a pair; the others wait for the next pass.
-  partnerOf_.resize(plan_.size());
+  // Serial, in candidate order, so that the grouping is deterministic: a proposal is accepted when
+  // none of its particles is already in a group; the others wait for the next pass. The group
+  // goes to its lowest index.
+  groupOf_.resize(plan_.size());
   std::size_t merges = 0;
+  const auto taken = [&](std::uint32_t p) { return plan_[p] == Plan::MergeOwner || plan_[p] == Plan::MergedAway; };
   for (std::size_t c = 0; c < candidates_.size(); ++c) {
-    const std::uint32_t i = candidates_[c], j = proposal_[c];
-    if (j == kNone) continue;
-    const auto taken = [&](std::uint32_t p) { return plan_[p] == Plan::MergeOwner || plan_[p] == Plan::MergedAway; };
-    if (taken(i) || taken(j)) continue;
-    const std::uint32_t owner = std::min(i, j), other = std::max(i, j);
+    const MergeGroup& group = groups_[c];
+    const std::uint32_t i = candidates_[c];
+    if (taken(i)) continue;
+    if (group.size == 0) {
+      plan_[i] = Plan::Regularize;  // no valid merge exists for it
+      continue;
+    }
+    const auto members = std::span(group.members).first(group.size);
+    if (std::any_of(members.begin(), members.end(), taken)) continue;
+    const std::uint32_t owner = std::min(i, *std::min_element(members.begin(), members.end()));
+    plan_[i] = Plan::MergedAway;
+    for (std::uint32_t j : members) plan_[j] = Plan::MergedAway;
     plan_[owner] = Plan::MergeOwner;
-    plan_[other] = Plan::MergedAway;
-    partnerOf_[owner] = other;
+    groupOf_[owner] = static_cast<std::uint32_t>(c);
     ++merges;
   }
   return merges;
@@ -160,11 +245,20 @@ void SplitMerge::emit(const GranularParticles& in, GranularParticles& out) const
         break;
       case Plan::MergedAway:
         break;
+      case Plan::Regularize:
+        out.copyFrom(in, i, at);
+        out.shape[at] = toShape(regularized(shapeMatrix(in.shape[i])));
+        break;
       case Plan::MergeOwner: {
-        const std::uint32_t j = partnerOf_[i];
-        const MergedParticle k = mergeParticles(
-            in.position[i].cast<double>(), in.velocity[i].cast<double>(), in.mass[i], shapeMatrix(in.shape[i]),
-            in.position[j].cast<double>(), in.velocity[j].cast<double>(), in.mass[j], shapeMatrix(in.shape[j]));
+        // The same sums in the same order as the proposal that found the group valid.
+        const std::uint32_t c = groupOf_[i], first = candidates_[c];
+        MergeAccumulator group(in.position[first].cast<double>());
+        auto add = [&](std::uint32_t j) {
+          group.add(in.position[j].cast<double>(), in.velocity[j].cast<double>(), in.mass[j], shapeMatrix(in.shape[j]));
+        };
+        add(first);
+        for (std::uint8_t m = 0; m < groups_[c].size; ++m) add(groups_[c].members[m]);
+        const MergedParticle k = group.result();
         out.position[at] = k.position.cast<float>();
         out.velocity[at] = k.velocity.cast<float>();
         out.mass[at] = static_cast<float>(k.mass);
@@ -226,14 +320,22 @@ SplitMergeStats SplitMerge::apply(GranularParticles& particles) {
       stats.children += count;
     } else if (plan_[i] == Plan::MergedAway) {
       count = 0;
+    } else if (plan_[i] == Plan::Regularize) {
+      ++stats.regularized;
     }
     successors_[i] = {next, count};
     next += count;
   }
-  for (std::size_t i = 0; i < n; ++i)
-    if (plan_[i] == Plan::MergeOwner) successors_[partnerOf_[i]] = {successors_[i].begin, 1};
+  for (std::size_t i = 0; i < n; ++i) {
+    if (plan_[i] != Plan::MergeOwner) continue;
+    const std::uint32_t c = groupOf_[i];
+    const MergeGroup& group = groups_[c];
+    successors_[candidates_[c]] = {successors_[i].begin, 1};
+    for (std::uint8_t m = 0; m < group.size; ++m) successors_[group.members[m]] = {successors_[i].begin, 1};
+    stats.mergedAway += group.size;
+  }
 
-  if (stats.splits == 0 && stats.merges == 0) return stats;
+  if (stats.splits == 0 && stats.merges == 0 && stats.regularized == 0) return stats;
   out_.resize(next);
   emit(particles, out_);
   std::swap(particles, out_);
