@@ -275,15 +275,18 @@ void GranularSimulation::removeVelocityAgainstCorrection() {
   // so the pressure never holds them) keep falling in velocity while the correction puts them back
   // every step. Relative, because packed material moving as a whole (a falling block, whose
   // seeding's jitter the correction evens out) is not in contact with anything: removing its
-  // absolute velocity against dx held the top of a falling block in mid-air.
+  // absolute velocity against dx held the top of a falling block in mid-air. A particle already
+  // moving along dx is not moving into the overlap and is left alone: a contact only stops motion
+  // into it. (Given the velocity of a faster pusher instead, light grains beside a resting body in
+  // granular_explosion were kept moving at 1.5 m/s long after the sand had settled.)
   const double reach = 0.5 * settings_.grid.dx;
   parallelFor(0, particles_.size(), [&](std::size_t i) {
     const Vec3& d = correctionAt_[i];
     const double d2 = d.squaredNorm();
-    if (!(d2 > 0.0)) return;
+    const Vec3 v = particles_.velocity[i].cast<double>();
+    if (!(d2 > 0.0) || v.dot(d) >= 0.0) return;
     const Vec3 x = particles_.position[i].cast<double>();
     const Vec3 behind = sampleLinear<3>(velocityNew_, clampIntoDomain(settings_.grid, x - (reach / std::sqrt(d2)) * d));
-    const Vec3 v = particles_.velocity[i].cast<double>();
     const double vd = (v - behind).dot(d);
     if (vd < 0.0) particles_.velocity[i] = (v - (vd / d2) * d).cast<float>();
   });

@@ -85,6 +85,8 @@ class GranularSimulation {
   // One step of length dt. Throws std::runtime_error if a velocity becomes non-finite.
   void step(double dt);
   double time() const { return time_; }
+  // Continues a saved run at time t (winds are sampled at the simulation time).
+  void setTime(double t) { time_ = t; }
 
   const GranularSettings& settings() const { return settings_; }
   const ParticleGridFields& gridFields() const { return fields_; }

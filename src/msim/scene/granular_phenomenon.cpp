@@ -96,6 +96,7 @@ class GranularPhenomenon final : public Phenomenon {
     // Render points are not saved: new ones are sampled inside the restored particles.
     sim_.resampleRenderPoints();
     time_ = time;
+    sim_.setTime(time);
     for (std::size_t k = 0; k < fired_.size(); ++k) fired_[k] = setup_.explosions[k].time < time;
   }
 
