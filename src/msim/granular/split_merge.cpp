@@ -16,8 +16,6 @@ namespace msim::granular {
 
 namespace {
 
-constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
-
 // Eigenvalues (squared semi-axes) in ascending order; the closed form is enough to classify.
 Vec3 squaredSemiAxes(const Eigen::Matrix3d& a) {
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
@@ -138,8 +136,8 @@ void SplitMerge::classify(const GranularParticles& particles) {
     int depth = l[2] > 2.0 * r2 ? splitDepth(a) : 0;
     if (depth > 0 && std::ldexp(static_cast<double>(particles.mass[i]), -depth) < minimumChildMass_) depth = 0;
     depth_[i] = static_cast<std::uint8_t>(depth);
-    // Too long with no valid split (children too thin or too light): no merge makes it shorter
-    // either, so its shape is brought into the band.
+    // No valid split (children too thin or too light): a too-small particle below the mass limit
+    // looks for a merge (and is regularized if none is valid); any other is regularized at once.
     const bool mayMerge = l[0] < 0.5 * r2 && particles.mass[i] < maximumMergedMass(particles.material[i]);
     plan_[i] = depth > 0 ? Plan::Split : (mayMerge ? Plan::MergeCandidate : Plan::Regularize);
   });
