@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 #include <stdexcept>
 #include <string>
 
@@ -347,10 +348,14 @@ void GranularSimulation::step(double dt) {
       splitMergeStats_ = splitMerge_.apply(particles_);
       // A child of a split lies up to (sqrt3/2) of its parent's semi-axis away from it, which can be
       // beyond a wall; it is put back inside like an advected particle.
-      if (splitMergeStats_.splits > 0)
-        parallelFor(0, particles_.size(), [&](std::size_t i) {
-          particles_.position[i] = clampIntoDomain(settings_.grid, particles_.position[i].cast<double>()).cast<float>();
+      if (splitMergeStats_.splits > 0) {
+        const std::span<const SplitMerge::Successors> successors = splitMerge_.successors();
+        parallelFor(0, successors.size(), [&](std::size_t i) {
+          if (successors[i].count < 2) return;
+          for (std::uint32_t c = successors[i].begin; c < successors[i].begin + successors[i].count; ++c)
+            particles_.position[c] = clampIntoDomain(settings_.grid, particles_.position[c].cast<double>()).cast<float>();
         });
+      }
     }
     if (renderPoints_)
       renderPoints_->carry(motion_, dt, settings_.grid, particles_,
@@ -370,7 +375,7 @@ void GranularSimulation::step(double dt) {
 void GranularSimulation::releaseSeparatingWalls(FaceField& velocity) const {
   for (int a = 0; a < 3; ++a) {
     const IVec3 n = wallFaces_.size(a);
-    const std::size_t stride = a == 0 ? 1 : (a == 1 ? static_cast<std::size_t>(n[0]) : static_cast<std::size_t>(n[0]) * n[1]);
+    const std::size_t stride = wallFaces_.index(a, IVec3::Unit(a));  // one face along axis a
     const std::vector<double>& open = wallFaces_.values[a];
     const std::vector<double>& rho = state_.rhoFace.values[a];
     std::vector<double>& v = velocity.values[a];

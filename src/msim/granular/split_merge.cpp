@@ -36,6 +36,10 @@ bool eigenvaluesWithin(const Eigen::Matrix3d& a, double lo, double hi) {
   return positiveDefinite(a - lo * identity) && positiveDefinite(hi * identity - a);
 }
 
+void addParticle(MergeAccumulator& k, const GranularParticles& p, std::uint32_t j) {
+  k.add(p.position[j].cast<double>(), p.velocity[j].cast<double>(), p.mass[j], shapeMatrix(p.shape[j]));
+}
+
 }  // namespace
 
 bool isValidShape(const Eigen::Matrix3d& a, double radius) {
@@ -172,16 +176,12 @@ void SplitMerge::proposeMerges(const GranularParticles& particles) {
     MergeGroup& group = groups_[c];
     group.size = 0;
     const double maximumMass = maximumMergedMass(particles.material[i]), mi = particles.mass[i];
-    auto add = [&](MergeAccumulator& k, std::uint32_t j) {
-      k.add(particles.position[j].cast<double>(), particles.velocity[j].cast<double>(), particles.mass[j],
-            shapeMatrix(particles.shape[j]));
-    };
     // A pair first, the nearest partner that makes one valid particle.
     for (int k = 0; k < found; ++k) {
       if (mi + particles.mass[nearest[k].second] > maximumMass) continue;
       MergeAccumulator pair(xi);
-      add(pair, i);
-      add(pair, nearest[k].second);
+      addParticle(pair, particles, i);
+      addParticle(pair, particles, nearest[k].second);
       if (valid(pair.result().shape)) {
         group.size = 1;
         group.members[0] = nearest[k].second;
@@ -191,12 +191,12 @@ void SplitMerge::proposeMerges(const GranularParticles& particles) {
     // Then the nearest partners together: a particle squashed along more than one axis (a landed
     // cloud) grows by a merge only along the separation, so no pair can make it valid.
     MergeAccumulator all(xi);
-    add(all, i);
+    addParticle(all, particles, i);
     double mass = mi;
     for (int k = 0; k < found; ++k) {
       mass += particles.mass[nearest[k].second];
       if (mass > maximumMass) return;
-      add(all, nearest[k].second);
+      addParticle(all, particles, nearest[k].second);
       if (k > 0 && valid(all.result().shape)) {
         group.size = static_cast<std::uint8_t>(k + 1);
         for (int m = 0; m <= k; ++m) group.members[m] = nearest[m].second;
@@ -251,11 +251,8 @@ void SplitMerge::emit(const GranularParticles& in, GranularParticles& out) const
         // The same sums in the same order as the proposal that found the group valid.
         const std::uint32_t c = groupOf_[i], first = candidates_[c];
         MergeAccumulator group(in.position[first].cast<double>());
-        auto add = [&](std::uint32_t j) {
-          group.add(in.position[j].cast<double>(), in.velocity[j].cast<double>(), in.mass[j], shapeMatrix(in.shape[j]));
-        };
-        add(first);
-        for (std::uint8_t m = 0; m < groups_[c].size; ++m) add(groups_[c].members[m]);
+        addParticle(group, in, first);
+        for (std::uint8_t m = 0; m < groups_[c].size; ++m) addParticle(group, in, groups_[c].members[m]);
         const MergedParticle k = group.result();
         out.position[at] = k.position.cast<float>();
         out.velocity[at] = k.velocity.cast<float>();
