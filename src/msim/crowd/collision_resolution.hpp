@@ -22,10 +22,12 @@ struct DomainBox {
 struct CollisionResolutionParams {
   // Pairs closer than separation * d_min (d_min = r_i + r_j) are pushed to that distance. The
   // seed found a target "somewhat larger than d_min" gave smoother, jitter-free motion and a better
-  // spacing (ch. 4.5.1). With the UIC's alpha = 0.64 packing and 6 Gauss-Seidel sweeps (the scene
-  // default), 1.2 gives the circle scene of Fig. 4.5 0.003-0.035% of agent-frames closer than
-  // d_min (chaotic: it moves with the sweep order) and a mean nearest-neighbour distance of 1.17
-  // d_min in dense regions (the seed: 0.12% and 1.25).
+  // spacing (ch. 4.5.1). With the UIC's alpha = 0.56 packing and 6 Gauss-Seidel sweeps (the scene
+  // defaults), 1.2 gives the circle scene of Fig. 4.5 about 0.004% of agent-frames closer than
+  // d_min (chaotic: it moves with the sweep order) and a mean nearest-neighbour distance of 1.18
+  // d_min in dense regions (the seed: 0.12% and 1.25). The target must leave room: at alpha 0.64
+  // the separation discs at rho_max are at random close packing, the sweeps never converge and
+  // cost three times as much.
   float separation = 1.2f;
   // Most sweeps; each resolves isolated pairs exactly, clusters converge geometrically. 6
   // Gauss-Seidel sweeps give the circle scene the quality 12 Jacobi sweeps gave (the scene
@@ -43,8 +45,8 @@ struct CollisionResolutionParams {
   // pairs), and the sweeps stop once there are none. After a step a few pairs overlap: in the
   // 100k circle 1-3% of the agents are active after the first sweep, so the later sweeps cost
   // little. Jacobi stops once a sweep moved nobody by more. 0 = always run `iterations` sweeps
-  // over the whole crowd.
-  float tolerance = 0.01f;
+  // over the whole crowd. 0.03 d_min is 1.5 cm for adult agents.
+  float tolerance = 0.03f;
 };
 
 class CollisionResolver {

@@ -360,7 +360,9 @@ class CrowdPhenomenon final : public Phenomenon {
         if (!in) throw std::runtime_error(fmt::format("trajectory part of frame {} is missing in {}", f, dir.string()));
         std::string header;
         std::getline(in, header);
-        out << in.rdbuf();
+        // A frame with no agents (everyone has left) has only the header; inserting an empty
+        // buffer would set the stream's failbit.
+        if (in.peek() != std::char_traits<char>::eof()) out << in.rdbuf();
       }
       if (!out) throw std::runtime_error("writing trajectories.csv failed");
     });

@@ -60,9 +60,10 @@ Schema crowdKeys() {
   c.field("agent", agent);
   Schema uic = Schema::object("the unilateral incompressibility constraint (ch. 4.4)");
   uic.boolean("enabled", true, "project the crowd flow (off: agents walk their preferred velocity, Fig. 4.3b)");
-  uic.number("packing", "", 0.64,
-             "alpha of eq. 4.4, the fraction of hexagonal close packing a crowd reaches; 0.64 = (1/1.25)^2 puts "
-             "neighbours 1.25 d_min apart at rho_max, the spacing the seed measured (ch. 4.5.1)").min(0.0, Bound::Exclusive).max(1.0);
+  uic.number("packing", "", 0.56,
+             "alpha of eq. 4.4, the fraction of hexagonal close packing a crowd reaches; at 0.56 the discs of the "
+             "pairwise separation (1.2 d_min) fill 0.56 x 1.2^2 = 81% of close packing at rho_max, below random "
+             "close packing (about 93%), so pairwise resolution can reach its target").min(0.0, Bound::Exclusive).max(1.0);
   uic.number("rho_max", "1/m^2", 0.0, "maximum density; 0 = eq. 4.4, 2 alpha / (sqrt(3) d_min^2)").min(0.0);
   uic.number("tolerance", "", 5e-3, "QP tolerance: overdensity left per cell, relative to rho_max").min(0.0, Bound::Exclusive);
   uic.integer("max_iterations", 500, "MPRGP iterations per solve").min(1);
@@ -75,7 +76,7 @@ Schema crowdKeys() {
   col.boolean("enabled", true, "push overlapping agents apart (off: Fig. 4.3c)");
   col.number("separation", "", 1.2, "pairs closer than this x d_min are pushed to it (ch. 4.5.1: 'somewhat larger')").min(1.0).max(2.0);
   col.integer("iterations", 6, "most Gauss-Seidel sweeps per step").min(1).max(100);
-  col.number("tolerance", "", 0.01, "stop the sweeps once none moves an agent farther than this x d_min").min(0.0);
+  col.number("tolerance", "", 0.03, "stop the sweeps once none moves an agent farther than this x d_min").min(0.0);
   c.field("collision_resolution", col);
   Schema orca = Schema::object("ORCA agents (van den Berg et al. 2011)");
   orca.number("neighbour_distance", "m", 3.0, "neighbours farther than this are ignored").min(0.0, Bound::Exclusive);
