@@ -49,9 +49,17 @@ TEST(GranularCli, TinySceneWritesParticlesBodiesVdbAndPng) {
   ASSERT_EQ(run.at("frames").size(), 2u);
   const json& last = run.at("frames").back();
   for (const char* key : {"particles", "total_mass_kg", "max_speed_mps", "max_phi", "active_pressure_cells",
-                          "pressure_iterations_per_step", "pressure_s_per_step", "friction_s_per_step",
+                          "pressure_iterations_per_step", "seconds_per_step", "transfer_s_per_step",
+                          "assembly_s_per_step", "pressure_s_per_step", "friction_s_per_step",
                           "particles_s_per_step", "body0_y_m", "render_points"})
     EXPECT_TRUE(last.contains(key)) << key;
+  // The stages are parts of the step: together no more than its wall time.
+  double stages = 0.0;
+  for (const char* key : {"transfer_s_per_step", "assembly_s_per_step", "pressure_s_per_step", "friction_s_per_step",
+                          "particles_s_per_step"})
+    stages += last.value(key, 0.0);
+  EXPECT_GT(stages, 0.0);
+  EXPECT_LE(stages, last.value("seconds_per_step", 0.0) * (1.0 + 1e-9));
   EXPECT_GT(last.at("particles").get<double>(), 1000.0);
   // The ball fell (gravity and its initial speed) but stays above the floor.
   EXPECT_LT(last.at("body0_y_m").get<double>(), 0.35);

@@ -63,10 +63,9 @@ double solveAndCheck(double freeShare, unsigned seed) {
   CoupledBody body;
   body.inverseMass = Eigen::Matrix<double, 6, 6>::Identity() * 0.5;
   body.centre = Vec3(0.25, 0.25, 0.25);
-  body.cellFraction.assign(st.spec.cellCount(), 0.0);
-  body.faceFraction = FaceField(res);
+  body.cover(res, LatticeBox::whole(res));
   for (int a = 0; a < 3; ++a)
-    for (std::size_t i = 0; i < body.faceFraction.values[a].size(); i += 7) body.faceFraction.values[a][i] = 0.5;
+    for (std::size_t i = 0; i < body.faceFraction[a].size(); i += 7) body.faceFraction[a][i] = 0.5;
 
   StressProblem pr;
   pr.terms = {{StressComponent::OffDiagonal(0, 1), 1.0}};

@@ -62,5 +62,26 @@ TEST(RigidSignedDistance, CompoundIsMinimumOverParts) {
   EXPECT_NEAR(signedDistance(s, Vec3(-1.5, 0, 3)), 2.0, 1e-14);
 }
 
+TEST(RigidOrientedBounds, TurnedBoxAndCompoundAgainstClosedForms) {
+  // A 1 x 2 x 3 box turned 90 degrees about z swaps its x and y extents; turned 45 degrees its x
+  // extent is (0.5 + 1) / sqrt(2).
+  const Shape box = Box{Vec3(0.5, 1.0, 1.5)};
+  const Eigen::Quaterniond quarter(Eigen::AngleAxisd(0.5 * M_PI, Vec3::UnitZ()));
+  const Eigen::AlignedBox3d b = orientedBounds(box, quarter);
+  EXPECT_TRUE(b.max().isApprox(Vec3(1.0, 0.5, 1.5), 1e-14)) << b.max().transpose();
+  EXPECT_TRUE(b.min().isApprox(-Vec3(1.0, 0.5, 1.5), 1e-14)) << b.min().transpose();
+  const Eigen::Quaterniond eighth(Eigen::AngleAxisd(0.25 * M_PI, Vec3::UnitZ()));
+  EXPECT_NEAR(orientedBounds(box, eighth).max().x(), 1.5 / std::sqrt(2.0), 1e-14);
+  // Two unit spheres 3 apart along x (offsets +-1.5 once centred), the pair turned 90 degrees
+  // about z: they now lie along y.
+  const Shape pair = makeCompound({{Sphere{1.0}, Vec3(0, 0, 0), Eigen::Quaterniond::Identity()},
+                                   {Sphere{1.0}, Vec3(3, 0, 0), Eigen::Quaterniond::Identity()}});
+  const Eigen::AlignedBox3d p = orientedBounds(pair, quarter);
+  EXPECT_TRUE(p.max().isApprox(Vec3(1.0, 2.5, 1.0), 1e-14)) << p.max().transpose();
+  EXPECT_TRUE(p.min().isApprox(Vec3(-1.0, -2.5, -1.0), 1e-14)) << p.min().transpose();
+  // Never larger than the bounding sphere's cube.
+  EXPECT_LE(p.max().maxCoeff(), boundingRadius(pair) + 1e-14);
+}
+
 }  // namespace
 }  // namespace msim::rigid

@@ -1,6 +1,7 @@
 #include "msim/granular/granular_simulation.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <span>
 #include <stdexcept>
@@ -157,29 +158,37 @@ void GranularSimulation::buildGridState() {
 }
 
 void GranularSimulation::rasterizeBodies(double dt) {
-  bodies_.clear();
+  // The CoupledBody objects and their arrays are reused from step to step (no allocation once
+  // the boxes stop growing).
+  std::size_t used = 0;
   bodyIndex_.clear();
-  if (!settings_.coupleBodies) return;
+  if (!settings_.coupleBodies) {
+    bodies_.clear();
+    return;
+  }
   const GridSpec<3>& g = settings_.grid;
   const std::vector<rigid::RigidBody>& bodies = world_.bodies();
   for (std::size_t k = 0; k < bodies.size(); ++k) {
     const rigid::RigidBody& b = bodies[k];
     if (b.isStatic()) continue;
-    CoupledBody c;
+    if (used == bodies_.size()) bodies_.emplace_back();
+    CoupledBody& c = bodies_[used];
     c.inverseMass = b.inverseMassMatrix();
     rigid::Vec6 gravity = rigid::Vec6::Zero();
     gravity.head<3>() = b.mass() * settings_.gravity;
     c.velocity = b.generalizedVelocity() + dt * c.inverseMass * gravity;
     c.centre = b.position;
     // Covered fraction: the ramp 0.5 - d / dx across the surface cell (geometry/occupancy.hpp),
-    // over the cells of the body's bounding sphere.
-    c.cellFraction.assign(g.cellCount(), 0.0);
-    const double reach = rigid::boundingRadius(b.shape()) + g.dx;
+    // nonzero only within half a cell of the body: over the cells of its bounds grown by a cell.
+    const Eigen::AlignedBox3d bounds = rigid::orientedBounds(b.shape(), b.orientation);
     IVec3 lo, hi;
     for (int a = 0; a < 3; ++a) {
-      lo[a] = std::max(0, static_cast<int>(std::floor((b.position[a] - reach - g.origin[a]) / g.dx)));
-      hi[a] = std::min(g.res[a] - 1, static_cast<int>(std::floor((b.position[a] + reach - g.origin[a]) / g.dx)));
+      lo[a] = std::max(0, static_cast<int>(std::floor((b.position[a] + bounds.min()[a] - g.dx - g.origin[a]) / g.dx)));
+      hi[a] = std::min(g.res[a] - 1,
+                       static_cast<int>(std::floor((b.position[a] + bounds.max()[a] + g.dx - g.origin[a]) / g.dx)));
     }
+    c.cover(g.res, LatticeBox{lo, hi});
+    if (c.cells.empty()) continue;
     const Eigen::Quaterniond toBody = b.orientation.conjugate();
     auto distance = [&](const Vec3& p) { return rigid::signedDistance(b.shape(), toBody * (p - b.position)); };
     // Blocks of kBlock^3 cells, a slab of blocks per task. The signed distance is 1-Lipschitz, so a
@@ -204,9 +213,9 @@ void GranularSimulation::rasterizeBodies(double dt) {
                 for (int z = first[2]; z <= last[2]; ++z)
                   for (int y = first[1]; y <= last[1]; ++y)
                     for (int x = first[0]; x <= last[0]; ++x) {
-                      const double f =
-                          inside ? 1.0 : std::clamp(0.5 - distance(g.cellCenter(IVec3(x, y, z))) / g.dx, 0.0, 1.0);
-                      c.cellFraction[(static_cast<std::size_t>(z) * g.res[1] + y) * g.res[0] + x] = f;
+                      const IVec3 q(x, y, z);
+                      const double f = inside ? 1.0 : std::clamp(0.5 - distance(g.cellCenter(q)) / g.dx, 0.0, 1.0);
+                      c.cellFraction[CoupledBody::local(c.cells, q)] = f;
                       found |= f > 0.0;
                     }
               }
@@ -214,28 +223,23 @@ void GranularSimulation::rasterizeBodies(double dt) {
         },
         [](bool a, bool b) { return a || b; });
     if (!any) continue;
-    c.cells = LatticeBox{lo, hi};
-    // Face fractions, the mean of the two cells: nonzero only on the faces of the box's cells.
-    c.faceFraction = FaceField(g.res);
+    // Face fractions, the mean of the two cells (0 beyond the box and the grid).
     for (int a = 0; a < 3; ++a) {
-      const IVec3 n = c.faceFraction.size(a);
-      for (int z = lo[2]; z <= hi[2] + (a == 2); ++z)
-        for (int y = lo[1]; y <= hi[1] + (a == 1); ++y)
-          for (int x = lo[0]; x <= hi[0] + (a == 0); ++x) {
+      const LatticeBox faces = c.faces(a);
+      tbb::parallel_for(faces.first[2], faces.last[2] + 1, [&](int z) {
+        for (int y = faces.first[1]; y <= faces.last[1]; ++y)
+          for (int x = faces.first[0]; x <= faces.last[0]; ++x) {
             const IVec3 q(x, y, z);
             IVec3 below = q;
             below[a] -= 1;
-            auto cell = [&](const IVec3& k) {
-              if (k[a] < 0 || k[a] >= g.res[a]) return 0.0;
-              return c.cellFraction[(static_cast<std::size_t>(k[2]) * g.res[1] + k[1]) * g.res[0] + k[0]];
-            };
-            c.faceFraction.values[a][(static_cast<std::size_t>(z) * n[1] + y) * n[0] + x] =
-                0.5 * (cell(q) + cell(below));
+            c.faceFraction[a][CoupledBody::local(faces, q)] = 0.5 * (c.cellFractionAt(q) + c.cellFractionAt(below));
           }
+      });
     }
-    bodies_.push_back(std::move(c));
+    ++used;
     bodyIndex_.push_back(static_cast<int>(k));
   }
+  bodies_.resize(used);
 }
 
 void GranularSimulation::pushOutOfSolids() {
@@ -296,6 +300,7 @@ void GranularSimulation::removeVelocityAgainstCorrection() {
 void GranularSimulation::step(double dt) {
   if (!(dt > 0.0) || !std::isfinite(dt)) throw std::invalid_argument("granular: the time step must be positive");
   times_ = {};
+  const auto stepStart = std::chrono::steady_clock::now();
   {
     ScopedTimer t(times_.transfer);
     buildGridState();
@@ -319,9 +324,14 @@ void GranularSimulation::step(double dt) {
         velocity.values[a][i] = v[i] + dt * settings_.gravity[a];
   }
   if (!winds_.empty()) applyWinds(dt, velocity);
-  stress_.solve(state_, dt, velocity, coupled);
+  double solveSeconds = 0.0;
+  {
+    ScopedTimer t(solveSeconds);
+    stress_.solve(state_, dt, velocity, coupled);
+  }
   times_.pressure = stress_.stats().pressureSeconds;
   times_.friction = stress_.stats().frictionSeconds;
+  times_.assembly = std::max(0.0, solveSeconds - times_.pressure - times_.friction);
   for (int a = 0; a < 3; ++a)
     for (double v : velocity.values[a])
       if (!std::isfinite(v))
@@ -362,6 +372,9 @@ void GranularSimulation::step(double dt) {
                            settings_.splitMerge ? splitMerge_.successors() : std::span<const SplitMerge::Successors>{});
   }
   time_ += dt;
+  times_.step = std::chrono::duration<double>(std::chrono::steady_clock::now() - stepStart).count();
+  times_.other = std::max(0.0, times_.step - (times_.transfer + times_.correction + times_.assembly + times_.pressure +
+                                              times_.friction + times_.bodies + times_.particles));
 }
 
 // The seed closes the domain with ghost cells held full (phi = 1, line 1192), so a wall is a

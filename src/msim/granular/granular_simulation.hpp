@@ -46,8 +46,12 @@ struct GranularSettings {
 };
 
 // Stage times of the last step [s] (the split of Table 5.1: pressure, friction, particles).
+// Wall time of one step by stage [s]. assembly: the stress solve outside its QP loops (face
+// coefficients, the problems' operators and body columns, the force bookkeeping); other: the rest
+// of the step (the predicted velocity, the wall release, checks). The stages add up to `step`.
 struct GranularStepTimes {
-  double transfer = 0, correction = 0, pressure = 0, friction = 0, bodies = 0, particles = 0;
+  double transfer = 0, correction = 0, assembly = 0, pressure = 0, friction = 0, bodies = 0, particles = 0, other = 0;
+  double step = 0;
 };
 
 class GranularSimulation {

@@ -1,6 +1,7 @@
 #pragma once
 // What the granular stress solve (stress_solver.hpp) reads at the start of a step: the material
 // on the grid, from the particles, and the rigid bodies coupled to it (Narain 2011 ch. 5.3.4).
+#include <array>
 #include <vector>
 
 #include <Eigen/Core>
@@ -11,22 +12,52 @@
 namespace msim::granular {
 
 // A rigid body as the stress sees it (generalized 6-vectors: force then moment about `centre`).
+// Its covered fractions are stored over the box of cells it may cover only (a wheel covers a few
+// thousand of a million cells; full-grid arrays per body and step cost more than the rest of its
+// coupling).
 struct CoupledBody {
   Eigen::Matrix<double, 6, 6> inverseMass = Eigen::Matrix<double, 6, 6>::Zero();
   Eigen::Matrix<double, 6, 1> velocity = Eigen::Matrix<double, 6, 1>::Zero();  // V~ without stress
   Vec3 centre = Vec3::Zero();
-  std::vector<double> cellFraction;  // phi_s per cell (the body's covered volume fraction)
-  FaceField faceFraction;            // phi_s per face (averaged from the cells on either side)
-  // The cells where cellFraction may be nonzero (the faces: the same box, one further along the
-  // face's axis); the whole grid unless the rasterisation narrowed it.
-  LatticeBox cells{IVec3::Zero(), IVec3::Constant(1 << 29)};
-  // The faces of `axis` where faceFraction may be nonzero, within a grid of `res` cells.
-  LatticeBox faces(int axis, const IVec3& res) const {
+  IVec3 res = IVec3::Zero();  // cells of the grid
+  // The cells where the covered fraction may be nonzero (within the grid); the faces: the same box,
+  // one further along the face's axis.
+  LatticeBox cells;
+  std::vector<double> cellFraction;                // phi_s per cell of `cells`, x fastest
+  std::array<std::vector<double>, 3> faceFraction;  // phi_s per face of faces(a), x fastest
+
+  // Sets the grid and the box and zeroes the fractions (keeping the storage).
+  void cover(const IVec3& gridCells, const LatticeBox& box) {
+    res = gridCells;
+    cells = box.intersect(LatticeBox::whole(gridCells));
+    cellFraction.assign(count(cells), 0.0);
+    for (int a = 0; a < 3; ++a) faceFraction[a].assign(count(faces(a)), 0.0);
+  }
+  // The faces of `axis` where the face fraction may be nonzero.
+  LatticeBox faces(int axis) const {
+    if (cells.empty()) return cells;
     IVec3 last = cells.last;
     last[axis] += 1;
-    IVec3 size = res;
-    size[axis] += 1;
-    return LatticeBox{cells.first.cwiseMax(IVec3::Zero()), last.cwiseMin(size - IVec3::Ones())};
+    return LatticeBox{cells.first, last};
+  }
+  // Index into cellFraction (faceFraction[axis]) of a cell (face) inside cells (faces(axis)).
+  static std::size_t local(const LatticeBox& box, const IVec3& q) {
+    const IVec3 n = box.last - box.first + IVec3::Ones(), d = q - box.first;
+    return (static_cast<std::size_t>(d[2]) * n[1] + d[1]) * n[0] + d[0];
+  }
+  // phi_s of cell q, or of face q of `axis` (0 outside the box).
+  double cellFractionAt(const IVec3& q) const { return inside(cells, q) ? cellFraction[local(cells, q)] : 0.0; }
+  double faceFractionAt(int axis, const IVec3& q) const {
+    const LatticeBox box = faces(axis);
+    return inside(box, q) ? faceFraction[axis][local(box, q)] : 0.0;
+  }
+
+ private:
+  static std::size_t count(const LatticeBox& box) {
+    return box.empty() ? 0 : (box.last - box.first + IVec3::Ones()).cast<std::size_t>().prod();
+  }
+  static bool inside(const LatticeBox& box, const IVec3& q) {
+    return (q.array() >= box.first.array()).all() && (q.array() <= box.last.array()).all();
   }
 };
 

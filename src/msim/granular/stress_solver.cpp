@@ -102,18 +102,30 @@ void weightedFaces(const FaceField& w, const FaceField& v, FaceField& out) {
 void StressSolver::faceCoefficients(const GranularGridState& st, const std::vector<const CoupledBody*>& bodies,
                                     double minimumFaceFraction, Impl& m) {
   for (FaceField* f : {&m.kappa, &m.weightP, &m.weightS, &m.weightB}) f->reset(st.spec.res);
-  for (int a = 0; a < 3; ++a)
-    parallelFor(0, m.kappa.values[a].size(), [&](std::size_t i) {
-      const double rho = st.rhoFace.values[a][i], phi = st.phiFace.values[a][i];
-      if (st.open.values[a][i] == 0.0 || !(rho > 0.0) || !(phi > 0.0)) return;
-      double solid = 0.0;
-      for (const CoupledBody* b : bodies) solid += b->faceFraction.values[a][i];
-      const double k = std::max(0.0, 1.0 - solid) * phi / (rho * std::max(phi, minimumFaceFraction));
-      m.kappa.values[a][i] = k;
-      m.weightP.values[a][i] = phi * k;
-      m.weightS.values[a][i] = phi * rho * k * k;
-      m.weightB.values[a][i] = phi * rho * k;
-    }, 4096);
+  // The faces away from the bodies first (phi_s = 0), then those of each body's box again with
+  // the covered fraction of every body there.
+  auto coefficients = [&](int a, std::size_t i, double solid) {
+    const double rho = st.rhoFace.values[a][i], phi = st.phiFace.values[a][i];
+    if (st.open.values[a][i] == 0.0 || !(rho > 0.0) || !(phi > 0.0)) return;
+    const double k = std::max(0.0, 1.0 - solid) * phi / (rho * std::max(phi, minimumFaceFraction));
+    m.kappa.values[a][i] = k;
+    m.weightP.values[a][i] = phi * k;
+    m.weightS.values[a][i] = phi * rho * k * k;
+    m.weightB.values[a][i] = phi * rho * k;
+  };
+  for (int a = 0; a < 3; ++a) {
+    parallelFor(0, m.kappa.values[a].size(), [&](std::size_t i) { coefficients(a, i, 0.0); }, 4096);
+    for (const CoupledBody* body : bodies) {
+      const LatticeBox box = body->faces(a);
+      forBoxRows(box, m.kappa.size(a), [&](std::size_t row, int y, int z) {
+        for (int x = box.first[0]; x <= box.last[0]; ++x) {
+          double solid = 0.0;
+          for (const CoupledBody* b : bodies) solid += b->faceFractionAt(a, IVec3(x, y, z));
+          coefficients(a, row + static_cast<std::size_t>(x - box.first[0]), solid);
+        }
+      });
+    }
+  }
 }
 
 void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velocity,
@@ -179,15 +191,15 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
     auto& list = m.bodyFaces[k];
     list.clear();
     for (int a = 0; a < 3; ++a) {
-      const std::vector<double>& frac = bodies[k]->faceFraction.values[a];
-      forEachInBox(bodies[k]->faces(a, st.spec.res), st.open.size(a), [&](std::size_t i, const IVec3& f) {
-        if (frac[i] <= 0.0 || st.open.values[a][i] == 0.0) return;
+      forEachInBox(bodies[k]->faces(a), st.open.size(a), [&](std::size_t i, const IVec3& f) {
+        const double fraction = bodies[k]->faceFractionAt(a, f);
+        if (fraction <= 0.0 || st.open.values[a][i] == 0.0) return;
         Vec3 x = st.spec.origin + (f.cast<double>().array() + 0.5).matrix() * dx;
         x[a] -= 0.5 * dx;
         Vec6 g;
         g.head<3>() = Vec3::Unit(a);
         g.tail<3>() = Vec3(x - bodies[k]->centre).cross(Vec3(Vec3::Unit(a)));
-        list.push_back({a, i, frac[i] * g});
+        list.push_back({a, i, fraction * g});
       });
     }
   }
@@ -313,8 +325,9 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
     // Bodies: + phi_s^{n+1}|p=0 = phi_s^n + dt J1^T V~ (the columns carry the pressure's -1).
     for (std::size_t b = 0; b < bodies.size(); ++b) {
       const BodyColumns& bc = pr.bodies[b];
-      forEachInBox(bodies[b]->cells.intersect(LatticeBox::whole(st.spec.res)), st.spec.res,
-                   [&](std::size_t i, const IVec3&) { pr.b[static_cast<Eigen::Index>(i)] += bodies[b]->cellFraction[i]; });
+      forEachInBox(bodies[b]->cells, st.spec.res, [&](std::size_t i, const IVec3& q) {
+        pr.b[static_cast<Eigen::Index>(i)] += bodies[b]->cellFractionAt(q);
+      });
       for (std::size_t j = 0; j < bc.sample.size(); ++j)
         pr.b[static_cast<Eigen::Index>(bc.sample[j])] -= dt * bc.column[j].dot(m.bodyVelocity[b]);
     }
@@ -344,11 +357,14 @@ const FaceField& StressSolver::correctDensity(GranularGridState& st, const std::
   // Bodies do not move in the correction: only the grid part, with their volume in the constraint.
   pr.build(st, m.weightP, 1.0, {});
   pr.b.resize(static_cast<Eigen::Index>(cells));
-  parallelFor(0, cells, [&](std::size_t i) {
-    double solid = 0.0;
-    for (const CoupledBody* b : bodies) solid += b->cellFraction[i];
-    pr.b[static_cast<Eigen::Index>(i)] = st.phi[i] + solid - 1.0;
-  }, 4096);
+  // phi + phi_s - 1: phi - 1 away from the bodies, then the cells of their boxes.
+  parallelFor(0, cells, [&](std::size_t i) { pr.b[static_cast<Eigen::Index>(i)] = st.phi[i] - 1.0; }, 4096);
+  for (const CoupledBody* body : bodies)
+    forEachInBox(body->cells, st.spec.res, [&](std::size_t i, const IVec3& q) {
+      double solid = 0.0;
+      for (const CoupledBody* b : bodies) solid += b->cellFractionAt(q);
+      pr.b[static_cast<Eigen::Index>(i)] = st.phi[i] + solid - 1.0;
+    });
   displacement_.reset(st.spec.res);
   stats_.correctionIterations = 0;
   if (!(pr.b.maxCoeff() > 0.0)) return displacement_;

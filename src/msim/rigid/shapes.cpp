@@ -93,6 +93,28 @@ double radiusOf(const Compound& c) {
   return r;
 }
 
+Eigen::AlignedBox3d boundsOf(const Sphere& s, const Eigen::Quaterniond&) {
+  return {Vec3::Constant(-s.radius), Vec3::Constant(s.radius)};
+}
+Eigen::AlignedBox3d boundsOf(const Box& b, const Eigen::Quaterniond& q) {
+  const Vec3 extent = q.toRotationMatrix().cwiseAbs() * b.halfExtents;
+  return {-extent, extent};
+}
+Eigen::AlignedBox3d boundsOf(const ConvexMesh& m, const Eigen::Quaterniond& q) {
+  Eigen::AlignedBox3d box;
+  for (const Vec3& v : m.vertices) box.extend(q * v);
+  return box;
+}
+Eigen::AlignedBox3d boundsOf(const Compound& c, const Eigen::Quaterniond& q) {
+  Eigen::AlignedBox3d box;
+  for (const CompoundPart& part : c.parts) {
+    const Eigen::AlignedBox3d b = std::visit([&](const auto& s) { return boundsOf(s, q * part.rotation); }, part.shape);
+    const Vec3 shift = q * part.offset;
+    box.extend(Eigen::AlignedBox3d(b.min() + shift, b.max() + shift));
+  }
+  return box;
+}
+
 template <class S>
 double distanceOf(const S& s, const Vec3& p) {
   return closestSurfacePoint(s, p).distance;
@@ -114,6 +136,10 @@ double partBoundingRadius(const PartShape& shape) {
 
 double boundingRadius(const Shape& shape) {
   return std::visit([](const auto& s) { return radiusOf(s); }, shape);
+}
+
+Eigen::AlignedBox3d orientedBounds(const Shape& shape, const Eigen::Quaterniond& orientation) {
+  return std::visit([&](const auto& s) { return boundsOf(s, orientation); }, shape);
 }
 
 double signedDistance(const Shape& shape, const Vec3& localPoint) {

@@ -64,6 +64,11 @@ using Shape = std::variant<Sphere, Box, ConvexMesh, Compound>;
 double boundingRadius(const Shape& shape);
 double partBoundingRadius(const PartShape& shape);
 
+// Axis-aligned box holding the shape turned by `orientation`, in world axes relative to the body
+// origin (exact for spheres, boxes and meshes; the union of the parts' for a compound). A long
+// thin body's is much smaller than its bounding sphere's cube.
+Eigen::AlignedBox3d orientedBounds(const Shape& shape, const Eigen::Quaterniond& orientation);
+
 // Nearest surface point of a convex shape to a body-frame point: `distance` is signed (negative
 // inside) and exact, `normal` the outward unit normal there (the gradient of the distance).
 // Inside a polyhedron the nearest surface point lies on the nearest face plane.

@@ -47,15 +47,19 @@ class GranularPhenomenon final : public Phenomenon {
     const granular::GranularStepTimes& t = sim_.lastStepTimes();
     timers_.add("granular: transfer", t.transfer);
     timers_.add("granular: density correction", t.correction);
+    timers_.add("granular: stress assembly", t.assembly);
     timers_.add("granular: pressure", t.pressure);
     timers_.add("granular: friction", t.friction);
     timers_.add("granular: bodies", t.bodies);
     timers_.add("granular: particles", t.particles);
+    timers_.add("granular: other", t.other);
     frame_.steps += 1;
     frame_.transfer += t.transfer + t.correction;
+    frame_.assembly += t.assembly;
     frame_.pressure += t.pressure;
     frame_.friction += t.friction;
     frame_.particles += t.particles + t.bodies;
+    frame_.step += t.step;
     const granular::StressSolverStats& s = sim_.stress().stats();
     frame_.pressureIterations += s.pressureIterations;
     frame_.frictionIterations += s.frictionIterations;
@@ -122,7 +126,9 @@ class GranularPhenomenon final : public Phenomenon {
               {"pressure_iterations_per_step", last_.pressureIterations / steps},
               {"friction_iterations_per_step", last_.frictionIterations / steps},
               {"correction_iterations_per_step", last_.correctionIterations / steps},
+              {"seconds_per_step", last_.step / steps},
               {"transfer_s_per_step", last_.transfer / steps},
+              {"assembly_s_per_step", last_.assembly / steps},
               {"pressure_s_per_step", last_.pressure / steps},
               {"friction_s_per_step", last_.friction / steps},
               {"particles_s_per_step", last_.particles / steps}};
@@ -158,7 +164,7 @@ class GranularPhenomenon final : public Phenomenon {
   struct FrameWork {
     int steps = 0;
     long pressureIterations = 0, frictionIterations = 0, correctionIterations = 0;
-    double transfer = 0, pressure = 0, friction = 0, particles = 0;  // [s]
+    double step = 0, transfer = 0, assembly = 0, pressure = 0, friction = 0, particles = 0;  // [s]
   };
 
   std::string source_, name_;
