@@ -58,6 +58,30 @@ struct CoupledBody {
   }
 };
 
+// G_f = [e_a; (x_f - c) x e_a] (eqs. 5.21-5.22): the generalized direction of face `f` of `axis`
+// (x_f its centre) about the body's centre c.
+inline Eigen::Matrix<double, 6, 1> faceDirection(const GridSpec<3>& spec, const CoupledBody& body, int axis,
+                                                 const IVec3& f) {
+  Vec3 x = spec.origin + (f.cast<double>().array() + 0.5).matrix() * spec.dx;
+  x[axis] -= 0.5 * spec.dx;
+  Eigen::Matrix<double, 6, 1> g;
+  g.head<3>() = Vec3::Unit(axis);
+  g.tail<3>() = Vec3(x - body.centre).cross(Vec3(Vec3::Unit(axis)));
+  return g;
+}
+
+// phi_s of all the bodies together at cell q, or at face q of `axis`.
+inline double coveredCellFraction(const std::vector<const CoupledBody*>& bodies, const IVec3& q) {
+  double solid = 0.0;
+  for (const CoupledBody* b : bodies) solid += b->cellFractionAt(q);
+  return solid;
+}
+inline double coveredFaceFraction(const std::vector<const CoupledBody*>& bodies, int axis, const IVec3& q) {
+  double solid = 0.0;
+  for (const CoupledBody* b : bodies) solid += b->faceFractionAt(axis, q);
+  return solid;
+}
+
 // f(linear index, coordinates) for every element of `box` in a grid of size n, in linear order.
 template <typename F>
 void forEachInBox(const LatticeBox& box, const IVec3& n, F&& f) {

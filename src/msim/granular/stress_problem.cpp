@@ -84,11 +84,7 @@ void StressProblem::bodyColumns(const GranularGridState& st, const CoupledBody& 
     tbb::parallel_for(std::size_t(0), slices, [&](std::size_t k) {
       std::size_t next = begin + columnSliceOffsets[k];
       visitSlice(faces.first[2] + static_cast<int>(k), [&](const IVec3& f, double fraction, double sign, std::size_t q) {
-        Vec3 x = st.spec.origin + (f.cast<double>().array() + 0.5).matrix() * st.spec.dx;
-        x[a] -= 0.5 * st.spec.dx;
-        Vec6 g;
-        g.head<3>() = Vec3::Unit(a);
-        g.tail<3>() = Vec3(x - body.centre).cross(Vec3(Vec3::Unit(a)));
+        Vec6 g = faceDirection(st.spec, body, a, f);
         g *= fraction * invDx;
         out.sample[next] = q;
         out.column[next] = sign * g;

@@ -118,11 +118,8 @@ void StressSolver::faceCoefficients(const GranularGridState& st, const std::vect
     for (const CoupledBody* body : bodies) {
       const LatticeBox box = body->faces(a);
       forBoxRows(box, m.kappa.size(a), [&](std::size_t row, int y, int z) {
-        for (int x = box.first[0]; x <= box.last[0]; ++x) {
-          double solid = 0.0;
-          for (const CoupledBody* b : bodies) solid += b->faceFractionAt(a, IVec3(x, y, z));
-          coefficients(a, row + static_cast<std::size_t>(x - box.first[0]), solid);
-        }
+        for (int x = box.first[0]; x <= box.last[0]; ++x)
+          coefficients(a, row + static_cast<std::size_t>(x - box.first[0]), coveredFaceFraction(bodies, a, IVec3(x, y, z)));
       });
     }
   }
@@ -194,12 +191,7 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
       forEachInBox(bodies[k]->faces(a), st.open.size(a), [&](std::size_t i, const IVec3& f) {
         const double fraction = bodies[k]->faceFractionAt(a, f);
         if (fraction <= 0.0 || st.open.values[a][i] == 0.0) return;
-        Vec3 x = st.spec.origin + (f.cast<double>().array() + 0.5).matrix() * dx;
-        x[a] -= 0.5 * dx;
-        Vec6 g;
-        g.head<3>() = Vec3::Unit(a);
-        g.tail<3>() = Vec3(x - bodies[k]->centre).cross(Vec3(Vec3::Unit(a)));
-        list.push_back({a, i, fraction * g});
+        list.push_back({a, i, fraction * faceDirection(st.spec, *bodies[k], a, f)});
       });
     }
   }
@@ -361,9 +353,7 @@ const FaceField& StressSolver::correctDensity(GranularGridState& st, const std::
   parallelFor(0, cells, [&](std::size_t i) { pr.b[static_cast<Eigen::Index>(i)] = st.phi[i] - 1.0; }, 4096);
   for (const CoupledBody* body : bodies)
     forEachInBox(body->cells, st.spec.res, [&](std::size_t i, const IVec3& q) {
-      double solid = 0.0;
-      for (const CoupledBody* b : bodies) solid += b->cellFractionAt(q);
-      pr.b[static_cast<Eigen::Index>(i)] = st.phi[i] + solid - 1.0;
+      pr.b[static_cast<Eigen::Index>(i)] = st.phi[i] + coveredCellFraction(bodies, q) - 1.0;
     });
   displacement_.reset(st.spec.res);
   stats_.correctionIterations = 0;
