@@ -94,7 +94,7 @@ void BM_SplitMerge(benchmark::State& state) {
   // particles that just became invalid (those no split or merge could fix were regularized).
   GranularParticles deformed = seeded();
   const MacGrid<3> velocity = shearingFlow();
-  SplitMerge splitMerge(defaultParticleRadius(kDx));
+  SplitMerge splitMerge(particleRadius(kDx));
   for (int k = 0; k < 40; ++k) {
     if (k > 0) splitMerge.apply(deformed);
     advectParticles(deformed, velocity, 5 * kDt);
@@ -122,7 +122,7 @@ void BM_ParticleStep(benchmark::State& state) {
   GranularParticles p = seeded();
   ParticleGridFields fields(kGrid);
   ParticleGridTransfer transfer;
-  SplitMerge splitMerge(defaultParticleRadius(kDx));
+  SplitMerge splitMerge(particleRadius(kDx));
   const MacGrid<3> solved = shearingFlow();
   double particles = 0.0;
   for (auto _ : state) {

@@ -105,6 +105,32 @@ TEST(GranularSeeding, InsidePredicateSeedsTheRegionVolume) {
   for (const Vecf<3>& x : p.position) EXPECT_LE((x.cast<double>() - centre).norm(), radius + 1e-6);
 }
 
+TEST(GranularSeeding, DenserSeedingScalesTheSpacingMassAndShape) {
+  const GridSpec<3> grid(Vec3::Zero(), 0.1, IVec3::Constant(10));
+  const std::vector<GranularMaterial> materials{{1600.0, 0.5}};
+  SeedOptions options;
+  options.particlesPerCell = 27.0;  // a 3 x 3 x 3 lattice in every cell
+  GranularParticles p;
+  EXPECT_EQ(seedBox(p, grid, Vec3(0.2, 0.1, 0.3), Vec3(0.6, 0.4, 0.5), materials, options), 27u * 4 * 3 * 2);
+  const double h = grid.dx / 3.0;
+  EXPECT_DOUBLE_EQ(particleSpacing(grid.dx, 27.0), h);
+  EXPECT_DOUBLE_EQ(particleRadius(grid.dx, 27.0), h / 2);
+  EXPECT_DOUBLE_EQ(particleRadius(grid.dx), grid.dx / 4);  // the seed's r at 8 per cell
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    EXPECT_FLOAT_EQ(p.mass[i], float(1600.0 * h * h * h));
+    EXPECT_TRUE(shapeMatrix(p.shape[i]).isApprox(h * h / 4 * Eigen::Matrix3d::Identity(), 1e-6));
+  }
+  // A density whose lattice does not fit the cells still seeds k per cell and rho_max V on average.
+  GranularParticles q;
+  options.particlesPerCell = 12.0;
+  const std::size_t n = seedBox(q, grid, Vec3::Zero(), Vec3::Ones(), materials, options);
+  double mass = 0.0;
+  for (float m : q.mass) mass += m;
+  std::printf("12 per cell over 1000 cells: %zu particles, mass %.2f kg of %.2f\n", n, mass, 1600.0);
+  EXPECT_NEAR(double(n), 12000.0, 120.0);
+  EXPECT_NEAR(mass, 1600.0, 16.0);
+}
+
 TEST(GranularSeeding, RejectsBadOptions) {
   const GridSpec<3> grid(Vec3::Zero(), 0.1, IVec3::Constant(4));
   const std::vector<GranularMaterial> materials{{1600.0, 0.5}};
@@ -120,6 +146,11 @@ TEST(GranularSeeding, RejectsBadOptions) {
   options = {};
   options.velocity = Vec3(kNaN, 0, 0);
   EXPECT_THROW(seedBox(p, grid, Vec3::Zero(), Vec3::Ones(), materials, options), std::invalid_argument);
+  for (double k : {0.5, 126.0, kNaN}) {
+    options = {};
+    options.particlesPerCell = k;
+    EXPECT_THROW(seedBox(p, grid, Vec3::Zero(), Vec3::Ones(), materials, options), std::invalid_argument);
+  }
   const std::vector<GranularMaterial> bad{{-1.0, 0.5}};
   EXPECT_THROW(seedBox(p, grid, Vec3::Zero(), Vec3::Ones(), bad), std::invalid_argument);
   EXPECT_TRUE(p.empty());

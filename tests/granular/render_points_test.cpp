@@ -78,7 +78,7 @@ TEST(GranularRenderPoints, FollowTheFlowInsideTheirParticlesThroughSplits) {
   }
   const double worstAfterAdvection = worstDistance(points, p);
   // Then with split/merge every step: points follow a child of their particle.
-  SplitMerge splitMerge(defaultParticleRadius(kDx));
+  SplitMerge splitMerge(particleRadius(kDx));
   std::size_t splits = 0, resampled = 0;
   for (int step = 0; step < 20; ++step) {
     advectParticles(p, velocity, dt, {}, &motion);
@@ -103,7 +103,7 @@ TEST(GranularRenderPoints, FollowTheFlowInsideTheirParticlesThroughSplits) {
 
 TEST(GranularRenderPoints, MergedParticleTakesBothSetsOfPoints) {
   Eigen::Matrix3d thin = Vec3(0.3, 1.0, 1.0).asDiagonal();
-  const double r = defaultParticleRadius(kDx);
+  const double r = particleRadius(kDx);
   thin *= r * r;
   GranularParticles p;
   p.append(Vecf<3>(1, 1, 1), Vecf<3>::Zero(), 1.0f, toShape(thin), 0);

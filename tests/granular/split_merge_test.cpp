@@ -16,7 +16,7 @@ namespace msim::granular {
 namespace {
 
 constexpr double kDx = 0.1;
-const double kR = defaultParticleRadius(kDx);
+const double kR = particleRadius(kDx);
 
 // Semi-axes relative to r, ascending.
 Vec3 semiAxesOverR(const ParticleShape& s) {

@@ -24,6 +24,13 @@ void validate(std::span<const GranularMaterial> materials) {
   for (std::size_t i = 0; i < materials.size(); ++i) validate(materials[i], i);
 }
 
+void validateParticlesPerCell(double particlesPerCell) {
+  if (!(particlesPerCell >= 1.0 && particlesPerCell <= kMaxParticlesPerCell))
+    throw std::invalid_argument("granular: particles per cell must lie in [1, " +
+                                std::to_string(static_cast<int>(kMaxParticlesPerCell)) + "], got " +
+                                std::to_string(particlesPerCell));
+}
+
 Eigen::Matrix3d shapeMatrix(const ParticleShape& s) {
   Eigen::Matrix3d a;
   a << s[0], s[3], s[4],  //
@@ -84,17 +91,21 @@ std::size_t seedRegion(GranularParticles& particles, const GridSpec<3>& grid, co
   if (!lo.allFinite() || !hi.allFinite() || !options.velocity.allFinite())
     throw std::invalid_argument("granular seeding: region corners and velocity must be finite");
   if (!(grid.dx > 0.0)) throw std::invalid_argument("granular seeding: grid spacing must be > 0");
+  validateParticlesPerCell(options.particlesPerCell);
 
-  const double dx = grid.dx;
-  const double r = defaultParticleRadius(dx);
-  const float mass = static_cast<float>(options.fillFraction * materials[options.material].density * dx * dx * dx / 8.0);
+  const double h = particleSpacing(grid.dx, options.particlesPerCell);
+  const double r = particleRadius(grid.dx, options.particlesPerCell);
+  const float mass = static_cast<float>(options.fillFraction * materials[options.material].density * h * h * h);
   const ParticleShape sphere = toShape(r * r * Eigen::Matrix3d::Identity());
   const Vecf<3> velocity = options.velocity.cast<float>();
 
-  IVec3 first, last;  // cells overlapping the box, clipped to the grid
+  // Lattice cubes overlapping the box clipped to the grid; `count` numbers the cubes of the whole grid.
+  const Vec3 boxLo = lo.cwiseMax(grid.origin), boxHi = hi.cwiseMin(grid.upper());
+  IVec3 first, last, count;
   for (int a = 0; a < 3; ++a) {
-    first[a] = std::max(0, static_cast<int>(std::floor((std::max(lo[a], grid.origin[a]) - grid.origin[a]) / dx)));
-    last[a] = std::min(grid.res[a], static_cast<int>(std::ceil((std::min(hi[a], grid.upper()[a]) - grid.origin[a]) / dx)));
+    count[a] = static_cast<int>(std::ceil(grid.res[a] * grid.dx / h)) + 1;
+    first[a] = std::max(0, static_cast<int>(std::floor((boxLo[a] - grid.origin[a]) / h)));
+    last[a] = std::min(count[a], static_cast<int>(std::ceil((boxHi[a] - grid.origin[a]) / h)));
   }
   const Rng base(options.seed);
   const std::size_t before = particles.size();
@@ -102,18 +113,15 @@ std::size_t seedRegion(GranularParticles& particles, const GridSpec<3>& grid, co
   for (c[2] = first[2]; c[2] < last[2]; ++c[2])
     for (c[1] = first[1]; c[1] < last[1]; ++c[1])
       for (c[0] = first[0]; c[0] < last[0]; ++c[0]) {
-        const std::uint64_t cell =
+        const std::uint64_t cube =
             static_cast<std::uint64_t>(c[0]) +
-            static_cast<std::uint64_t>(grid.res[0]) * (static_cast<std::uint64_t>(c[1]) +
-                                                       static_cast<std::uint64_t>(grid.res[1]) * c[2]);
-        Rng rng = base.split(cell);
-        const Vec3 corner = grid.origin + c.cast<double>() * dx;
-        for (int sub = 0; sub < 8; ++sub) {
-          const Vec3 jitter(rng.uniform(), rng.uniform(), rng.uniform());
-          const Vec3 x = corner + 0.5 * dx * (Vec3(sub & 1, (sub >> 1) & 1, (sub >> 2) & 1) + jitter);
-          if ((x.array() < lo.array()).any() || (x.array() > hi.array()).any() || !inside(x)) continue;
-          particles.append(x.cast<float>(), velocity, mass, sphere, options.material);
-        }
+            static_cast<std::uint64_t>(count[0]) * (static_cast<std::uint64_t>(c[1]) +
+                                                    static_cast<std::uint64_t>(count[1]) * c[2]);
+        Rng rng = base.split(cube);
+        const Vec3 jitter(rng.uniform(), rng.uniform(), rng.uniform());
+        const Vec3 x = grid.origin + (c.cast<double>() + jitter) * h;
+        if ((x.array() < boxLo.array()).any() || (x.array() > boxHi.array()).any() || !inside(x)) continue;
+        particles.append(x.cast<float>(), velocity, mass, sphere, options.material);
       }
   return particles.size() - before;
 }

@@ -8,6 +8,7 @@
 // scales need no more), with the material as an index into a table of GranularMaterial so that
 // rho_max and the friction coefficient are not stored per particle.
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -53,28 +54,46 @@ struct GranularParticles {
   void copyFrom(const GranularParticles& source, std::size_t from, std::size_t to);
 };
 
+// Seeding density: the seed's particle radius r = dx/4 (seed line 1399) is 8 particles per cell.
+inline constexpr double kDefaultParticlesPerCell = 8.0;
+inline constexpr double kMaxParticlesPerCell = 125.0;  // r >= dx/10
+
 struct SeedOptions {
-  double fillFraction = 1.0;  // phi of the seeded material: mass = phi rho_max dx^3 / 8, in (0, 1]
+  double fillFraction = 1.0;  // phi of the seeded material: mass = phi rho_max h^3, in (0, 1]
+  // k, in [1, kMaxParticlesPerCell]: the particle spacing h = dx / cbrt(k). GranularSimulation::seed
+  // uses its settings' value instead.
+  double particlesPerCell = kDefaultParticlesPerCell;
   Vec3 velocity = Vec3::Zero();
   std::uint16_t material = 0;
   std::uint64_t seed = 0;  // jitter stream (core/rng.hpp); the same seed gives the same particles
 };
 
-// Seeds 8 particles in every cell of `grid` that overlaps the box [lo, hi], one at a uniformly
-// jittered position in each of the cell's 2x2x2 sub-cells, keeping those inside the box for which
-// inside(x) holds. Each gets mass fillFraction rho_max dx^3 / 8, the shape A = r^2 I with
-// r = dx/4 (the particle radius the seed recommends, seed line 1399) and the given velocity.
-// The jitter of a cell depends only on the seed and the cell, so the result does not depend on the
-// region's extent or on what was seeded before. Returns the number of particles added.
-// std::invalid_argument for an invalid material, a material index outside the table, a fill
-// fraction outside (0, 1], or non-finite box or velocity.
+// Seeds particlesPerCell particles per cell on average over the part of the box [lo, hi] inside
+// `grid`: one at a uniformly jittered position in each cube of a lattice of spacing
+// h = dx / cbrt(particlesPerCell) anchored at the grid origin (at 8 per cell, the cells' 2x2x2
+// sub-cells), keeping those inside the box for which inside(x) holds. Each gets mass
+// fillFraction rho_max h^3, the spherical shape A = r^2 I with r = h/2 (particleRadius) and the
+// given velocity. The jitter of a lattice cube depends only on the seed and the cube, so the result
+// does not depend on the region's extent or on what was seeded before. Returns the number of
+// particles added. std::invalid_argument for an invalid material, a material index outside the
+// table, a fill fraction outside (0, 1], a density outside [1, kMaxParticlesPerCell], or non-finite
+// box or velocity.
 std::size_t seedRegion(GranularParticles& particles, const GridSpec<3>& grid, const Vec3& lo, const Vec3& hi,
                        const std::function<bool(const Vec3&)>& inside, std::span<const GranularMaterial> materials,
                        const SeedOptions& options = {});
 std::size_t seedBox(GranularParticles& particles, const GridSpec<3>& grid, const Vec3& lo, const Vec3& hi,
                     std::span<const GranularMaterial> materials, const SeedOptions& options = {});
 
-// The particle radius r of the seed (a quarter of the grid spacing), used by seeding and split/merge.
-inline double defaultParticleRadius(double dx) { return 0.25 * dx; }
+// The particle spacing h = dx / cbrt(k) of k particles per cell, and the particle radius r = h/2 that
+// seeding and split/merge use: the seed's user parameter r (ch. 5.4.1), a quarter of the grid
+// spacing at the default 8 per cell.
+inline double particleSpacing(double dx, double particlesPerCell = kDefaultParticlesPerCell) {
+  return dx / std::cbrt(particlesPerCell);
+}
+inline double particleRadius(double dx, double particlesPerCell = kDefaultParticlesPerCell) {
+  return 0.5 * particleSpacing(dx, particlesPerCell);
+}
+// std::invalid_argument unless k lies in [1, kMaxParticlesPerCell].
+void validateParticlesPerCell(double particlesPerCell);
 
 }  // namespace msim::granular

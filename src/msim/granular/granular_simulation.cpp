@@ -53,11 +53,14 @@ GranularSimulation::GranularSimulation(GranularSettings settings, std::vector<Gr
         w.gravity = settings_.gravity;
         return w;
       }()),
-      splitMerge_(defaultParticleRadius(settings_.grid.dx)) {
+      splitMerge_([&] {
+        if (!(settings_.grid.dx > 0.0) || (settings_.grid.res.array() < 1).any())
+          throw std::invalid_argument("granular: the grid needs a positive cell size and at least one cell per axis");
+        validateParticlesPerCell(settings_.particlesPerCell);
+        return particleRadius(settings_.grid.dx, settings_.particlesPerCell);
+      }()) {
   if (materials_.empty()) throw std::invalid_argument("granular: at least one material is needed");
   validate(materials_);
-  if (!(settings_.grid.dx > 0.0) || (settings_.grid.res.array() < 1).any())
-    throw std::invalid_argument("granular: the grid needs a positive cell size and at least one cell per axis");
   if (!(settings_.cfl > 0.0)) throw std::invalid_argument("granular: cfl must be > 0");
   if (!(settings_.flipRatio >= 0.0 && settings_.flipRatio <= 1.0))
     throw std::invalid_argument("granular: flip_ratio must lie in [0, 1]");
@@ -78,12 +81,13 @@ GranularSimulation::GranularSimulation(GranularSettings settings, std::vector<Gr
   }
   if (settings_.renderPointsPerParticle > 0) renderPoints_.emplace(settings_.renderPointsPerParticle);
   // No split below 1/256 of a fully packed seeded particle of the lightest material (8 halvings).
+  const double seededVolume = std::pow(particleSpacing(settings_.grid.dx, settings_.particlesPerCell), 3);
   double lightest = materials_.front().density;
   for (const GranularMaterial& m : materials_) lightest = std::min(lightest, m.density);
-  splitMerge_.setMinimumChildMass(lightest * settings_.grid.cellVolume() / 8.0 / 256.0);
+  splitMerge_.setMinimumChildMass(lightest * seededVolume / 256.0);
   // No merge above twice a fully packed seeded particle of its material.
   std::vector<double> maximumMass;
-  for (const GranularMaterial& m : materials_) maximumMass.push_back(2.0 * m.density * settings_.grid.cellVolume() / 8.0);
+  for (const GranularMaterial& m : materials_) maximumMass.push_back(2.0 * m.density * seededVolume);
   splitMerge_.setMaximumMergedMass(std::move(maximumMass));
 }
 
@@ -110,11 +114,13 @@ std::size_t GranularSimulation::seed(const Vec3& lo, const Vec3& hi, const std::
   for (int a = 0; a < 3; ++a)
     if (!(lo[a] < hi[a]) || hi[a] <= g.origin[a] || lo[a] >= g.upper()[a])
       throw std::invalid_argument("granular: a seeded region must have lo < hi and overlap the domain");
+  SeedOptions dense = options;
+  dense.particlesPerCell = settings_.particlesPerCell;
   // Particles are kept half a particle radius clear of every solid.
-  const double clearance = 0.5 * defaultParticleRadius(g.dx);
+  const double clearance = 0.5 * particleRadius(g.dx, settings_.particlesPerCell);
   const std::size_t added = seedRegion(
       particles_, g, lo.cwiseMax(g.origin), hi.cwiseMin(g.upper()),
-      [&](const Vec3& x) { return inside(x) && solidDistance(x) > clearance; }, materials_, options);
+      [&](const Vec3& x) { return inside(x) && solidDistance(x) > clearance; }, materials_, dense);
   if (added == 0) throw std::invalid_argument("granular: the seeded region lies inside solids or holds no cell");
   if (renderPoints_) renderPoints_->sample(particles_);
   return added;

@@ -38,6 +38,9 @@ struct GranularSettings {
   double flipRatio = 0.9;
   StressSolverSettings stress;      // its upAxis follows gravity
   bool splitMerge = true;
+  // Seeding density k (seed(), in [1, kMaxParticlesPerCell]); the particle radius r = dx / (2 cbrt k)
+  // of split/merge and the seeded particle mass rho_max dx^3 / k follow from it (ch. 5.4.1).
+  double particlesPerCell = kDefaultParticlesPerCell;
   std::size_t renderPointsPerParticle = 0;  // 0: no render points
   bool coupleBodies = true;         // false: bodies move through the material (one-way tests)
   // Response time of a free grain to the air [s] (winds, addWind): the drag (u_air - v) / tau per
@@ -75,7 +78,8 @@ class GranularSimulation {
   const std::vector<GranularMaterial>& materials() const { return materials_; }
   const RenderPoints* renderPoints() const { return renderPoints_ ? &*renderPoints_ : nullptr; }
 
-  // Seeds 8 particles per cell in [lo, hi] where inside(x) holds and no solid is (seedRegion);
+  // Seeds settings.particlesPerCell particles per cell in [lo, hi] where inside(x) holds and no solid
+  // is (seedRegion, with options.particlesPerCell replaced by the settings' value);
   // throws std::invalid_argument if the region lies entirely inside solids or outside the grid.
   std::size_t seed(const Vec3& lo, const Vec3& hi, const std::function<bool(const Vec3&)>& inside,
                    const SeedOptions& options);

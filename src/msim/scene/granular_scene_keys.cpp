@@ -43,6 +43,11 @@ Schema granularKeys() {
             "cells at least half full also resist expansion (with friction off: an inviscid liquid, for comparison "
             "with sand; off: the unilateral constraint of the seed, grains dilate freely)");
   g.boolean("split_merge", true, "split stretched particles and merge crowded ones (ch. 5.4.1)");
+  g.number("particles_per_cell", "", granular::kDefaultParticlesPerCell,
+           "seeding density k: particle spacing dx / cbrt(k), particle radius r = dx / (2 cbrt(k)) (8: the seed's "
+           "r = dx/4)")
+      .min(1.0)
+      .max(granular::kMaxParticlesPerCell);
   g.integer("render_points_per_particle", 0, "render points per particle (ch. 5.6); 0 = none").min(0).max(256);
   g.number("max_step", "s", 0.01, "longest time step").min(0.0, Bound::Exclusive);
   g.integer("seed", 1, "jitter of the seeded particles").min(0);
@@ -65,7 +70,7 @@ Schema materialSchema() {
 }
 
 Schema regionSchema() {
-  Schema r = Schema::object("material seeded at t = 0 (8 particles per cell, jittered)");
+  Schema r = Schema::object("material seeded at t = 0 (granular.particles_per_cell per cell, jittered)");
   r.field("shape", granularShapeSchema("where the material is").required());
   r.string("material", "", "name in materials[]; empty = the first material");
   r.number("fill_fraction", "", 1.0, "volume fraction phi of the seeded material").min(0.0, Bound::Exclusive).max(1.0);
@@ -120,6 +125,7 @@ struct Builder {
     s.stress.friction = g.at("friction").get<bool>();
     s.stress.bilateral = g.at("bilateral").get<bool>();
     s.splitMerge = g.at("split_merge").get<bool>();
+    s.particlesPerCell = g.at("particles_per_cell").get<double>();
     s.renderPointsPerParticle = g.at("render_points_per_particle").get<std::size_t>();
     s.airResponseTime = g.at("air_response_time").get<double>();
     out.maxStep = g.at("max_step").get<double>();
