@@ -70,7 +70,9 @@ double solveAndCheck(double freeShare, unsigned seed) {
   StressProblem pr;
   pr.terms = {{StressComponent::OffDiagonal(0, 1), 1.0}};
   FaceField weight(res, 1.0 / 1500.0);
-  pr.build(st, weight, kDt, {&body});
+  std::vector<std::vector<BodyFace>> faces(1);
+  collectBodyFaces(st, body, faces[0]);
+  pr.build(st, weight, kDt, {&body}, faces);
   const Eigen::Index n = static_cast<Eigen::Index>(pr.lattice.prod());
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0), pick(0.0, 1.0);

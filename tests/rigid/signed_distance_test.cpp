@@ -37,6 +37,13 @@ const Probe kBoxProbes[] = {
 TEST(RigidSignedDistance, BoxIsExactInEveryRegion) {
   const Shape box = Box{Vec3(0.5, 1.0, 1.5)};
   for (const Probe& q : kBoxProbes) EXPECT_NEAR(signedDistance(box, q.p), q.d, 1e-14) << q.p.transpose();
+  // The distance-only path agrees with the closest point the contacts use.
+  for (int i = -3; i <= 3; ++i)
+    for (int j = -3; j <= 3; ++j)
+      for (int k = -3; k <= 3; ++k) {
+        const Vec3 p(0.31 * i, 0.57 * j, 0.83 * k);
+        EXPECT_EQ(signedDistance(box, p), closestSurfacePoint(std::get<Box>(box), p).distance) << p.transpose();
+      }
 }
 
 TEST(RigidSignedDistance, MeshCubeMatchesBox) {

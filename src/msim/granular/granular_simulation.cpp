@@ -108,6 +108,25 @@ double GranularSimulation::solidDistance(const Vec3& x) const {
   return d;
 }
 
+double GranularSimulation::solidDistance(const Vec3& x, double cap, std::span<const double> bodyRadii) const {
+  double d = std::numeric_limits<double>::infinity();
+  for (const auto& s : staticSolids_) d = std::min(d, s->distance(x));
+  const auto& bodies = world_.bodies();
+  for (std::size_t k = 0; k < bodies.size(); ++k) {
+    const rigid::RigidBody& b = bodies[k];
+    // The distance to a body is at least that to its bounding sphere.
+    if ((x - b.position).norm() - bodyRadii[k] >= std::min(d, cap)) continue;
+    d = std::min(d, rigid::signedDistance(b.shape(), b.orientation.conjugate() * (x - b.position)));
+  }
+  return d;
+}
+
+std::vector<double> GranularSimulation::bodyBoundingRadii() const {
+  std::vector<double> radii;
+  for (const rigid::RigidBody& b : world_.bodies()) radii.push_back(rigid::boundingRadius(b.shape()));
+  return radii;
+}
+
 std::size_t GranularSimulation::seed(const Vec3& lo, const Vec3& hi, const std::function<bool(const Vec3&)>& inside,
                                      const SeedOptions& options) {
   const GridSpec<3>& g = settings_.grid;
@@ -252,10 +271,11 @@ void GranularSimulation::rasterizeBodies(double dt) {
 void GranularSimulation::pushOutOfSolids() {
   if (staticSolids_.empty() && world_.bodies().empty()) return;
   const double h = 0.25 * settings_.grid.dx;
+  const std::vector<double> radii = bodyBoundingRadii();
   parallelFor(0, particles_.size(), [&](std::size_t i) {
     const Vec3 x = particles_.position[i].cast<double>();
+    if (solidDistance(x, 0.0, radii) >= 0.0) return;
     const double d = solidDistance(x);
-    if (d >= 0.0) return;
     // Out along the distance gradient (central differences), to the surface.
     Vec3 n;
     for (int a = 0; a < 3; ++a) {

@@ -13,6 +13,7 @@
 // meets them like the domain walls, with wall friction from the edge stresses beside them.
 #include <memory>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "msim/core/grid_spec.hpp"
@@ -110,6 +111,10 @@ class GranularSimulation {
   Vec3 totalMomentum() const;
   // Signed distance to the nearest solid (static or body), negative inside.
   double solidDistance(const Vec3& x) const;
+  // The same where it is below `cap`, and some value >= cap elsewhere: bodies whose bounding sphere
+  // (radii from bodyBoundingRadii, in the world's order) lies at least that far away are skipped.
+  double solidDistance(const Vec3& x, double cap, std::span<const double> bodyRadii) const;
+  std::vector<double> bodyBoundingRadii() const;
 
  private:
   void buildGridState();

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>  // cross (faceDirection)
 
 #include "msim/core/grid_spec.hpp"
 #include "msim/granular/stress_lattice.hpp"
@@ -101,5 +102,27 @@ struct GranularGridState {
   FaceField rhoFace;          // faces: density [kg/m^3]
   FaceField open;             // faces: 1 where the velocity is free, 0 on walls (domain, static solids)
 };
+
+// A face where a body meets the grid: open, with covered fraction phi_s > 0 and direction G_f.
+struct BodyFace {
+  int axis;
+  std::size_t index;  // in the face grid of `axis`
+  IVec3 face;
+  double fraction;
+  Eigen::Matrix<double, 6, 1> direction;
+};
+
+// The body's faces with phi_s > 0 that st.open leaves open, by axis and then in linear order: the
+// faces its coupling acts on (the solver's impulses and every problem's body columns), found once
+// per step.
+inline void collectBodyFaces(const GranularGridState& st, const CoupledBody& body, std::vector<BodyFace>& out) {
+  out.clear();
+  for (int a = 0; a < 3; ++a)
+    forEachInBox(body.faces(a), st.open.size(a), [&](std::size_t i, const IVec3& f) {
+      const double fraction = body.faceFractionAt(a, f);
+      if (fraction <= 0.0 || st.open.values[a][i] == 0.0) return;
+      out.push_back({a, i, f, fraction, faceDirection(st.spec, body, a, f)});
+    });
+}
 
 }  // namespace msim::granular

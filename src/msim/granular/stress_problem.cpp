@@ -7,7 +7,6 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
 #include "msim/core/parallel.hpp"
@@ -15,7 +14,8 @@
 namespace msim::granular {
 
 void StressProblem::build(const GranularGridState& st, const FaceField& weight, double dt,
-                          const std::vector<const CoupledBody*>& coupled) {
+                          const std::vector<const CoupledBody*>& coupled,
+                          const std::vector<std::vector<BodyFace>>& faces) {
   lattice = latticeSize(terms.front().c, st.spec.res);
   const std::size_t n = static_cast<std::size_t>(lattice.prod());
   // dt^2 (sum over terms of the stencils): the first term's straight into place, the next ones
@@ -41,56 +41,30 @@ void StressProblem::build(const GranularGridState& st, const FaceField& weight, 
   op.setBodyWeight(dt2 * st.spec.cellVolume());
   compact.bodyWeight = dt2 * st.spec.cellVolume();
   bodies.resize(coupled.size());
-  for (std::size_t k = 0; k < coupled.size(); ++k) bodyColumns(st, *coupled[k], bodies[k]);
+  for (std::size_t k = 0; k < coupled.size(); ++k) bodyColumns(st, *coupled[k], faces[k], bodies[k]);
 }
 
-void StressProblem::bodyColumns(const GranularGridState& st, const CoupledBody& body, BodyColumns& out) {
+void StressProblem::bodyColumns(const GranularGridState& st, const CoupledBody& body,
+                                const std::vector<BodyFace>& faces, BodyColumns& out) const {
   out.inverseMass = body.inverseMass;
   out.sample.clear();
   out.column.clear();
   const double invDx = 1.0 / st.spec.dx;
-  for (int a = 0; a < 3; ++a) {
-    // Only the faces some term's divergence acts on have columns.
-    const bool acts = std::any_of(terms.begin(), terms.end(), [&](const StressTerm& t) {
+  // Only the faces some term's divergence acts on have columns.
+  std::array<bool, 3> acts{};
+  for (int a = 0; a < 3; ++a)
+    acts[static_cast<std::size_t>(a)] = std::any_of(terms.begin(), terms.end(), [&](const StressTerm& t) {
       return t.c.a == a || (!t.c.diagonal() && t.c.b == a);
     });
-    const LatticeBox faces = body.faces(a);
-    if (!acts || faces.empty()) continue;
-    const IVec3 n = st.open.size(a);
-    // Each slice of the box (z) visits its faces in order: counted first, then written at its
-    // offset, so the columns come out in the order of a serial pass.
-    auto visitSlice = [&](int z, const auto& emit) {
-      for (int y = faces.first[1]; y <= faces.last[1]; ++y)
-        for (int x = faces.first[0]; x <= faces.last[0]; ++x) {
-          const IVec3 f(x, y, z);
-          const std::size_t i = (static_cast<std::size_t>(z) * n[1] + y) * n[0] + x;
-          const double fraction = body.faceFractionAt(a, f);
-          if (fraction <= 0.0 || st.open.values[a][i] == 0.0) continue;
-          for (const StressTerm& t : terms)
-            forEachFaceSample(t.c, lattice, a, f, [&](std::size_t q, double sign) { emit(f, fraction, t.sign * sign, q); });
-        }
-    };
-    const std::size_t slices = static_cast<std::size_t>(faces.last[2] - faces.first[2] + 1);
-    columnSliceOffsets.assign(slices + 1, 0);
-    tbb::parallel_for(std::size_t(0), slices, [&](std::size_t k) {
-      std::size_t count = 0;
-      visitSlice(faces.first[2] + static_cast<int>(k), [&](const IVec3&, double, double, std::size_t) { ++count; });
-      columnSliceOffsets[k + 1] = count;
-    });
-    for (std::size_t k = 0; k < slices; ++k) columnSliceOffsets[k + 1] += columnSliceOffsets[k];
-    const std::size_t begin = out.sample.size();
-    out.sample.resize(begin + columnSliceOffsets[slices]);
-    out.column.resize(begin + columnSliceOffsets[slices]);
-    tbb::parallel_for(std::size_t(0), slices, [&](std::size_t k) {
-      std::size_t next = begin + columnSliceOffsets[k];
-      visitSlice(faces.first[2] + static_cast<int>(k), [&](const IVec3& f, double fraction, double sign, std::size_t q) {
-        Vec6 g = faceDirection(st.spec, body, a, f);
-        g *= fraction * invDx;
-        out.sample[next] = q;
-        out.column[next] = sign * g;
-        ++next;
+  for (const BodyFace& f : faces) {
+    if (!acts[static_cast<std::size_t>(f.axis)]) continue;
+    for (const StressTerm& t : terms)
+      forEachFaceSample(t.c, lattice, f.axis, f.face, [&](std::size_t q, double sign) {
+        Vec6 g = f.direction;
+        g *= f.fraction * invDx;
+        out.sample.push_back(q);
+        out.column.push_back(t.sign * sign * g);
       });
-    });
   }
 }
 

@@ -113,12 +113,13 @@ struct StressProblem {
   Eigen::VectorXd subB, subLo, subHi, subX;  // the restricted problem (box or list)
   std::vector<std::uint32_t> freeToLattice;
   std::vector<std::int32_t> latticeToFree;  // -1 for samples held at a bound
-  std::vector<std::size_t> columnSliceOffsets;  // bodyColumns: where each slice's columns start
 
-  // Builds dt^2 (sum_terms D^T W D) for face weights W, and the bodies' columns.
+  // Builds dt^2 (sum_terms D^T W D) for face weights W, and the bodies' columns from their faces
+  // (faces[k]: collectBodyFaces of coupled[k]).
   void build(const GranularGridState& st, const FaceField& weight, double dt,
-             const std::vector<const CoupledBody*>& coupled);
-  void bodyColumns(const GranularGridState& st, const CoupledBody& body, BodyColumns& out);
+             const std::vector<const CoupledBody*>& coupled, const std::vector<std::vector<BodyFace>>& faces);
+  void bodyColumns(const GranularGridState& st, const CoupledBody& body, const std::vector<BodyFace>& faces,
+                   BodyColumns& out) const;
   // Solves on the bounding box of the samples whose bounds leave room (lo < hi): the others are
   // fixed at their bound, which is 0 for the friction (no pressure, no friction) - the friction
   // lives only where the material is packed, often a small part of the grid. Samples outside the

@@ -20,12 +20,7 @@ struct StressSolver::Impl {
   std::array<StressProblem, 5> friction;  // up diagonal, the other pair, and the three off-diagonals
   FaceField kappa, weightP, weightS, weightB, force, flux, velocity0;
   std::vector<double> tmp, tmp2, var, cellScratch, cellBound;
-  struct BodyFace {
-    int axis;
-    std::size_t index;
-    Vec6 g;  // phi_s G_f
-  };
-  std::vector<std::vector<BodyFace>> bodyFaces;
+  std::vector<std::vector<BodyFace>> bodyFaces;  // collectBodyFaces of each body, this step
   std::vector<Vec6> bodyVelocity;  // current V~ of each body with the current stresses
 };
 
@@ -182,22 +177,12 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
     }
   };
 
-  // Each body's faces: phi_s G_f (G_f = [e_a; r_f x e_a]).
+  // Each body's faces, with phi_s and G_f = [e_a; r_f x e_a].
   m.bodyFaces.resize(bodies.size());
-  for (std::size_t k = 0; k < bodies.size(); ++k) {
-    auto& list = m.bodyFaces[k];
-    list.clear();
-    for (int a = 0; a < 3; ++a) {
-      forEachInBox(bodies[k]->faces(a), st.open.size(a), [&](std::size_t i, const IVec3& f) {
-        const double fraction = bodies[k]->faceFractionAt(a, f);
-        if (fraction <= 0.0 || st.open.values[a][i] == 0.0) return;
-        list.push_back({a, i, fraction * faceDirection(st.spec, *bodies[k], a, f)});
-      });
-    }
-  }
+  for (std::size_t k = 0; k < bodies.size(); ++k) collectBodyFaces(st, *bodies[k], m.bodyFaces[k]);
   auto bodyImpulse = [&](std::size_t k) {
     Vec6 j = Vec6::Zero();
-    for (const auto& bf : m.bodyFaces[k]) j += bf.g * m.force.values[bf.axis][bf.index];
+    for (const BodyFace& bf : m.bodyFaces[k]) j += (bf.fraction * bf.direction) * m.force.values[bf.axis][bf.index];
     return (dt * vc * j).eval();
   };
   auto bodyVelocities = [&] {
@@ -209,10 +194,10 @@ void StressSolver::solve(const GranularGridState& st, double dt, FaceField& velo
   numerics::BoundQpSettings qp;
   qp.tolerance = settings_.tolerance;
   qp.maxIterations = settings_.maxIterations;
-  m.pressure.build(st, m.weightP, dt, bodies);
+  m.pressure.build(st, m.weightP, dt, bodies, m.bodyFaces);
   // Friction operators do not depend on p: built once per step.
   if (settings_.friction)
-    for (StressProblem& pr : m.friction) pr.build(st, m.weightS, dt, bodies);
+    for (StressProblem& pr : m.friction) pr.build(st, m.weightS, dt, bodies, m.bodyFaces);
 
   std::vector<double>& var = m.var;
   for (int iteration = 0; iteration < settings_.staggeredIterations; ++iteration) {
@@ -347,7 +332,7 @@ const FaceField& StressSolver::correctDensity(GranularGridState& st, const std::
   faceCoefficients(st, bodies, settings_.minimumFaceFraction, m);
   StressProblem& pr = m.pressure;
   // Bodies do not move in the correction: only the grid part, with their volume in the constraint.
-  pr.build(st, m.weightP, 1.0, {});
+  pr.build(st, m.weightP, 1.0, {}, {});
   pr.b.resize(static_cast<Eigen::Index>(cells));
   // phi + phi_s - 1: phi - 1 away from the bodies, then the cells of their boxes.
   parallelFor(0, cells, [&](std::size_t i) { pr.b[static_cast<Eigen::Index>(i)] = st.phi[i] - 1.0; }, 4096);

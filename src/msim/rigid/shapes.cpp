@@ -119,6 +119,15 @@ template <class S>
 double distanceOf(const S& s, const Vec3& p) {
   return closestSurfacePoint(s, p).distance;
 }
+// closestSurfacePoint(b, p).distance, bit for bit, without the point and normal (the distance of
+// every particle near a paddle wheel to each of its blades, every granular step): outside, the
+// distance to the clamped point; inside, the largest excess |p| - h over the axes.
+double distanceOf(const Box& b, const Vec3& p) {
+  const Vec3& h = b.halfExtents;
+  const double outside = (p - p.cwiseMax(-h).cwiseMin(h)).squaredNorm();
+  if (outside > 0.0) return std::sqrt(outside);
+  return (p.cwiseAbs() - h).maxCoeff();
+}
 double distanceOf(const Compound& c, const Vec3& p) {
   double d = std::numeric_limits<double>::infinity();
   for (const CompoundPart& part : c.parts) {
