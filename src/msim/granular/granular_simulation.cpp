@@ -53,7 +53,7 @@ GranularSimulation::GranularSimulation(GranularSettings settings, std::vector<Gr
         w.gravity = settings_.gravity;
         return w;
       }()),
-      splitMerge_([&] {
+      splitMerge_([&] {  // the radius comes from the grid and the density: both checked first
         if (!(settings_.grid.dx > 0.0) || (settings_.grid.res.array() < 1).any())
           throw std::invalid_argument("granular: the grid needs a positive cell size and at least one cell per axis");
         validateParticlesPerCell(settings_.particlesPerCell);

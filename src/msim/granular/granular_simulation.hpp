@@ -111,12 +111,12 @@ class GranularSimulation {
   Vec3 totalMomentum() const;
   // Signed distance to the nearest solid (static or body), negative inside.
   double solidDistance(const Vec3& x) const;
-  // The same where it is below `cap`, and some value >= cap elsewhere: bodies whose bounding sphere
+
+ private:
+  // solidDistance(x) where it is below `cap`, and some value >= cap elsewhere: bodies whose bounding sphere
   // (radii from bodyBoundingRadii, in the world's order) lies at least that far away are skipped.
   double solidDistance(const Vec3& x, double cap, std::span<const double> bodyRadii) const;
   std::vector<double> bodyBoundingRadii() const;
-
- private:
   void buildGridState();
   void rasterizeBodies(double dt);
   void pushOutOfSolids();
