@@ -77,8 +77,10 @@ io::Image GranularPreview::render(const granular::GranularSimulation& sim, const
   const bool fine = points && points->size() > 0;
   const std::size_t n = fine ? points->size() : p.size();
   const double perParticle = fine ? std::max(1.0, double(points->size()) / std::max<std::size_t>(1, p.size())) : 1.0;
-  // Packed particles sit dx/2 apart; discs of 0.35 dx (shrunk by the render points' count) close the gaps.
-  const double radius = std::max(0.7, 0.35 * pixelsPerCell_ / std::cbrt(perParticle));
+  // Packed particles sit a particle spacing h apart (dx/2 at 8 per cell); discs of 0.7 h (shrunk by
+  // the render points' count) close the gaps.
+  const double spacing = granular::particleSpacing(1.0, sim.settings().particlesPerCell);
+  const double radius = std::max(0.7, 0.7 * spacing * pixelsPerCell_ / std::cbrt(perParticle));
   const int reach = static_cast<int>(std::ceil(radius));
   for (std::size_t i = 0; i < n; ++i) {
     const Vec3 x = (fine ? points->positions()[i] : p.position[i]).cast<double>();
