@@ -181,8 +181,11 @@ class GranularPhenomenon final : public Phenomenon {
 void declare(Schema& root) { declareGranularKeys(root); }
 
 // Grid fields of the transfer and the stress solver (cells, faces, six stress lattices, QP
-// scratch) plus about 8 particles per filled cell at ~80 bytes each.
-double bytesPerCell(int, const json&) { return 2000.0; }
+// scratch), about 1360 bytes, plus granular.particles_per_cell particles per cell at ~80 bytes
+// each (their arrays, split/merge and transfer scratch), as if every cell were filled.
+double bytesPerCell(int, const json& resolved) {
+  return 1360.0 + 80.0 * resolved.at("granular").at("particles_per_cell").get<double>();
+}
 
 std::unique_ptr<Phenomenon> create(const Scene& scene, StageTimers& timers) {
   return std::make_unique<GranularPhenomenon>(scene, timers);
