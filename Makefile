@@ -5,7 +5,7 @@ SCENE ?= scenes/steam.json
 OUT ?= out/steam
 JOBS ?= $(shell nproc)
 
-.PHONY: deps configure build app run test bench clean
+.PHONY: deps configure build app run test sanitize bench clean
 
 deps:
 	@bash scripts/install-deps.sh
@@ -25,6 +25,16 @@ run: app
 
 test: build
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
+
+# The whole suite under AddressSanitizer (leak detection on) and UBSan, in the asan preset's
+# instrumented -O1 build; long tests run at a smaller size of the same check there. Any sanitizer
+# report fails its test.
+SANITIZER_ENV := ASAN_OPTIONS=detect_leaks=1:detect_stack_use_after_return=1:strict_string_checks=1:check_initialization_order=1 \
+	UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+sanitize: deps
+	@cmake --preset asan >/dev/null
+	@cmake --build build/asan -j $(JOBS)
+	cd build/asan && $(SANITIZER_ENV) ctest --output-on-failure -j $(JOBS)
 
 bench: build
 	@for b in $(BUILD_DIR)/bench/*_bench; do echo "== $$b"; $$b; done

@@ -12,6 +12,7 @@
 #include <memory>
 #include <string>
 
+#include "../sanitizer_build.hpp"
 #include "msim/fluid/smoke/smoke_solver.hpp"
 #include "msim/numerics/pressure/face_fractions.hpp"
 
@@ -136,7 +137,9 @@ void expectConservedAndBounded(int n) {
 
 }  // namespace
 
-TEST(ConservativeScalars, ClosedBoxWithObstaclesLeaksNothing3D) { expectConservedAndBounded<3>(32); }
+TEST(ConservativeScalars, ClosedBoxWithObstaclesLeaksNothing3D) {
+  expectConservedAndBounded<3>(test::fullOrSanitized(32, 24));
+}
 
 TEST(ConservativeScalars, ClosedBoxWithObstaclesLeaksNothing2D) { expectConservedAndBounded<2>(96); }
 

@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <numbers>
 
+#include "../sanitizer_build.hpp"
 #include "msim/granular/granular_simulation.hpp"
 
 using namespace msim;
@@ -90,7 +91,8 @@ TEST(GranularRepose, StaticAngleOfReposeLiesWithinFiveDegreesOfThePrediction) {
     const double flowed = slopeAfterOneSecond(alpha, above, height);
     ASSERT_TRUE(stands(below)) << "alpha " << alpha << ": a slope at " << below << " deg did not stand";
     ASSERT_LT(flowed, above - 3.0) << "alpha " << alpha << ": a slope at " << above << " deg did not flow";
-    for (int halving = 0; halving < 5; ++halving) {  // to 10 / 32 deg
+    // To 10 / 32 deg; the sanitizer build stops at 10 / 4 deg, which still separates the alphas.
+    for (int halving = 0; halving < test::fullOrSanitized(5, 2); ++halving) {
       const double mid = 0.5 * (below + above);
       (stands(mid) ? below : above) = mid;
     }

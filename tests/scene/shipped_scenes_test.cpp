@@ -3,7 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <string>
+#include <vector>
 
+#include "msim/core/error.hpp"
 #include "msim/scene/scene_file.hpp"
 #include "msim/scene/schema/describe.hpp"
 
@@ -40,4 +43,37 @@ TEST(SceneFile, OverridesAndDerivedGrid) {
   EXPECT_EQ(s.resolution.maxCoeff(), 32);
   EXPECT_NEAR(s.dx * 32, 0.6, 1e-12);  // the longest axis sets dx
   EXPECT_EQ(s.frameCount, 40);          // 4 s at 10 fps
+}
+
+namespace {
+
+// The InputError message of loading steam.json with `overrides`, or "" when it loads.
+std::string loadError(const std::vector<std::string>& overrides) {
+  try {
+    scene::loadScene(fs::path(MSIM_SOURCE_DIR) / "scenes" / "steam.json", overrides);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(SceneFile, AbsurdDurationsRatesAndDomainsAreErrorsNamingTheKey) {
+  // 1e308 s at 1e308 fps once became "1 frames" (the frame count overflowed int).
+  const std::string frames = loadError({"time.duration=1e308", "time.fps=1e308"});
+  EXPECT_NE(frames.find("'time.duration'"), std::string::npos) << frames;
+  EXPECT_NE(frames.find("'time.fps'"), std::string::npos) << frames;
+  EXPECT_NE(loadError({"time.duration=1e5", "time.fps=1e3"}).find("frames"), std::string::npos);
+  EXPECT_EQ(loadError({"time.duration=3600", "time.fps=24"}), "");
+  // 1e400 is beyond double: not a number (in a scene file, json_file_test checks the message).
+  EXPECT_NE(loadError({"time.duration=1e400"}).find("'time.duration'"), std::string::npos);
+  // Integers beyond exact double or long long are not integers msim can use.
+  EXPECT_NE(loadError({"domain.resolution=1e300"}).find("'domain.resolution'"), std::string::npos);
+  EXPECT_NE(loadError({"domain.resolution=18446744073709551615"}).find("'domain.resolution'"), std::string::npos);
+  // A domain whose extent overflows double.
+  const std::string extent = loadError({"domain.min=[-1e308, 0, 0]", "domain.max=[1e308, 1, 1]"});
+  EXPECT_NE(extent.find("'domain.max' - 'domain.min'"), std::string::npos) << extent;
+  // Cells per axis beyond int, and a cell count beyond 64 bits, are refused by the memory check.
+  EXPECT_NE(loadError({"domain.resolution=1073741824"}).find("'domain.resolution'"), std::string::npos);
 }

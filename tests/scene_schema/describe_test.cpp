@@ -16,6 +16,8 @@ const ParamRow* findRow(const std::vector<ParamRow>& rows, const std::string& pa
   const auto it = std::find_if(rows.begin(), rows.end(), [&](const ParamRow& r) { return r.path == path; });
   return it == rows.end() ? nullptr : &*it;
 }
+// The result points into rows: a temporary list would leave it dangling.
+const ParamRow* findRow(std::vector<ParamRow>&& rows, const std::string& path) = delete;
 
 json resolvedScene() {
   const json in = json::parse(R"({"name": "demo", "domain": {"resolution": 32},
@@ -62,7 +64,8 @@ TEST(Describe, ListsEveryLeafWithValueDefaultAndUnit) {
 
 TEST(Describe, EmptyArrayStaysVisible) {
   const json resolved = resolve(sampleSchema(), json::parse(R"({"name": "x"})"), "x.json");
-  const ParamRow* sources = findRow(describe(sampleSchema(), resolved), "sources");
+  const auto rows = describe(sampleSchema(), resolved);
+  const ParamRow* sources = findRow(rows, "sources");
   ASSERT_NE(sources, nullptr);
   EXPECT_EQ(sources->value, "[]");
 }

@@ -33,6 +33,12 @@ TEST(LoadJsonFile, ParsesValidFileWithComments) {
   EXPECT_EQ(loadJsonFile(path)["resolution"], 64);
 }
 
+TEST(LoadJsonFile, NumberBeyondDoubleReportsLineAndColumn) {
+  // nlohmann refuses it with out_of_range, not parse_error: once it escaped as exit code 1.
+  const auto path = writeTemp("huge.json", "{\n  \"time\": {\"duration\": 1e400}\n}\n");
+  EXPECT_EQ(loadError(path), path.string() + ":2:24: the number '1e400' is beyond the range of double");
+}
+
 TEST(LoadJsonFile, MissingFileIsNamed) {
   const auto path = std::filesystem::path(MSIM_TEST_TMP) / "no_such_scene.json";
   EXPECT_EQ(loadError(path), "scene file '" + path.string() + "' not found");

@@ -1,6 +1,7 @@
 #include "msim/io/obj.hpp"
 
 #include <charconv>
+#include <cmath>
 #include <fstream>
 #include <string>
 #include <system_error>
@@ -50,7 +51,8 @@ TriangleMesh readObj(const std::filesystem::path& path) {
       for (int a = 0; a < 3; ++a) {
         const char* last = w[a + 1].data() + w[a + 1].size();
         const auto [end, ec] = std::from_chars(w[a + 1].data(), last, p[a]);
-        if (ec != std::errc() || end != last) fail("expected a number, got '" + std::string(w[a + 1]) + "'");
+        if (ec != std::errc() || end != last || !std::isfinite(p[a]))
+          fail("expected a finite number, got '" + std::string(w[a + 1]) + "'");
       }
       mesh.vertices.push_back(p);
     } else if (w[0] == "f") {

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <system_error>
@@ -252,6 +253,8 @@ class PlyParser {
 
   void parseBinary() {
     for (auto& e : file_.elements) {
+      // Entries without properties take no bytes: there is nothing to read however many there are.
+      if (e.properties.empty()) continue;
       reserveFor(e);
       for (auto& p : e.properties)
         if (p.isList) p.listStarts.push_back(0);
@@ -330,6 +333,14 @@ const PlyProperty& requireScalar(const PlyElement& e, const std::filesystem::pat
   if (!p || p->isList)
     throw InputError(path.string() + ": PLY element '" + e.name + "' has no scalar property '" + std::string(name) + "'");
   return *p;
+}
+
+// Vertex i's coordinates; InputError for a NaN or infinite one (a damaged or foreign file), which
+// would otherwise travel on into bounding boxes and voxelisation.
+Vec3 vertexPosition(const PlyProperty* const (&xyz)[3], std::size_t i, const std::filesystem::path& path) {
+  const Vec3 p(xyz[0]->values[i], xyz[1]->values[i], xyz[2]->values[i]);
+  if (!p.allFinite()) throw InputError(path.string() + ": PLY vertex " + std::to_string(i) + " has a non-finite coordinate");
+  return p;
 }
 
 std::vector<PointAttribute> vertexAttributesOf(const PlyElement& vertex) {
@@ -427,8 +438,12 @@ PointCloud readPlyPoints(const std::filesystem::path& path) {
                                &requireScalar(vertex, path, "z")};
   PointCloud cloud;
   cloud.positions.resize(vertex.count);
-  for (std::size_t i = 0; i < vertex.count; ++i)
-    for (int a = 0; a < 3; ++a) cloud.positions[i][a] = static_cast<float>(xyz[a]->values[i]);
+  for (std::size_t i = 0; i < vertex.count; ++i) {
+    const Vec3 p = vertexPosition(xyz, i, path);
+    if (p.cwiseAbs().maxCoeff() > std::numeric_limits<float>::max())
+      throw InputError(path.string() + ": PLY vertex " + std::to_string(i) + " lies beyond the range of float");
+    cloud.positions[i] = p.cast<float>();
+  }
   cloud.attributes = vertexAttributesOf(vertex);
   return cloud;
 }
@@ -483,8 +498,7 @@ PlyMesh readPlyMesh(const std::filesystem::path& path) {
 
   PlyMesh out;
   out.mesh.vertices.resize(vertex.count);
-  for (std::size_t i = 0; i < vertex.count; ++i)
-    for (int a = 0; a < 3; ++a) out.mesh.vertices[i][a] = xyz[a]->values[i];
+  for (std::size_t i = 0; i < vertex.count; ++i) out.mesh.vertices[i] = vertexPosition(xyz, i, path);
   out.vertexAttributes = vertexAttributesOf(vertex);
 
   out.mesh.triangles.reserve(face.count);

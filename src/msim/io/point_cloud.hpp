@@ -18,12 +18,14 @@ struct PointCloud {
   std::vector<Vecf<3>> positions;
   std::vector<PointAttribute> attributes;
 
-  // The attribute with this name, or nullptr.
-  const PointAttribute* find(const std::string& name) const {
+  // The attribute with this name, or nullptr. The pointer refers into this cloud, so calling it on
+  // a temporary (a cloud just read) would dangle: that overload is deleted.
+  const PointAttribute* find(const std::string& name) const& {
     for (const auto& a : attributes)
       if (a.name == name) return &a;
     return nullptr;
   }
+  const PointAttribute* find(const std::string& name) const&& = delete;
 };
 
 }  // namespace msim::io

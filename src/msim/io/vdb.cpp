@@ -1,5 +1,6 @@
 #include "msim/io/vdb.hpp"
 
+#include <openvdb/io/Stream.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/points/PointAttribute.h>
 #include <openvdb/points/PointConversion.h>
@@ -12,13 +13,19 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <fstream>
 #include <mutex>
 #include <numeric>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 
+#include <fmt/format.h>
+
 #include "msim/core/error.hpp"
+#include "msim/core/system_memory.hpp"
 #include "msim/io/atomic_file.hpp"
+#include "msim/io/vdb_seal.hpp"
 
 namespace msim::io {
 
@@ -106,35 +113,38 @@ openvdb::Vec3f toVdb(const Vecf<3>& v) { return {v.x(), v.y(), v.z()}; }
   throw InputError(path.string() + ": " + what);
 }
 
-openvdb::GridBase::Ptr readGridNamed(const std::filesystem::path& path, const std::string& name) {
-  initializeOpenVdb();
-  try {
-    openvdb::io::File file(path.string());
-    // Load everything now: delayed loading would keep the file mapped behind our back.
-    file.open(/*delayLoad=*/false);
-    if (!file.hasGrid(name)) {
-      std::string names;
-      for (auto it = file.beginName(); it != file.endName(); ++it) names += (names.empty() ? "" : ", ") + *it;
-      failRead(path, "no grid named '" + name + "' (the file has: " + (names.empty() ? "none" : names) + ")");
-    }
-    auto grid = file.readGrid(name);
-    file.close();
-    return grid;
-  } catch (const InputError&) {
-    throw;
-  } catch (const std::exception& e) {  // openvdb::Exception, or a stream error on a corrupt file
-    failRead(path, std::string("cannot read VDB file (") + e.what() + ")");
-  }
+// The whole file in memory. Its size is checked first: the bytes have to fit in memory beside
+// the grids parsed from them.
+std::string readFileBytes(const std::filesystem::path& path) {
+  std::error_code error;
+  const std::uintmax_t size = std::filesystem::file_size(path, error);
+  if (error) failRead(path, "cannot read VDB file (" + error.message() + ")");
+  const double available = double(availableMemoryBytes());
+  if (available > 0.0 && double(size) > 0.5 * available)
+    failRead(path, fmt::format("the file is {}, more than half of the {} of memory available", formatBytes(double(size)),
+                               formatBytes(available)));
+  std::string bytes(static_cast<std::size_t>(size), '\0');
+  std::ifstream in(path, std::ios::binary);
+  if (!in.read(bytes.data(), static_cast<std::streamsize>(bytes.size())))
+    failRead(path, "cannot read VDB file (read failed)");
+  return bytes;
 }
 
-template <typename GridT>
-typename GridT::Ptr readGridOfType(const std::filesystem::path& path, const std::string& name) {
-  auto base = readGridNamed(path, name);
-  auto grid = openvdb::gridPtrCast<GridT>(base);
-  if (!grid)
-    failRead(path, "grid '" + name + "' has type " + base->valueType() + ", expected " +
-                       openvdb::typeNameAsString<typename GridT::ValueType>());
-  return grid;
+// Parses every grid of the file's bytes. The stream throws at the end of the data, so a count
+// read from a damaged file cannot make OpenVDB loop on past it.
+openvdb::GridPtrVec parseGrids(std::string bytes, const std::filesystem::path& path) {
+  initializeOpenVdb();
+  try {
+    std::istringstream stream(std::move(bytes));
+    stream.exceptions(std::ios::failbit | std::ios::badbit);
+    openvdb::io::Stream archive(stream, /*delayLoad=*/false);
+    openvdb::GridPtrVec grids;
+    for (const auto& grid : *archive.getGrids())
+      if (grid) grids.push_back(grid);
+    return grids;
+  } catch (const std::exception& e) {  // openvdb::Exception, a stream error or bad_alloc on a corrupt file
+    failRead(path, std::string("cannot read VDB file (") + e.what() + ")");
+  }
 }
 
 // Where the grid's voxels go in the returned msim grid: msim cell = voxel - shift.
@@ -332,48 +342,84 @@ void VdbWriter::write(const std::filesystem::path& path) const {
   writeFileAtomically(path, [&](const std::filesystem::path& tmp) {
     try {
       openvdb::io::File file(tmp.string());
-      file.write(impl_->grids);
+      openvdb::MetaMap fileMetadata;
+      fileMetadata.insertMeta(kVdbSealKey, openvdb::StringMetadata(kVdbSealPlaceholder));
+      file.write(impl_->grids, fileMetadata);
       file.close();
+      sealVdbFile(tmp);
     } catch (const openvdb::Exception& e) {
       throw std::runtime_error("cannot write " + path.string() + ": " + e.what());
     }
   });
 }
 
-std::vector<std::string> listVdbGrids(const std::filesystem::path& path) {
-  initializeOpenVdb();
-  try {
-    openvdb::io::File file(path.string());
-    file.open(/*delayLoad=*/false);
-    std::vector<std::string> names;
-    for (auto it = file.beginName(); it != file.endName(); ++it) names.push_back(*it);
-    file.close();
-    return names;
-  } catch (const InputError&) {
-    throw;
-  } catch (const std::exception& e) {  // openvdb::Exception, or a stream error on a corrupt file
-    failRead(path, std::string("cannot read VDB file (") + e.what() + ")");
+struct VdbFile::Impl {
+  std::filesystem::path path;
+  openvdb::GridPtrVec grids;
+
+  openvdb::GridBase::Ptr grid(const std::string& name) const {
+    for (const auto& g : grids)
+      if (g->getName() == name) return g;
+    std::string names;
+    for (const auto& g : grids) names += (names.empty() ? "" : ", ") + g->getName();
+    failRead(path, "no grid named '" + name + "' (the file has: " + (names.empty() ? "none" : names) + ")");
   }
+
+  template <typename GridT>
+  typename GridT::Ptr gridOfType(const std::string& name) const {
+    auto base = grid(name);
+    auto typed = openvdb::gridPtrCast<GridT>(base);
+    if (!typed)
+      failRead(path, "grid '" + name + "' has type " + base->valueType() + ", expected " +
+                         openvdb::typeNameAsString<typename GridT::ValueType>());
+    return typed;
+  }
+};
+
+VdbFile::VdbFile(const std::filesystem::path& path, VdbProvenance provenance) : impl_(std::make_unique<Impl>()) {
+  impl_->path = path;
+  std::string bytes = readFileBytes(path);
+  // The seal is checked before OpenVDB reads a byte: a damaged frame never reaches its parser.
+  if (checkVdbSeal(bytes, path) == VdbSeal::Absent && provenance == VdbProvenance::MsimRun)
+    failRead(path, "not a frame written by this version of msim, or damaged: it carries no msim checksum");
+  impl_->grids = parseGrids(std::move(bytes), path);
 }
 
-Grid<float, 3> readFloatGrid(const std::filesystem::path& path, const std::string& name) {
-  const auto grid = readGridOfType<openvdb::FloatGrid>(path, name);
-  const Placement placement = placementOf(*grid, path);
+VdbFile::~VdbFile() = default;
+VdbFile::VdbFile(VdbFile&&) noexcept = default;
+VdbFile& VdbFile::operator=(VdbFile&&) noexcept = default;
+
+const std::filesystem::path& VdbFile::path() const { return impl_->path; }
+
+std::vector<std::string> VdbFile::gridNames() const {
+  std::vector<std::string> names;
+  for (const auto& g : impl_->grids) names.push_back(g->getName());
+  return names;
+}
+
+bool VdbFile::hasGrid(const std::string& name) const {
+  return std::any_of(impl_->grids.begin(), impl_->grids.end(), [&](const auto& g) { return g->getName() == name; });
+}
+
+Grid<float, 3> VdbFile::floatGrid(const std::string& name) const {
+  const auto grid = impl_->gridOfType<openvdb::FloatGrid>(name);
+  const Placement placement = placementOf(*grid, impl_->path);
   Grid<float, 3> out(placement.spec, 0.0f);
   copyActiveValues(grid->tree(), placement, [&](std::size_t linear, float v) { out[linear] = v; });
   return out;
 }
 
-Grid<Vecf<3>, 3> readVectorGrid(const std::filesystem::path& path, const std::string& name) {
-  const auto base = readGridNamed(path, name);
-  if (const auto vs = openvdb::gridPtrCast<openvdb::Vec3SGrid>(base)) return readVectorGridAs(*vs, path);
-  if (const auto vd = openvdb::gridPtrCast<openvdb::Vec3DGrid>(base)) return readVectorGridAs(*vd, path);
-  failRead(path, "grid '" + name + "' has type " + base->valueType() + ", expected vec3s or vec3d");
+Grid<Vecf<3>, 3> VdbFile::vectorGrid(const std::string& name) const {
+  const auto base = impl_->grid(name);
+  if (const auto vs = openvdb::gridPtrCast<openvdb::Vec3SGrid>(base)) return readVectorGridAs(*vs, impl_->path);
+  if (const auto vd = openvdb::gridPtrCast<openvdb::Vec3DGrid>(base)) return readVectorGridAs(*vd, impl_->path);
+  failRead(impl_->path, "grid '" + name + "' has type " + base->valueType() + ", expected vec3s or vec3d");
 }
 
-PointCloud readPoints(const std::filesystem::path& path, const std::string& name) {
+PointCloud VdbFile::points(const std::string& name) const {
   using openvdb::points::PointDataGrid;
-  const auto grid = readGridOfType<PointDataGrid>(path, name);
+  const auto grid = impl_->gridOfType<PointDataGrid>(name);
+  const std::filesystem::path& path = impl_->path;
   const auto& tree = grid->tree();
   PointCloud cloud;
   const auto firstLeaf = tree.cbeginLeaf();
@@ -433,6 +479,23 @@ PointCloud readPoints(const std::filesystem::path& path, const std::string& name
     }
   });
   return cloud;
+}
+
+std::vector<std::string> listVdbGrids(const std::filesystem::path& path, VdbProvenance provenance) {
+  return VdbFile(path, provenance).gridNames();
+}
+
+Grid<float, 3> readFloatGrid(const std::filesystem::path& path, const std::string& name, VdbProvenance provenance) {
+  return VdbFile(path, provenance).floatGrid(name);
+}
+
+Grid<Vecf<3>, 3> readVectorGrid(const std::filesystem::path& path, const std::string& name,
+                                VdbProvenance provenance) {
+  return VdbFile(path, provenance).vectorGrid(name);
+}
+
+PointCloud readPoints(const std::filesystem::path& path, const std::string& name, VdbProvenance provenance) {
+  return VdbFile(path, provenance).points(name);
 }
 
 }  // namespace msim::io

@@ -44,7 +44,8 @@ class VdbWriter {
   // back bit-equal. std::invalid_argument for non-finite positions or mismatched attributes.
   void addPoints(const std::string& name, const PointCloud& points, double voxelSize);
 
-  // Writes all added grids atomically (std::runtime_error if writing fails).
+  // Writes all added grids atomically and seals the file with its checksum (vdb_seal.hpp);
+  // std::runtime_error if writing fails.
   void write(const std::filesystem::path& path) const;
 
  private:
@@ -52,19 +53,51 @@ class VdbWriter {
   std::unique_ptr<Impl> impl_;
 };
 
-// Names of the grids stored in a .vdb file.
-std::vector<std::string> listVdbGrids(const std::filesystem::path& path);
+// Whether a .vdb file must carry msim's checksum (vdb_seal.hpp) to be read.
+enum class VdbProvenance {
+  MsimRun,  // a frame of an msim run (render of a run folder, --resume): refused without a matching seal
+  AnyTool,  // a file the user names: a seal, if present, must match; a file without one (written by
+            // another tool) is parsed by OpenVDB as it is, which trusts the sizes stored in it
+};
 
-// Reads a float grid. Grids written by msim get their GridSpec back exactly; other grids get one
-// covering their active voxels (voxel size from the transform, which must be uniform and
-// axis-aligned). InputError naming the file for a missing file or grid, a grid of another type
-// or an unsupported transform.
-Grid<float, 3> readFloatGrid(const std::filesystem::path& path, const std::string& name);
-// Reads a Vec3s (or Vec3d, converted to float) grid, as readFloatGrid.
-Grid<Vecf<3>, 3> readVectorGrid(const std::filesystem::path& path, const std::string& name);
-// Reads a point set: positions and every float attribute, in the original order for points
-// written by msim. An empty set comes back without attributes (VDB keeps attribute names in the
-// leaves, and an empty grid has none). InputError as readFloatGrid.
-PointCloud readPoints(const std::filesystem::path& path, const std::string& name);
+// A .vdb file read whole, checked and parsed once; its grids are then copied out by name.
+// InputError naming the file for a missing, unreadable, damaged or unsealed (MsimRun) file, and
+// from the accessors for a missing grid, a grid of another type or an unsupported transform.
+class VdbFile {
+ public:
+  VdbFile(const std::filesystem::path& path, VdbProvenance provenance);
+  ~VdbFile();
+  VdbFile(VdbFile&&) noexcept;
+  VdbFile& operator=(VdbFile&&) noexcept;
+
+  const std::filesystem::path& path() const;
+  // Names of the grids, in file order.
+  std::vector<std::string> gridNames() const;
+  bool hasGrid(const std::string& name) const;
+  // A float grid. Grids written by msim get their GridSpec back exactly; other grids get one
+  // covering their active voxels (voxel size from the transform, which must be uniform and
+  // axis-aligned).
+  Grid<float, 3> floatGrid(const std::string& name) const;
+  // A Vec3s (or Vec3d, converted to float) grid, as floatGrid.
+  Grid<Vecf<3>, 3> vectorGrid(const std::string& name) const;
+  // A point set: positions and every float attribute, in the original order for points written by
+  // msim. An empty set comes back without attributes (VDB keeps attribute names in the leaves, and
+  // an empty grid has none).
+  PointCloud points(const std::string& name) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// One-grid shorthands for VdbFile(path, provenance).gridNames(), .floatGrid(name) and so on.
+std::vector<std::string> listVdbGrids(const std::filesystem::path& path,
+                                      VdbProvenance provenance = VdbProvenance::AnyTool);
+Grid<float, 3> readFloatGrid(const std::filesystem::path& path, const std::string& name,
+                             VdbProvenance provenance = VdbProvenance::AnyTool);
+Grid<Vecf<3>, 3> readVectorGrid(const std::filesystem::path& path, const std::string& name,
+                                VdbProvenance provenance = VdbProvenance::AnyTool);
+PointCloud readPoints(const std::filesystem::path& path, const std::string& name,
+                      VdbProvenance provenance = VdbProvenance::AnyTool);
 
 }  // namespace msim::io

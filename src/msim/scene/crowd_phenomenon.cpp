@@ -131,8 +131,9 @@ class CrowdPhenomenon final : public Phenomenon {
   }
 
   void restore(const fs::path& vdbFile, double time) override {
-    const io::PointCloud points = io::readPoints(vdbFile, kAgentPoints);
-    const io::PointCloud state = io::readPoints(vdbFile, kStatePoints);
+    const io::VdbFile saved(vdbFile, io::VdbProvenance::MsimRun);
+    const io::PointCloud points = saved.points(kAgentPoints);
+    const io::PointCloud state = saved.points(kStatePoints);
     auto attribute = [&](const io::PointCloud& cloud, const std::string& name) -> const std::vector<float>& {
       return savedPointAttribute(cloud, name, vdbFile, source_);
     };

@@ -168,9 +168,10 @@ class GasPhenomenon final : public Phenomenon {
   // The motion fields are steady and the winds a function of time, so the state is the two grids
   // and the clock.
   void restore(const std::filesystem::path& vdbFile, double time) override {
+    const io::VdbFile saved(vdbFile, io::VdbProvenance::MsimRun);
     solver_.setTime(time);
-    restoreGrid(vdbFile, "density", solver_.density(), source_);
-    restoreGrid(vdbFile, "temperature", solver_.temperature(), source_);
+    restoreGrid(saved, "density", solver_.density(), source_);
+    restoreGrid(saved, "temperature", solver_.temperature(), source_);
   }
 
   // Each wind's spectrum against the prescribed one (winds/), and its measures in run.json.

@@ -109,8 +109,9 @@ void writeGranularVdb(const fs::path& file, const granular::GranularSimulation& 
 
 void restoreGranularVdb(const fs::path& file, granular::GranularSimulation& sim, const std::vector<int>& bodies,
                         const std::string& source) {
-  const io::PointCloud points = io::readPoints(file, kParticles);
-  const io::PointCloud state = bodies.empty() ? io::PointCloud{} : io::readPoints(file, kBodies);
+  const io::VdbFile saved(file, io::VdbProvenance::MsimRun);
+  const io::PointCloud points = saved.points(kParticles);
+  const io::PointCloud state = bodies.empty() ? io::PointCloud{} : saved.points(kBodies);
   auto values = [&](const io::PointCloud& cloud, const std::string& name) -> const std::vector<float>& {
     return savedPointAttribute(cloud, name, file, source);
   };

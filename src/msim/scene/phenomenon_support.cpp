@@ -23,14 +23,14 @@ void requireFinite(const Grid<float, D>& g, const std::string& field, long stepI
 }
 
 template <int D>
-void restoreGrid(const std::filesystem::path& file, const std::string& name, Grid<float, D>& target,
+void restoreGrid(const io::VdbFile& file, const std::string& name, Grid<float, D>& target,
                  const std::string& sceneSource) {
-  const Grid<float, 3> saved = io::readFloatGrid(file, name);
+  const Grid<float, 3> saved = file.floatGrid(name);
   bool same = saved.spec().dx == target.spec().dx && saved.count() == target.count();
   for (int a = 0; a < D; ++a) same = same && saved.size()[a] == target.size()[a];
   if (!same)
     throw InputError(fmt::format("{}: cannot resume from '{}': its grid '{}' does not match the scene's domain",
-                                 sceneSource, file.string(), name));
+                                 sceneSource, file.path().string(), name));
   std::copy(saved.data().begin(), saved.data().end(), target.data().begin());
 }
 
@@ -78,7 +78,7 @@ std::vector<std::pair<std::size_t, float>> coveredOpenCells(const Scene& scene, 
 
 #define MSIM_INSTANTIATE(D)                                                                                        \
   template void requireFinite<D>(const Grid<float, D>&, const std::string&, long, double);                          \
-  template void restoreGrid<D>(const std::filesystem::path&, const std::string&, Grid<float, D>&,                    \
+  template void restoreGrid<D>(const io::VdbFile&, const std::string&, Grid<float, D>&,                             \
                                const std::string&);                                                              \
   template std::unique_ptr<geometry::Shape<D>> sceneShape<D>(const Scene&, const nlohmann::json&,                  \
                                                              const std::string&);                                 \

@@ -12,6 +12,7 @@
 
 #include "msim/core/grid.hpp"
 #include "msim/geometry/shape.hpp"
+#include "msim/io/vdb.hpp"
 #include "msim/io/point_cloud.hpp"
 #include "msim/render/density_preview.hpp"
 
@@ -26,7 +27,7 @@ void requireFinite(const Grid<float, D>& grid, const std::string& field, long st
 // Copies grid `name` of a saved frame into `target` (a cell or face grid); InputError naming the
 // scene and file when the grid is missing or its size differs.
 template <int D>
-void restoreGrid(const std::filesystem::path& vdbFile, const std::string& name, Grid<float, D>& target,
+void restoreGrid(const io::VdbFile& saved, const std::string& name, Grid<float, D>& target,
                  const std::string& sceneSource);
 
 // Point attribute `name` of a cloud read back from a saved frame for --resume; InputError naming

@@ -233,7 +233,8 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
       if (layout.render.enabled) {
         // From the file just written, exactly as 'msim render' would make it later.
         ScopedStage stage(timers, "render frame");
-        renderSavedFrame(frameFile(layout.vdbDir, layout.name, frame, "vdb"), layout.render,
+        renderSavedFrame(io::VdbFile(frameFile(layout.vdbDir, layout.name, frame, "vdb"), io::VdbProvenance::MsimRun),
+                         layout.render,
                          frameFile(layout.renderDir, layout.name, frame, "png"));
       }
       if (layout.png) {

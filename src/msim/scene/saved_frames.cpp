@@ -34,8 +34,8 @@ bool hasGrid(const std::vector<std::string>& grids, const std::string& name) {
 // A grid of a saved frame; a 2D scene's frame (one cell thick in z) becomes a slab `slabCells`
 // thick, every layer a copy of the slice, so the 3D renderer sees the flow face-on with some body
 // (obstacles become prisms, as a 2D obstacle is).
-Grid<float, 3> readForRender(const fs::path& vdbFile, const std::string& name, int slabCells) {
-  Grid<float, 3> grid = io::readFloatGrid(vdbFile, name);
+Grid<float, 3> readForRender(const io::VdbFile& frame, const std::string& name, int slabCells) {
+  Grid<float, 3> grid = frame.floatGrid(name);
   if (grid.size().z() != 1 || slabCells <= 1) return grid;
   GridSpec<3> spec = grid.spec();
   spec.res.z() = slabCells;
@@ -63,19 +63,19 @@ RenderKeys jobKeys(const nlohmann::json& storedRender, const std::vector<std::st
 
 }  // namespace
 
-void renderSavedFrame(const fs::path& vdbFile, const RenderKeys& keys, const fs::path& png,
+void renderSavedFrame(const io::VdbFile& frame, const RenderKeys& keys, const fs::path& png,
                       render::FrameTimings* timings) {
-  const std::vector<std::string> grids = io::listVdbGrids(vdbFile);
+  const std::vector<std::string> grids = frame.gridNames();
+  const std::string vdbFile = frame.path().string();
   if (!hasGrid(grids, keys.densityGrid))
-    throw InputError(fmt::format("{}: no grid '{}' to render (the file has: {}); set render.grids.density",
-                                 vdbFile.string(), keys.densityGrid, fmt::join(grids, ", ")));
-  const Grid<float, 3> density = readForRender(vdbFile, keys.densityGrid, keys.slabCells);
+    throw InputError(fmt::format("{}: no grid '{}' to render (the file has: {}); set render.grids.density", vdbFile,
+                                 keys.densityGrid, fmt::join(grids, ", ")));
+  const Grid<float, 3> density = readForRender(frame, keys.densityGrid, keys.slabCells);
   std::optional<Grid<float, 3>> temperature, emitter;
-  if (hasGrid(grids, keys.temperatureGrid)) temperature = readForRender(vdbFile, keys.temperatureGrid, keys.slabCells);
-  if (temperature && hasGrid(grids, keys.emitterGrid))
-    emitter = readForRender(vdbFile, keys.emitterGrid, keys.slabCells);
+  if (hasGrid(grids, keys.temperatureGrid)) temperature = readForRender(frame, keys.temperatureGrid, keys.slabCells);
+  if (temperature && hasGrid(grids, keys.emitterGrid)) emitter = readForRender(frame, keys.emitterGrid, keys.slabCells);
   std::optional<Grid<float, 3>> obstacles;
-  if (hasGrid(grids, keys.obstacleGrid)) obstacles = readForRender(vdbFile, keys.obstacleGrid, keys.slabCells);
+  if (hasGrid(grids, keys.obstacleGrid)) obstacles = readForRender(frame, keys.obstacleGrid, keys.slabCells);
   render::FrameSurfaces surfaces;
   surfaces.distance = obstacles ? &*obstacles : nullptr;
   for (const TriangleMesh& mesh : keys.geometry->meshes) surfaces.meshes.push_back(&mesh);
@@ -95,12 +95,14 @@ void renderSavedFrame(const fs::path& vdbFile, const RenderKeys& keys, const fs:
   } catch (const std::invalid_argument& e) {
     // What the renderer refuses in a valid file (a camera inside an obstacle, grids of different
     // layouts) is an input error of this frame: exit 2 naming it.
-    throw InputError(fmt::format("{}: cannot render: {}", vdbFile.string(), e.what()));
+    throw InputError(fmt::format("{}: cannot render: {}", vdbFile, e.what()));
   }
 }
 
 std::vector<fs::path> renderSavedFrames(const RenderJob& job) {
   std::vector<fs::path> frames;
+  // A run folder's frames must be the ones the run wrote; a single file may come from any tool.
+  io::VdbProvenance provenance = io::VdbProvenance::MsimRun;
   fs::path outDir;
   RenderKeys keys;
   double fps = 24.0;
@@ -127,6 +129,7 @@ std::vector<fs::path> renderSavedFrames(const RenderJob& job) {
     if (!fs::exists(job.input)) throw InputError(source + ": no such file");
     keys = jobKeys(nlohmann::json::object(), job.overrides, source, fs::path());
     frames.push_back(job.input);
+    provenance = io::VdbProvenance::AnyTool;
   } else {
     throw InputError(source + ": expected a run folder (with run.json) or a .vdb file");
   }
@@ -141,7 +144,7 @@ std::vector<fs::path> renderSavedFrames(const RenderJob& job) {
       fs::create_directories(outDir);
       target = outDir / frames[i].filename().replace_extension(".png");
     }
-    renderSavedFrame(frames[i], keys, target);
+    renderSavedFrame(io::VdbFile(frames[i], provenance), keys, target);
     written.push_back(target);
     if (job.showProgress) progress.update(static_cast<int>(i) + 1, 1);
   }

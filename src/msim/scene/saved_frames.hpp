@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "msim/io/png.hpp"
+#include "msim/io/vdb.hpp"
 #include "msim/render/frame_renderer.hpp"
 #include "msim/scene/render_keys.hpp"
 
@@ -15,7 +16,7 @@ namespace msim::scene {
 // Renders one saved frame into `png` (and its .exr twin when keys.exr). InputError naming the
 // file for a missing or unreadable file, a missing density grid, or a picture the renderer refuses
 // (a camera inside an obstacle); the temperature, emitter and obstacle grids are used when present.
-void renderSavedFrame(const std::filesystem::path& vdbFile, const RenderKeys& keys, const std::filesystem::path& png,
+void renderSavedFrame(const io::VdbFile& frame, const RenderKeys& keys, const std::filesystem::path& png,
                       render::FrameTimings* timings = nullptr);
 
 struct RenderJob {

@@ -17,11 +17,19 @@ namespace msim::scene {
 
 namespace {
 
+// Cell indices are int; a domain this long along one axis is refused by the memory check anyway
+// unless it is a line of cells.
+constexpr long long kMaxCellsPerAxis = 1LL << 30;
+// A run writes every frame: more than this is a typo in time.duration or time.fps, not a plan.
+constexpr double kMaxFrames = 1e7;
+
 Schema domainSchema() {
   Schema domain = Schema::object("the simulated box");
   domain.vector("min", "m", 3, "lower corner; 2 numbers make a 2D scene").lengths({2, 3}).required();
   domain.vector("max", "m", 3, "upper corner; snapped up to whole cells").lengths({2, 3}).required();
-  domain.integer("resolution", 64, "cells along the longest axis (dx = longest extent / resolution)").min(1);
+  domain.integer("resolution", 64, "cells along the longest axis (dx = longest extent / resolution)")
+      .min(1)
+      .max(kMaxCellsPerAxis);
   Schema sides = Schema::object("what each side of the box does to the flow");
   for (const char* side : {"x_min", "x_max", "y_min", "y_max", "z_min", "z_max"})
     sides.string(side, "open", "open: gas flows in and out; closed: a wall").choices({"open", "closed"});
@@ -108,6 +116,9 @@ Scene loadScene(const std::filesystem::path& file, const std::vector<std::string
   double longest = 0.0;
   for (int a = 0; a < scene.dimensions; ++a) {
     const double extent = maxCorner[a] - minCorner[a];
+    if (!std::isfinite(extent))
+      throw InputError(fmt::format("{}: 'domain.max' - 'domain.min' along {} is beyond the range of numbers ({} - {})",
+                                   source, "xyz"[a], maxCorner[a], minCorner[a]));
     if (!(extent > 0.0))
       throw InputError(fmt::format("{}: 'domain.max' must exceed 'domain.min' on every axis (axis {} has extent {})",
                                    source, "xyz"[a], extent));
@@ -121,17 +132,25 @@ Scene loadScene(const std::filesystem::path& file, const std::vector<std::string
 
   const auto& time = scene.resolved.at("time");
   scene.fps = time.at("fps").get<double>();
-  scene.frameCount = std::max(1, static_cast<int>(std::lround(time.at("duration").get<double>() * scene.fps)));
+  const double duration = time.at("duration").get<double>();
+  const double frames = std::round(duration * scene.fps);
+  if (!(frames <= kMaxFrames))
+    throw InputError(fmt::format("{}: 'time.duration' = {} s at 'time.fps' = {} gives {:.3g} frames; at most {:.0f} "
+                                 "frames can be written",
+                                 source, duration, scene.fps, frames, kMaxFrames));
+  scene.frameCount = std::max(1, static_cast<int>(frames));
 
   // Refuse before anything is allocated: a run that swaps or is killed by the OOM killer helps no one.
-  scene.memoryEstimate = static_cast<double>(scene.cellCount()) * scene.type->bytesPerCell(scene.dimensions, scene.resolved);
+  // The cell count in double: the axes' product can exceed 64 bits before this check.
+  const double cells = double(scene.resolution.x()) * double(scene.resolution.y()) * double(scene.resolution.z());
+  scene.memoryEstimate = cells * scene.type->bytesPerCell(scene.dimensions, scene.resolved);
   const double available = static_cast<double>(availableMemoryBytes());
   if (available > 0.0 && scene.memoryEstimate > available)
     throw InputError(fmt::format(
-        "{}: 'domain.resolution' = {} gives {} x {}{} = {} cells needing about {}, more than the {} available on "
+        "{}: 'domain.resolution' = {} gives {} x {}{} = {:.4g} cells needing about {}, more than the {} available on "
         "this machine; lower 'domain.resolution'",
         source, resolution, scene.resolution.x(), scene.resolution.y(),
-        scene.dimensions == 3 ? fmt::format(" x {}", scene.resolution.z()) : std::string(), scene.cellCount(),
+        scene.dimensions == 3 ? fmt::format(" x {}", scene.resolution.z()) : std::string(), cells,
         formatBytes(scene.memoryEstimate), formatBytes(available)));
   return scene;
 }

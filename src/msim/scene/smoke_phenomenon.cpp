@@ -168,24 +168,25 @@ class SmokePhenomenon final : public Phenomenon {
   }
 
   void restore(const std::filesystem::path& vdbFile, double time) override {
+    const io::VdbFile saved(vdbFile, io::VdbProvenance::MsimRun);
     time_ = time;
     solver_.setTime(time);
     if (obstacles_.moving()) placeObstacles(time_);
     if (turbulence_) {
       // The noise particles are not saved: they start afresh (the resumed run is not bit-exact).
-      restoreGrid(vdbFile, "density", turbulence_->density(), source_);
-      restoreGrid(vdbFile, "temperature", turbulence_->temperature(), source_);
-      restoreGrid(vdbFile, "turbulent_energy", turbulence_->energy().energy(), source_);
+      restoreGrid(saved, "density", turbulence_->density(), source_);
+      restoreGrid(saved, "temperature", turbulence_->temperature(), source_);
+      restoreGrid(saved, "turbulent_energy", turbulence_->energy().energy(), source_);
       turbulence_->downsample(solver_.density(), solver_.temperature());
       turbulence_->reseedParticles();
     } else {
-      restoreGrid(vdbFile, "density", solver_.density(), source_);
-      restoreGrid(vdbFile, "temperature", solver_.temperature(), source_);
+      restoreGrid(saved, "density", solver_.density(), source_);
+      restoreGrid(saved, "temperature", solver_.temperature(), source_);
     }
     for (std::size_t i = 0; i < solver_.scalarCount(); ++i)
-      restoreGrid(vdbFile, solver_.scalarName(i), solver_.scalar(i), source_);
-    for (int a = 0; a < D; ++a) restoreGrid(vdbFile, faceGridName(a), solver_.velocity().component(a), source_);
-    restoreGrid(vdbFile, "pressure", solver_.pressure(), source_);
+      restoreGrid(saved, solver_.scalarName(i), solver_.scalar(i), source_);
+    for (int a = 0; a < D; ++a) restoreGrid(saved, faceGridName(a), solver_.velocity().component(a), source_);
+    restoreGrid(saved, "pressure", solver_.pressure(), source_);
   }
 
   // Each wind's spectrum against the prescribed one (winds/), and its measures in run.json.

@@ -29,7 +29,8 @@ struct Measured {
 };
 
 Measured measure(const fs::path& input, const std::string& grid) {
-  const Grid<Vecf<3>, 3> velocity = io::readVectorGrid(input, grid);
+  const io::VdbFile file(input, io::VdbProvenance::AnyTool);
+  const Grid<Vecf<3>, 3> velocity = file.vectorGrid(grid);
   const IVec3 size = velocity.size();
   const int side = (size.minCoeff() / 2) * 2;
   if (side < 16)
@@ -37,9 +38,8 @@ Measured measure(const fs::path& input, const std::string& grid) {
                                  input.string(), grid, size.x(), size.y(), size.z()));
   // Centre: the smoke's centroid when the file holds a density on the same voxels.
   Vec3 centre = 0.5 * size.cast<double>();
-  const auto names = io::listVdbGrids(input);
-  if (std::find(names.begin(), names.end(), "density") != names.end()) {
-    const Grid<float, 3> density = io::readFloatGrid(input, "density");
+  if (file.hasGrid("density")) {
+    const Grid<float, 3> density = file.floatGrid("density");
     if (density.size() == size) {
       Vec3 moment = Vec3::Zero();
       double mass = 0.0;

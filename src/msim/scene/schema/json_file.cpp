@@ -65,6 +65,18 @@ nlohmann::json loadJsonFile(const std::filesystem::path& path) {
     const TextPosition pos = positionOf(text, offendingTokenStart(text, e.byte));
     throw InputError(path.string() + ":" + std::to_string(pos.line) + ":" + std::to_string(pos.column) +
                      ": malformed JSON: " + parseErrorReason(e.what()));
+  } catch (const nlohmann::json::out_of_range& e) {
+    // A number beyond double's range ("1e400"); nlohmann names the token but not its place.
+    const std::string message = e.what();
+    const std::size_t open = message.find('\''), close = message.rfind('\'');
+    const std::string token = open < close ? message.substr(open + 1, close - open - 1) : std::string();
+    const std::size_t at = token.empty() ? std::string::npos : text.find(token);
+    const std::string where =
+        at == std::string::npos
+            ? std::string()
+            : ":" + std::to_string(positionOf(text, at).line) + ":" + std::to_string(positionOf(text, at).column);
+    throw InputError(path.string() + where + ": the number " + (token.empty() ? "" : "'" + token + "' ") +
+                     "is beyond the range of double");
   }
 }
 

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <string>
 
 #include "msim/core/error.hpp"
@@ -18,9 +20,13 @@ bool withinBound(double v, const std::optional<NumericBound>& lo, const std::opt
 }
 
 bool isIntegral(const json& v) {
+  // Integers are read as long long: larger unsigned ones do not fit.
+  if (v.is_number_unsigned()) return v.get<std::uint64_t>() <= std::uint64_t(std::numeric_limits<long long>::max());
   if (v.is_number_integer()) return true;
-  // 128.0 is an integer to a person editing JSON; accept it.
-  return v.is_number_float() && std::isfinite(v.get<double>()) && std::floor(v.get<double>()) == v.get<double>();
+  // 128.0 is an integer to a person editing JSON; accept it while it converts exactly (|v| <= 2^53).
+  if (!v.is_number_float()) return false;
+  const double d = v.get<double>();
+  return std::isfinite(d) && std::floor(d) == d && std::abs(d) <= 9007199254740992.0;
 }
 
 class Resolver {
