@@ -379,9 +379,8 @@ struct VdbFile::Impl {
 VdbFile::VdbFile(const std::filesystem::path& path, VdbProvenance provenance) : impl_(std::make_unique<Impl>()) {
   impl_->path = path;
   std::string bytes = readFileBytes(path);
-  // DEMONSTRATION, reverted in the next commit: the seal check is skipped, so damaged frames reach
-  // OpenVDB's parser.
-  if (false && checkVdbSeal(bytes, path) == VdbSeal::Absent && provenance == VdbProvenance::MsimRun)
+  // The seal is checked before OpenVDB reads a byte: a damaged frame never reaches its parser.
+  if (checkVdbSeal(bytes, path) == VdbSeal::Absent && provenance == VdbProvenance::MsimRun)
     failRead(path, "not a frame written by this version of msim, or damaged: it carries no msim checksum");
   impl_->grids = parseGrids(std::move(bytes), path);
 }
