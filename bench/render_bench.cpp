@@ -104,8 +104,21 @@ void BM_RenderFrameWithMultipleScattering(benchmark::State& state) {
   state.counters["diffusion_cycles"] = total.diffusionCycles;
 }
 
+// One light's transmittance grid at 128^3 (the sweep of lightTransmittance): range(1) = 0 the
+// directional sun, 1 a point light above the box, 2 a point light inside it.
+void BM_LightTransmittance(benchmark::State& state) {
+  const Grid<float, 3> rho = smokePuffs(static_cast<int>(state.range(0)));
+  render::Light light = benchSun();
+  if (state.range(1) > 0) {
+    light.type = render::Light::Type::Point;
+    light.position = state.range(1) == 1 ? Vec3(0.8, 1.6, 0.3) : Vec3(0.5, 0.6, 0.5);
+  }
+  for (auto _ : state) benchmark::DoNotOptimize(render::lightTransmittance(rho, light, render::Medium(), 0.5).data().data());
+}
+
 }  // namespace
 
+BENCHMARK(BM_LightTransmittance)->Args({128, 0})->Args({128, 1})->Args({128, 2})->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_RenderVolume)->Arg(128)->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK(BM_RenderVolumeWithBall)->Arg(128)->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK(BM_RenderFrameWithMultipleScattering)->Arg(128)->Unit(benchmark::kMillisecond)->Iterations(5);

@@ -9,6 +9,7 @@ packages=(
   libtbb-dev libeigen3-dev nlohmann-json3-dev libcli11-dev libspdlog-dev libfmt-dev
   libpng-dev libopenexr-dev libopenvdb-dev libboost-iostreams-dev libgtest-dev libgmock-dev libbenchmark-dev libcgal-dev libkissfft-dev libxxhash-dev
   ffmpeg
+  libopenvdb-tools  # vdb_print: the tests check that OpenVDB's own tools read msim's frames
 )
 
 missing=()

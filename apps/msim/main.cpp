@@ -13,6 +13,7 @@
 #include <tbb/info.h>
 
 #include "msim/core/error.hpp"
+#include "msim/core/float_environment.hpp"
 #include "msim/core/log.hpp"
 #include "msim/core/system_memory.hpp"
 #include "msim/scene/interrupt.hpp"
@@ -49,6 +50,7 @@ void printInfo(const scene::Scene& s) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  flushSubnormalsToZero();
   CLI::App app{"msim: multi-scale simulation of natural phenomena"};
   app.set_version_flag("--version", std::string("msim ") + kVersion);
   app.require_subcommand(1);

@@ -61,6 +61,19 @@ TEST(RenderCli, RunWithRenderEnabledWritesPicturesAndExr) {
   EXPECT_GT(*std::max_element(radiance.rgb.begin(), radiance.rgb.end()), 0.0f);
 }
 
+TEST(RenderCli, LastFrameOnlyAndTheRunListsWhatItWrote) {
+  const fs::path dir = scratch("render_last");
+  writeText(dir / "s.json", tinyRun(R"(, "render": {"enabled": true, "frames": "last", "camera": {"width": 32, "height": 32}})"));
+  const Result r = runMsim("run " + (dir / "s.json").string() + " --out " + (dir / "out").string());
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "out" / "render" / "tiny3d_0001.png"));
+  EXPECT_TRUE(fs::exists(dir / "out" / "render" / "tiny3d_0002.png"));
+  const std::string listed = (dir / "out" / "render" / "tiny3d_0002.png").string();
+  EXPECT_NE(r.output.find(listed + " "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("physically based render of the last frame"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find((dir / "out" / "run.json").string()), std::string::npos) << r.output;
+}
+
 TEST(RenderCli, CameraInsideAnObstacleIsRefused) {
   const fs::path dir = simulate("render_inside", R"(, "obstacles": [{"shape": {"type": "sphere", "center": [0.5, 0.75, 0.5],
       "radius": 0.15}}])");

@@ -138,7 +138,11 @@ TEST(VolumeRenderer, TransmittanceOfAHomogeneousBoxToEveryLightPath) {
       EXPECT_LT(worst, 0.10);
       EXPECT_LT(mean, 0.01);
     } else {
-      EXPECT_LT(worst, 1e-5);  // shadow rays integrate the constant density exactly
+      // The point-light sweep interpolates the depth every 8 slices too: the path length is not
+      // linear across a slice near the light (the light inside: up to 3.5% there) nor where the
+      // paths change the face they leave by (the light outside: 5e-4).
+      EXPECT_LT(worst, 0.05);
+      EXPECT_LT(mean, 0.005);
     }
     std::printf("homogeneous box, light type %d: relative error of T worst %.2e mean %.2e\n", static_cast<int>(light.type),
                 worst, mean);

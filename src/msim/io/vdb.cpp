@@ -6,7 +6,9 @@
 #include <openvdb/points/PointConversion.h>
 #include <openvdb/points/PointCount.h>
 #include <openvdb/points/PointDataGrid.h>
+#include <openvdb/tools/Dense.h>
 #include <openvdb/tools/PointIndexGrid.h>
+#include <openvdb/tools/SignedFloodFill.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -26,6 +28,7 @@
 #include "msim/core/system_memory.hpp"
 #include "msim/io/atomic_file.hpp"
 #include "msim/io/vdb_seal.hpp"
+#include "msim/version.hpp"
 
 namespace msim::io {
 
@@ -37,6 +40,7 @@ constexpr const char* kMetaRes = "msim_res";
 // Points are stored bucketed by voxel; this attribute remembers each point's original position
 // in the cloud so reading restores the caller's order.
 constexpr const char* kPointIndexAttribute = "msim_index";
+constexpr const char* kUnits = "SI: m, s, kg, K; densities kg/m^3, velocities m/s";
 
 void initializeOpenVdb() {
   static std::once_flag once;
@@ -62,6 +66,9 @@ GridSpec<3> toSpec3(const GridSpec<2>& s) {
 
 bool isPositiveZero(float v) { return std::bit_cast<std::uint32_t>(v) == 0u; }
 
+// Fog volumes keep values above the tolerance that are normal floats (zeros and subnormals go).
+bool keepFog(float v, float tolerance) { return std::abs(v) > tolerance && std::isnormal(v); }
+
 bool keepScalar(float v, float tolerance) { return tolerance > 0.0f ? !(std::abs(v) <= tolerance) : !isPositiveZero(v); }
 
 bool keepVector(const openvdb::Vec3f& v, float tolerance) {
@@ -70,16 +77,16 @@ bool keepVector(const openvdb::Vec3f& v, float tolerance) {
 }
 
 // Builds a sparse grid from a dense x-fastest array of res cells, one leaf-sized block per task.
-// Values for which keep() is false stay background (0) and inactive.
+// Values for which keep() is false stay background and inactive.
 template <typename GridT, typename ValueAt, typename Keep>
-typename GridT::Ptr buildSparse(const IVec3& res, ValueAt valueAt, Keep keep) {
+typename GridT::Ptr buildSparse(const IVec3& res, ValueAt valueAt, Keep keep,
+                                typename GridT::ValueType background = openvdb::zeroVal<typename GridT::ValueType>()) {
   using TreeT = typename GridT::TreeType;
   using LeafT = typename TreeT::LeafNodeType;
   using ValueT = typename GridT::ValueType;
   constexpr int kDim = static_cast<int>(LeafT::DIM);
   const IVec3 blocks = (res.array() + kDim - 1) / kDim;
   const std::size_t blockCount = static_cast<std::size_t>(blocks.x()) * blocks.y() * blocks.z();
-  const ValueT background = openvdb::zeroVal<ValueT>();
   std::vector<std::unique_ptr<LeafT>> leaves(blockCount);
   tbb::parallel_for(std::size_t(0), blockCount, [&](std::size_t b) {
     const int bx = static_cast<int>(b % blocks.x());
@@ -229,6 +236,7 @@ Grid<Vecf<3>, 3> readVectorGridAs(const VdbGridT& grid, const std::filesystem::p
 }  // namespace
 
 struct VdbWriter::Impl {
+  VdbWriteOptions options;
   openvdb::GridPtrVec grids;
   std::set<std::string> names;
 
@@ -236,48 +244,91 @@ struct VdbWriter::Impl {
     if (name.empty()) throw std::invalid_argument("VdbWriter: empty grid name");
     if (!names.insert(name).second) throw std::invalid_argument("VdbWriter: duplicate grid name '" + name + "'");
     grid->setName(name);
+    grid->setCreator(std::string("msim ") + kVersion);
+    grid->setSaveFloatAsHalf(options.halfFloat);
     grids.push_back(std::move(grid));
+  }
+
+  // A float grid on spec's cells, values from the x-fastest array `values`.
+  template <typename Keep>
+  void addScalar(const std::string& name, const GridSpec<3>& spec, const std::vector<float>& values, Keep keep,
+                 openvdb::GridClass gridClass, float background = 0.0f) {
+    auto vdb = buildSparse<openvdb::FloatGrid>(
+        spec.res, [&](const IVec3&, std::size_t linear) { return values[linear]; }, keep, background);
+    vdb->setTransform(cellCentredTransform(spec));
+    vdb->setGridClass(gridClass);
+    storeSpec(*vdb, spec);
+    add(name, vdb);
+  }
+
+  void addFog(const std::string& name, const GridSpec<3>& spec, const std::vector<float>& values) {
+    addScalar(name, spec, values, [tolerance = options.fogTolerance](float v) { return keepFog(v, tolerance); },
+              openvdb::GRID_FOG_VOLUME);
+  }
+
+  // The narrow band |phi| < halfWidth*dx is active; signedFloodFill then gives the inactive
+  // voxels and tiles the sign of their side, as OpenVDB's level-set tools require.
+  void addLevelSet(const std::string& name, const GridSpec<3>& spec, const std::vector<float>& distance, int halfWidth) {
+    if (halfWidth < 1) throw std::invalid_argument("VdbWriter: level set '" + name + "' needs a half width >= 1");
+    const float band = static_cast<float>(halfWidth * spec.dx);
+    addScalar(name, spec, distance, [band](float v) { return std::abs(v) < band; }, openvdb::GRID_LEVEL_SET, band);
+    auto& grid = static_cast<openvdb::FloatGrid&>(*grids.back());
+    openvdb::tools::signedFloodFill(grid.tree());
+  }
+
+  void addVelocity(const std::string& name, const GridSpec<3>& spec, openvdb::Vec3SGrid::Ptr vdb) {
+    vdb->setTransform(cellCentredTransform(spec));
+    vdb->setVectorType(openvdb::VEC_CONTRAVARIANT_RELATIVE);
+    storeSpec(*vdb, spec);
+    add(name, vdb);
   }
 };
 
-VdbWriter::VdbWriter() : impl_(std::make_unique<Impl>()) { initializeOpenVdb(); }
+VdbWriter::VdbWriter(VdbWriteOptions options) : impl_(std::make_unique<Impl>()) {
+  if (!(options.fogTolerance >= 0.0f)) throw std::invalid_argument("VdbWriter: the fog tolerance must be >= 0");
+  impl_->options = options;
+  initializeOpenVdb();
+}
 VdbWriter::~VdbWriter() = default;
 
 void VdbWriter::addFloatGrid(const std::string& name, const Grid<float, 3>& grid, float tolerance) {
-  auto vdb = buildSparse<openvdb::FloatGrid>(
-      grid.size(), [&](const IVec3&, std::size_t linear) { return grid[linear]; },
-      [&](float v) { return keepScalar(v, tolerance); });
-  vdb->setTransform(cellCentredTransform(grid.spec()));
-  storeSpec(*vdb, grid.spec());
-  impl_->add(name, vdb);
+  impl_->addScalar(name, grid.spec(), grid.data(), [&](float v) { return keepScalar(v, tolerance); },
+                   openvdb::GRID_UNKNOWN);
 }
 
 void VdbWriter::addFloatGrid(const std::string& name, const Grid<float, 2>& grid, float tolerance) {
-  const GridSpec<3> spec = toSpec3(grid.spec());
-  auto vdb = buildSparse<openvdb::FloatGrid>(
-      spec.res, [&](const IVec3&, std::size_t linear) { return grid[linear]; },
-      [&](float v) { return keepScalar(v, tolerance); });
-  vdb->setTransform(cellCentredTransform(spec));
-  storeSpec(*vdb, spec);
-  impl_->add(name, vdb);
+  impl_->addScalar(name, toSpec3(grid.spec()), grid.data(), [&](float v) { return keepScalar(v, tolerance); },
+                   openvdb::GRID_UNKNOWN);
+}
+
+void VdbWriter::addFogVolume(const std::string& name, const Grid<float, 3>& grid) {
+  impl_->addFog(name, grid.spec(), grid.data());
+}
+
+void VdbWriter::addFogVolume(const std::string& name, const Grid<float, 2>& grid) {
+  impl_->addFog(name, toSpec3(grid.spec()), grid.data());
+}
+
+void VdbWriter::addLevelSet(const std::string& name, const Grid<float, 3>& distance, int halfWidth) {
+  impl_->addLevelSet(name, distance.spec(), distance.data(), halfWidth);
+}
+
+void VdbWriter::addLevelSet(const std::string& name, const Grid<float, 2>& distance, int halfWidth) {
+  impl_->addLevelSet(name, toSpec3(distance.spec()), distance.data(), halfWidth);
 }
 
 void VdbWriter::addVectorGrid(const std::string& name, const Grid<Vecf<3>, 3>& grid, float tolerance) {
-  auto vdb = buildSparse<openvdb::Vec3SGrid>(
-      grid.size(), [&](const IVec3&, std::size_t linear) { return toVdb(grid[linear]); },
-      [&](const openvdb::Vec3f& v) { return keepVector(v, tolerance); });
-  vdb->setTransform(cellCentredTransform(grid.spec()));
-  storeSpec(*vdb, grid.spec());
-  impl_->add(name, vdb);
+  impl_->addVelocity(name, grid.spec(),
+                     buildSparse<openvdb::Vec3SGrid>(
+                         grid.size(), [&](const IVec3&, std::size_t linear) { return toVdb(grid[linear]); },
+                         [&](const openvdb::Vec3f& v) { return keepVector(v, tolerance); }));
 }
 
 void VdbWriter::addVectorGrid(const std::string& name, const Grid<Vec3, 3>& grid, float tolerance) {
-  auto vdb = buildSparse<openvdb::Vec3SGrid>(
-      grid.size(), [&](const IVec3&, std::size_t linear) { return toVdb(grid[linear].cast<float>()); },
-      [&](const openvdb::Vec3f& v) { return keepVector(v, tolerance); });
-  vdb->setTransform(cellCentredTransform(grid.spec()));
-  storeSpec(*vdb, grid.spec());
-  impl_->add(name, vdb);
+  impl_->addVelocity(name, grid.spec(),
+                     buildSparse<openvdb::Vec3SGrid>(
+                         grid.size(), [&](const IVec3&, std::size_t linear) { return toVdb(grid[linear].cast<float>()); },
+                         [&](const openvdb::Vec3f& v) { return keepVector(v, tolerance); }));
 }
 
 void VdbWriter::addVectorGrid(const std::string& name, const MacGrid<3>& velocity, float tolerance) {
@@ -290,11 +341,9 @@ void VdbWriter::addVectorGrid(const std::string& name, const MacGrid<3>& velocit
     }
     return v;
   };
-  auto vdb = buildSparse<openvdb::Vec3SGrid>(velocity.spec().res, centre,
-                                             [&](const openvdb::Vec3f& v) { return keepVector(v, tolerance); });
-  vdb->setTransform(cellCentredTransform(velocity.spec()));
-  storeSpec(*vdb, velocity.spec());
-  impl_->add(name, vdb);
+  impl_->addVelocity(name, velocity.spec(),
+                     buildSparse<openvdb::Vec3SGrid>(velocity.spec().res, centre,
+                                                     [&](const openvdb::Vec3f& v) { return keepVector(v, tolerance); }));
 }
 
 void VdbWriter::addPoints(const std::string& name, const PointCloud& points, double voxelSize) {
@@ -338,11 +387,18 @@ void VdbWriter::addPoints(const std::string& name, const PointCloud& points, dou
   impl_->add(name, grid);
 }
 
-void VdbWriter::write(const std::filesystem::path& path) const {
+void VdbWriter::write(const std::filesystem::path& path, const VdbFrameInfo* frame) const {
   writeFileAtomically(path, [&](const std::filesystem::path& tmp) {
     try {
       openvdb::io::File file(tmp.string());
       openvdb::MetaMap fileMetadata;
+      fileMetadata.insertMeta("msim_version", openvdb::StringMetadata(kVersion));
+      fileMetadata.insertMeta("msim_units", openvdb::StringMetadata(kUnits));
+      if (frame) {
+        fileMetadata.insertMeta("msim_scene", openvdb::StringMetadata(frame->scene));
+        fileMetadata.insertMeta("msim_frame", openvdb::Int32Metadata(frame->frame));
+        fileMetadata.insertMeta("msim_time", openvdb::DoubleMetadata(frame->time));
+      }
       fileMetadata.insertMeta(kVdbSealKey, openvdb::StringMetadata(kVdbSealPlaceholder));
       file.write(impl_->grids, fileMetadata);
       file.close();
@@ -405,6 +461,15 @@ Grid<float, 3> VdbFile::floatGrid(const std::string& name) const {
   const auto grid = impl_->gridOfType<openvdb::FloatGrid>(name);
   const Placement placement = placementOf(*grid, impl_->path);
   Grid<float, 3> out(placement.spec, 0.0f);
+  if (grid->getGridClass() == openvdb::GRID_LEVEL_SET) {
+    // Inactive voxels of a level set carry the sign of their side: copy every value. Dense's
+    // LayoutXYZ (x fastest) is msim's cell order.
+    const IVec3& res = placement.spec.res;
+    const openvdb::CoordBBox box(placement.shift, placement.shift + openvdb::Coord(res.x() - 1, res.y() - 1, res.z() - 1));
+    openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(box, out.data().data());
+    openvdb::tools::copyToDense(*grid, dense);
+    return out;
+  }
   copyActiveValues(grid->tree(), placement, [&](std::size_t linear, float v) { out[linear] = v; });
   return out;
 }

@@ -4,11 +4,13 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numbers>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -222,6 +224,49 @@ class PathStencil {
   std::vector<Entry> entries_;
 };
 
+// The grids a light sweep fills: optical depth per cell and, with solids, the path's visibility.
+class SweepGrids {
+ public:
+  SweepGrids(const Grid<float, 3>& rho, const Grid<float, 3>* sdf) : depth_(rho.spec(), rho.size(), rho.offset()) {
+    if (sdf) visibility_.emplace(rho.spec(), rho.size(), rho.offset());
+  }
+  float* depth() { return depth_.data().data(); }
+  float* vis() { return visibility_ ? visibility_->data().data() : nullptr; }
+  // T = exp(-depth) V, in place of the depth.
+  Grid<float, 3> transmittance() {
+    float* d = depth();
+    const float* v = vis();
+    parallelFor(0, depth_.count(), [&](std::size_t i) { d[i] = std::exp(-d[i]) * (v ? v[i] : 1.0f); });
+    return std::move(depth_);
+  }
+
+ private:
+  Grid<float, 3> depth_;
+  std::optional<Grid<float, 3>> visibility_;
+};
+
+// The optical depth and visibility carried from slice `slice` of axis a: bilinear in the cells
+// (b, c) of sb and sc there. Weights that fall off beyond the box faces see depth 0 and V = 1.
+struct CarriedPath {
+  double depth = 0.0, visibility = 1.0;
+};
+CarriedPath carriedFromSlice(const Grid<float, 3>& rho, const float* depth, const float* vis, int a, int slice,
+                             const LateralStencil& sb, const LateralStencil& sc) {
+  const int b = (a + 1) % 3, c = (a + 2) % 3;
+  IVec3 p;
+  p[a] = slice;
+  CarriedPath carried;
+  for (int u = 0; u < 2; ++u)
+    for (int v = 0; v < 2; ++v) {
+      p[b] = sb.index[u];
+      p[c] = sc.index[v];
+      const double w = sb.depthWeight[u] * sc.depthWeight[v];
+      carried.depth += w * depth[rho.index(p)];
+      if (vis) carried.visibility -= w * (1.0 - vis[rho.index(p)]);
+    }
+  return carried;
+}
+
 // Optical depth from every cell centre towards a directional light (see lightTransmittance),
 // returned as transmittance. Slices across the axis closest to the light are done in order from
 // the light's side; each cell marches its path exactly over kSweepSlices slices and adds the depth
@@ -235,10 +280,8 @@ class PathStencil {
 // beyond the box faces, where lateralStencil's weights fall off, the missing weight sees V = 1.
 Grid<float, 3> sweepDirectional(const Grid<float, 3>& rho, const Grid<float, 3>* sdf, const Vec3& toLight,
                                 double sigmaT, double stepCells) {
-  Grid<float, 3> depth(rho.spec(), rho.size(), rho.offset());
-  std::optional<Grid<float, 3>> visibility;
-  if (sdf) visibility.emplace(rho.spec(), rho.size(), rho.offset());
-  float* vis = visibility ? visibility->data().data() : nullptr;
+  SweepGrids grids(rho, sdf);
+  float* vis = grids.vis();
   const float* dist = sdf ? sdf->data().data() : nullptr;
   const IVec3 n = rho.size();
   const double dx = rho.spec().dx, ds = stepCells * dx;
@@ -255,7 +298,7 @@ Grid<float, 3> sweepDirectional(const Grid<float, 3>& rho, const Grid<float, 3>*
   const Sampler sampler(rho);
   const PathStencil path(rho, toLight, tJump, ds);
   const float* r = rho.data().data();
-  float* d = depth.data().data();
+  float* d = grids.depth();
 
   // Cells `jump` or fewer slices apart do not depend on each other: one parallel loop per block.
   for (int first = 0; first < n[a]; first += jump) {
@@ -275,59 +318,100 @@ Grid<float, 3> sweepDirectional(const Grid<float, 3>& rho, const Grid<float, 3>*
           tau = sigmaT * densityIntegral(sampler, r, x, toLight, tExit, ds);  // leaves the box first
           if (vis) vis[i] = static_cast<float>(pathVisibility(sampler, dist, x, toLight, tExit, ds, dx, dist[i]));
         } else {
-          const LateralStencil sb = lateralStencil(ib + shiftB, n[b]), sc = lateralStencil(cell[c] + shiftC, n[c]);
-          IVec3 p = cell;
-          p[a] = cell[a] + jump * towardsLight;
-          double depthThere = 0.0, visThere = 1.0;
-          for (int u = 0; u < 2; ++u)
-            for (int v = 0; v < 2; ++v) {
-              p[b] = sb.index[u];
-              p[c] = sc.index[v];
-              const double w = sb.depthWeight[u] * sc.depthWeight[v];
-              depthThere += w * d[rho.index(p)];
-              if (vis) visThere -= w * (1.0 - vis[rho.index(p)]);
-            }
+          const CarriedPath there = carriedFromSlice(rho, d, vis, a, cell[a] + jump * towardsLight,
+                                                     lateralStencil(ib + shiftB, n[b]),
+                                                     lateralStencil(cell[c] + shiftC, n[c]));
           const double segment =
               path.fits(cell) ? path(r, i) : densityIntegral(sampler, r, x, toLight, tJump, ds);
-          tau = depthThere + sigmaT * segment;
+          tau = there.depth + sigmaT * segment;
           if (vis)
-            vis[i] = visThere > 0.0
-                         ? static_cast<float>(visThere * pathVisibility(sampler, dist, x, toLight, tJump, ds, dx, dist[i]))
-                         : 0.0f;
+            vis[i] = there.visibility > 0.0 ? static_cast<float>(there.visibility * pathVisibility(sampler, dist, x, toLight,
+                                                                                                  tJump, ds, dx, dist[i]))
+                                            : 0.0f;
         }
         d[i] = static_cast<float>(tau);
       }
     }, 1);
   }
-  parallelFor(0, depth.count(), [&](std::size_t i) { d[i] = std::exp(-d[i]) * (vis ? vis[i] : 1.0f); });
-  return depth;
+  return grids.transmittance();
 }
 
-// Transmittance from every cell centre to a point or spot light by a shadow ray per cell.
-// With solids (sdf), times the visibility of the same path.
-Grid<float, 3> shadowRays(const Grid<float, 3>& rho, const Grid<float, 3>* sdf, const Light& light, double sigmaT,
-                          double stepCells) {
-  Grid<float, 3> out(rho.spec(), rho.size(), rho.offset());
+// Optical depth from every cell centre to a point or spot light (see lightTransmittance), returned
+// as transmittance. As sweepDirectional, but the direction varies per cell: a cell marches its
+// path towards the light over kSweepSlices slices across its dominant axis (the axis along which
+// the light is farthest) and adds the depth interpolated bilinearly in that slice. The cells used
+// there are more than kSweepSlices - 1 cells closer to the light in the max norm (the lateral
+// offset shrinks along the path, the stencil adds less than a cell), so cells are done in layers
+// of kSweepSlices - 1 of that distance, outward from the light, each layer in parallel. Paths
+// that reach the light or leave the box within kSweepSlices slices are marched whole.
+Grid<float, 3> sweepPointLight(const Grid<float, 3>& rho, const Grid<float, 3>* sdf, const Vec3& light, double sigmaT,
+                               double stepCells) {
+  SweepGrids grids(rho, sdf);
+  float* vis = grids.vis();
+  const float* dist = sdf ? sdf->data().data() : nullptr;
+  const IVec3 n = rho.size();
+  const double dx = rho.spec().dx, ds = stepCells * dx;
   const Vec3 lo = rho.spec().origin, hi = rho.spec().upper();
+  const Vec3 lightIndex = (light - lo) / dx - Vec3::Constant(0.5);  // the light in cell-centre coordinates
   const Sampler sampler(rho);
   const float* r = rho.data().data();
-  const float* dist = sdf ? sdf->data().data() : nullptr;
-  const double dx = rho.spec().dx, ds = stepCells * dx;
+  float* d = grids.depth();
+
+  // Cells in layers of max-norm distance to the light, counted from the nearest cell's (a light far
+  // outside the box leaves no empty layers), by a counting sort.
+  constexpr int kLayer = kSweepSlices - 1;
+  const auto chebyshev = [&](const IVec3& cell) { return (cell.cast<double>() - lightIndex).cwiseAbs().maxCoeff(); };
+  const IVec3 nearest = lightIndex.array().round().cast<int>().cwiseMax(0).cwiseMin(n.array() - 1);
+  const double nearestDistance = chebyshev(nearest);
+  std::vector<std::uint32_t> layerOf(rho.count());
   parallelForCells(rho, [&](const IVec3& cell, std::size_t i) {
-    const Vec3 x = rho.position(cell);
-    const Vec3 toLight = light.position - x;
-    const double distance = toLight.norm();
-    if (!(distance > 0.0)) {
-      out[i] = 1.0f;
-      return;
-    }
-    const Vec3 dir = toLight / distance;
-    const double length = std::min(distance, exitDistance(x, dir, lo, hi));  // no medium outside the box
-    const double visible = dist ? pathVisibility(sampler, dist, x, dir, length, ds, dx, dist[i]) : 1.0;
-    out[i] = visible > 0.0 ? static_cast<float>(visible * std::exp(-sigmaT * densityIntegral(sampler, r, x, dir, length, ds)))
-                           : 0.0f;
+    layerOf[i] = static_cast<std::uint32_t>(std::max(chebyshev(cell) - nearestDistance, 0.0) / kLayer);
   });
-  return out;
+  const std::uint32_t layers = *std::max_element(layerOf.begin(), layerOf.end()) + 1;
+  std::vector<std::size_t> layerStart(layers + 1, 0);
+  for (std::uint32_t l : layerOf) ++layerStart[l + 1];
+  for (std::uint32_t l = 0; l < layers; ++l) layerStart[l + 1] += layerStart[l];
+  std::vector<std::size_t> order(rho.count());
+  {
+    std::vector<std::size_t> next(layerStart.begin(), layerStart.end() - 1);
+    for (std::size_t i = 0; i < rho.count(); ++i) order[next[layerOf[i]]++] = i;
+  }
+
+  for (std::uint32_t l = 0; l < layers; ++l) {
+    parallelFor(layerStart[l], layerStart[l + 1], [&](std::size_t k) {
+      const std::size_t i = order[k];
+      const IVec3 cell = rho.coord(i);
+      const Vec3 x = rho.position(cell);
+      const Vec3 toLight = light - x;
+      const double distance = toLight.norm();
+      if (!(distance > 0.0)) {
+        d[i] = 0.0f;
+        if (vis) vis[i] = 1.0f;
+        return;
+      }
+      const Vec3 dir = toLight / distance;
+      const double length = std::min(distance, exitDistance(x, dir, lo, hi));  // no medium outside the box
+      int a = 0;
+      for (int q = 1; q < 3; ++q)
+        if (std::abs(dir[q]) > std::abs(dir[a])) a = q;
+      const double tJump = kSweepSlices * dx / std::abs(dir[a]);  // path length to the slice kSweepSlices closer
+      if (length <= tJump * (1.0 + 1e-9)) {
+        d[i] = static_cast<float>(sigmaT * densityIntegral(sampler, r, x, dir, length, ds));
+        if (vis) vis[i] = static_cast<float>(pathVisibility(sampler, dist, x, dir, length, ds, dx, dist[i]));
+        return;
+      }
+      const int b = (a + 1) % 3, c = (a + 2) % 3;
+      const Vec3 end = (x + tJump * dir - lo) / dx - Vec3::Constant(0.5);  // in cell-centre coordinates
+      const CarriedPath there = carriedFromSlice(rho, d, vis, a, cell[a] + (dir[a] > 0.0 ? kSweepSlices : -kSweepSlices),
+                                                 lateralStencil(end[b], n[b]), lateralStencil(end[c], n[c]));
+      d[i] = static_cast<float>(there.depth + sigmaT * densityIntegral(sampler, r, x, dir, tJump, ds));
+      if (vis)
+        vis[i] = there.visibility > 0.0
+                     ? static_cast<float>(there.visibility * pathVisibility(sampler, dist, x, dir, tJump, ds, dx, dist[i]))
+                     : 0.0f;
+    }, 256);
+  }
+  return grids.transmittance();
 }
 
 void checkLights(const std::vector<Light>& lights) {
@@ -515,7 +599,7 @@ Grid<float, 3> lightTransmittance(const Grid<float, 3>& density, const Light& li
     throw std::invalid_argument("lightTransmittance: stepCells must be positive, got " + std::to_string(stepCells));
   if (light.type == Light::Type::Directional)
     return sweepDirectional(density, surfaceDistance, -light.direction.normalized(), medium.extinction, stepCells);
-  return shadowRays(density, surfaceDistance, light, medium.extinction, stepCells);
+  return sweepPointLight(density, surfaceDistance, light.position, medium.extinction, stepCells);
 }
 
 Grid<float, 3> firstScatterSource(const Grid<float, 3>& density, const std::vector<Light>& lights,

@@ -138,8 +138,8 @@ void checkCameraOutsideSolids(const Vec3& position, const Grid<float, 3>* surfac
 // marches its path over 8 slices (at stepCells) and adds the optical depth interpolated bilinearly
 // where the path crosses that slice: O(cells), exact where the depth varies linearly across a
 // slice (a homogeneous slab), but it blurs sharp shadow edges over a few cells. Point and spot
-// lights: a shadow ray per cell, marched at stepCells, all cells in parallel (about 2 s for 128^3
-// on 2 cores). The spot's cone does not enter: it is part of E_l.
+// lights: the same, with each cell's path across its own dominant axis and the cells done in
+// layers outward from the light. The spot's cone does not enter: it is part of E_l.
 // With a signed-distance grid of solid obstacles (cell-centred, the density's layout), paths
 // through a solid are blocked: T_l is multiplied by the visibility V = clamp(1 + d_min / dx, 0, 1),
 // d_min the least distance sampled along the path, so V is 1 on paths that stay outside and 0 on

@@ -91,7 +91,7 @@ class CrowdPhenomenon final : public Phenomenon {
                                           stepIndex, time, a.id[i]));
   }
 
-  void writeVolume(const fs::path& vdbFile) const override {
+  void writeVolume(io::VdbWriter& writer) const override {
     const crowd::Agents& a = sim_->agents();
     io::PointCloud points;
     points.positions.reserve(a.size());
@@ -112,7 +112,6 @@ class CrowdPhenomenon final : public Phenomenon {
     attribute("goal", [&](std::size_t i) { return static_cast<double>(a.goal[i]); });
     attribute("group", [&](std::size_t i) { return static_cast<double>(a.group[i]); });
     attribute("model", [&](std::size_t i) { return static_cast<double>(a.model[i]); });
-    io::VdbWriter writer;
     writer.addPoints(kAgentPoints, points, std::max(0.5, setup_.settings.grid.dx));
     // Run state that is not per agent, as one point's attributes: what --resume needs.
     io::PointCloud state;
@@ -124,10 +123,9 @@ class CrowdPhenomenon final : public Phenomenon {
     for (std::size_t s = 0; s < self.scriptProgress().size(); ++s)
       state.attributes.push_back({fmt::format("script_next_{}", s), {static_cast<float>(self.scriptProgress()[s])}});
     writer.addPoints(kStatePoints, state, 1.0);
-    writer.addFloatGrid("density", sim_->uic().density());
+    writer.addFogVolume("density", sim_->uic().density());
     writer.addFloatGrid("pressure", sim_->uic().pressure());
     writer.addFloatGrid("free_area", sim_->freeArea().fraction());
-    writer.write(vdbFile);
   }
 
   void restore(const fs::path& vdbFile, double time) override {

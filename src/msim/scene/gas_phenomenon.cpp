@@ -153,12 +153,10 @@ class GasPhenomenon final : public Phenomenon {
     requireFinite(solver_.temperature(), "temperature", stepIndex, time);
   }
 
-  void writeVolume(const std::filesystem::path& vdbFile) const override {
-    io::VdbWriter writer;
-    writer.addFloatGrid("density", solver_.density());
+  void writeVolume(io::VdbWriter& writer) const override {
+    writer.addFogVolume("density", solver_.density());
     writer.addFloatGrid("temperature", solver_.temperature());
-    if (obstacleDistance_) writer.addFloatGrid("obstacle_distance", *obstacleDistance_);
-    writer.write(vdbFile);
+    if (obstacleDistance_) writer.addLevelSet("obstacle_distance", *obstacleDistance_);
   }
 
   io::Image preview() const override {

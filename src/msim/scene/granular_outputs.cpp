@@ -70,17 +70,16 @@ void writeBodyPly(const fs::path& file, const rigid::World& world, const std::ve
   io::writePlyMesh(file, all, std::span<const io::PointAttribute>(&id, 1));
 }
 
-void writeGranularVdb(const fs::path& file, const granular::GranularSimulation& sim, const std::vector<int>& bodies) {
+void addGranularFrame(io::VdbWriter& writer, const granular::GranularSimulation& sim, const std::vector<int>& bodies) {
   const GridSpec<3>& spec = sim.settings().grid;
-  io::VdbWriter writer;
-  auto cellGrid = [&](const char* name, const std::vector<double>& values) {
+  auto cellGrid = [&](const std::vector<double>& values) {
     Grid<float, 3> g(spec);
     if (values.size() == g.count())
       for (std::size_t i = 0; i < values.size(); ++i) g[i] = static_cast<float>(values[i]);
-    writer.addFloatGrid(name, g);
+    return g;
   };
-  cellGrid("phi", sim.gridState().phi);
-  cellGrid("pressure", sim.stress().pressure());
+  writer.addFogVolume("phi", cellGrid(sim.gridState().phi));
+  writer.addFloatGrid("pressure", cellGrid(sim.stress().pressure()));
   writer.addVectorGrid("velocity", sim.gridVelocity());
   // Points are bucketed into voxels of the cell size: 8 particles per cell when packed.
   writer.addPoints(kParticles, particleCloud(sim.particles(), true), spec.dx);
@@ -104,7 +103,6 @@ void writeGranularVdb(const fs::path& file, const granular::GranularSimulation& 
   bodyAttribute("wy", [](const rigid::RigidBody& b) { return b.angularVelocity.y(); });
   bodyAttribute("wz", [](const rigid::RigidBody& b) { return b.angularVelocity.z(); });
   if (!bodies.empty()) writer.addPoints(kBodies, state, spec.dx);
-  writer.write(file);
 }
 
 void restoreGranularVdb(const fs::path& file, granular::GranularSimulation& sim, const std::vector<int>& bodies,

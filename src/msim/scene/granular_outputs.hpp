@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "msim/granular/granular_simulation.hpp"
+#include "msim/io/vdb.hpp"
 
 namespace msim::scene {
 
@@ -17,9 +18,9 @@ void writeRenderPointPly(const std::filesystem::path& file, const granular::Rend
 // All of `bodies` (world indices) as one triangle mesh, vertex attribute "body" = scene index.
 void writeBodyPly(const std::filesystem::path& file, const rigid::World& world, const std::vector<int>& bodies);
 
-void writeGranularVdb(const std::filesystem::path& file, const granular::GranularSimulation& sim,
-                      const std::vector<int>& bodies);
-// Particles and body states from a file of writeGranularVdb; InputError naming `source` and the
+// The frame's grids (phi as a fog volume, pressure, velocity), particles and body states.
+void addGranularFrame(io::VdbWriter& writer, const granular::GranularSimulation& sim, const std::vector<int>& bodies);
+// Particles and body states from a frame of addGranularFrame; InputError naming `source` and the
 // file when something is missing or the body count differs.
 void restoreGranularVdb(const std::filesystem::path& file, granular::GranularSimulation& sim,
                         const std::vector<int>& bodies, const std::string& source);

@@ -93,7 +93,7 @@ class GranularPhenomenon final : public Phenomenon {
     }
   }
 
-  void writeVolume(const fs::path& vdbFile) const override { writeGranularVdb(vdbFile, sim_, setup_.bodies); }
+  void writeVolume(io::VdbWriter& writer) const override { addGranularFrame(writer, sim_, setup_.bodies); }
 
   void restore(const fs::path& vdbFile, double time) override {
     restoreGranularVdb(vdbFile, sim_, setup_.bodies, source_);

@@ -10,6 +10,7 @@
 
 #include "msim/core/timer.hpp"
 #include "msim/io/png.hpp"
+#include "msim/io/vdb.hpp"
 #include "msim/scene/schema/schema.hpp"
 
 namespace msim::scene {
@@ -27,8 +28,9 @@ class Phenomenon {
   // Called once after the last substep of every frame, before its outputs (per-frame
   // measurements that the outputs and statistics() then report). Nothing by default.
   virtual void endFrame() {}
-  // Frame outputs. Each call writes one complete file (the runner makes it atomic).
-  virtual void writeVolume(const std::filesystem::path& vdbFile) const = 0;
+  // Frame outputs. writeVolume adds the frame's grids and points to the runner's writer (the
+  // runner owns the file: its name, storage options and metadata).
+  virtual void writeVolume(io::VdbWriter& writer) const = 0;
   virtual io::Image preview() const = 0;
   // Restores the state saved by writeVolume at simulated time `time` [s] (for --resume).
   virtual void restore(const std::filesystem::path& vdbFile, double time) = 0;

@@ -115,7 +115,9 @@ std::shared_ptr<const RenderGeometry> loadGeometry(const json& r, const std::str
 
 Schema renderSchema() {
   Schema r = Schema::object("the physically based picture of each frame (3D scenes; Stam ch. 5)");
-  r.boolean("enabled", false, "render every frame into render/<name>_NNNN.png (needs outputs.vdb)");
+  r.boolean("enabled", false, "render the frames into render/<name>_NNNN.png (needs outputs.vdb)");
+  r.string("frames", "all", "with enabled: render every frame (and render/<name>_render.mp4) or only the last")
+      .choices({"all", "last"});
   r.boolean("exr", false, "also write each picture's linear radiance as a float OpenEXR file (.exr)");
   r.field("camera", cameraSchema());
   r.array("lights", lightSchema(), "light sources; none: one key light from above and in front");
@@ -141,6 +143,7 @@ Schema renderSchema() {
 RenderKeys renderKeys(const json& r, const std::string& source, const std::filesystem::path& baseDirectory) {
   RenderKeys k;
   k.enabled = r.at("enabled").get<bool>();
+  k.lastFrameOnly = r.at("frames").get<std::string>() == "last";
   k.exr = r.at("exr").get<bool>();
   render::FrameRenderConfig& c = k.config;
   const json& cam = r.at("camera");

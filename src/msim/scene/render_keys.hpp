@@ -28,6 +28,7 @@ struct RenderGeometry {
 
 struct RenderKeys {
   bool enabled = false;
+  bool lastFrameOnly = false;  // render.frames = "last": only the run's last frame is rendered
   bool exr = false;  // also write the linear radiance as OpenEXR next to each PNG
   int slabCells = 8;  // a 2D frame is rendered as a slab this many cells thick
   render::FrameRenderConfig config;

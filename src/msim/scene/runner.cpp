@@ -34,6 +34,7 @@ namespace {
 struct Layout {
   fs::path root, vdbDir, pngDir, renderDir;
   bool vdb = false, png = false, mp4 = false;
+  io::VdbWriteOptions vdbOptions;
   RenderKeys render;  // render.enabled: each saved frame is also rendered into renderDir
   std::string name;
 };
@@ -45,6 +46,8 @@ Layout layoutFor(const Scene& scene, const fs::path& outDir) {
   l.vdbDir = outDir / "vdb";
   l.pngDir = outDir / "png";
   l.vdb = o.at("vdb").get<bool>();
+  l.vdbOptions.halfFloat = o.at("vdb_half_float").get<bool>();
+  l.vdbOptions.fogTolerance = o.at("vdb_fog_tolerance").get<float>();
   l.png = o.at("png").get<bool>();
   l.mp4 = o.at("mp4").get<bool>() && l.png;
   l.name = scene.name();
@@ -55,6 +58,22 @@ Layout layoutFor(const Scene& scene, const fs::path& outDir) {
   if (l.render.enabled && !l.vdb)
     throw InputError(scene.file.string() + ": 'render.enabled' renders the saved VDB frames; set 'outputs.vdb' to true");
   return l;
+}
+
+// What a run left in its folder and how to look at it, for the end of the run.
+std::string describeOutputs(const Layout& l, int lastFrame) {
+  std::string text = fmt::format("\nwrote {}:\n", l.root.string());
+  const auto line = [&](const fs::path& path, const std::string& what) {
+    if (fs::exists(path)) text += fmt::format("  {:<40} {}\n", path.string(), what);
+  };
+  line(l.root / (l.name + ".mp4"), "movie of the previews (any video player, e.g. ffplay)");
+  line(l.root / (l.name + "_render.mp4"), "movie of the rendered frames");
+  line(frameFile(l.renderDir, l.name, lastFrame, "png"), "physically based render of the last frame");
+  line(frameFile(l.pngDir, l.name, lastFrame, "png"), "preview of the last frame (png/ holds every frame)");
+  line(frameFile(l.vdbDir, l.name, lastFrame, "vdb"),
+       "last frame's volumes (vdb/ holds every frame: Houdini, Blender, vdb_print; msim render)");
+  line(l.root / "run.json", "parameters, statistics and timings of the run");
+  return text;
 }
 
 bool frameComplete(const Layout& l, int frame) {
@@ -183,6 +202,11 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
     if (done > 0) {
       ScopedStage stage(timers, "resume: read frame");
       phenomenon->restore(frameFile(layout.vdbDir, layout.name, done, "vdb"), done / scene.fps);
+      if (layout.vdbOptions.halfFloat || layout.vdbOptions.fogTolerance > 0.0f)
+        logger().info("frame {} was stored with outputs.vdb_fog_tolerance = {:g}{}: the resumed run continues from "
+                      "those values, close to but not bit-equal with an uninterrupted run (a tolerance of 0 and full "
+                      "floats make resuming exact)",
+                      done, layout.vdbOptions.fogTolerance, layout.vdbOptions.halfFloat ? " in half floats" : "");
       record.adoptPreviousFrames(done);
     }
     firstFrame = done + 1;
@@ -228,9 +252,12 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
       }
       if (layout.vdb) {
         ScopedStage stage(timers, "write vdb");
-        phenomenon->writeVolume(frameFile(layout.vdbDir, layout.name, frame, "vdb"));
+        io::VdbWriter writer(layout.vdbOptions);
+        phenomenon->writeVolume(writer);
+        const io::VdbFrameInfo info{layout.name, frame, frameEnd};
+        writer.write(frameFile(layout.vdbDir, layout.name, frame, "vdb"), &info);
       }
-      if (layout.render.enabled) {
+      if (layout.render.enabled && (!layout.render.lastFrameOnly || frame == lastFrame)) {
         // From the file just written, exactly as 'msim render' would make it later.
         ScopedStage stage(timers, "render frame");
         renderSavedFrame(io::VdbFile(frameFile(layout.vdbDir, layout.name, frame, "vdb"), io::VdbProvenance::MsimRun),
@@ -272,14 +299,17 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
       logger().warn("{}", video.note);
       record.note("mp4", video.note);
     }
-    if (layout.render.enabled && video.written) {
+    if (layout.render.enabled && !layout.render.lastFrameOnly && video.written) {
       std::vector<fs::path> rendered;
       for (int f = 1; f <= lastFrame; ++f) rendered.push_back(frameFile(layout.renderDir, layout.name, f, "png"));
       io::encodeMp4(rendered, scene.fps, layout.root / (layout.name + "_render.mp4"));
     }
   }
   record.save(status == RunStatus::Complete ? "complete" : "interrupted", timers, wall());
-  if (options.showProgress) std::fprintf(stderr, "%s", timers.formatTable().c_str());
+  if (options.showProgress) {
+    std::fprintf(stderr, "%s", timers.formatTable().c_str());
+    std::fprintf(stderr, "%s", describeOutputs(layout, lastFrame).c_str());
+  }
   return status;
 }
 

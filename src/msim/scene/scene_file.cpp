@@ -39,8 +39,10 @@ Schema domainSchema() {
 
 Schema timeSchema() {
   Schema time = Schema::object("frames and substeps");
-  time.number("duration", "s", 2.0, "simulated time").min(0.0, Bound::Exclusive);
-  time.number("fps", "1/s", 24.0, "frames written per second of simulated time").min(0.0, Bound::Exclusive);
+  // Upper bounds far beyond any use (three years; a frame every 10 microseconds) keep absurd
+  // values from passing as a plausible frame count.
+  time.number("duration", "s", 2.0, "simulated time").min(0.0, Bound::Exclusive).max(1e8);
+  time.number("fps", "1/s", 24.0, "frames written per second of simulated time").min(0.0, Bound::Exclusive).max(1e5);
   time.number("cfl", "", 0.9, "fraction of the largest stable substep actually taken")
       .min(0.0, Bound::Exclusive)
       .max(1.0);
@@ -51,6 +53,12 @@ Schema timeSchema() {
 Schema outputsSchema() {
   Schema outputs = Schema::object("what each frame writes");
   outputs.boolean("vdb", true, "OpenVDB volumes per frame (needed by --resume)");
+  outputs.boolean("vdb_half_float", false,
+                  "store float and vector grids as 16-bit halves: half the size, --resume no longer bit-exact");
+  outputs.number("vdb_fog_tolerance", "", 1e-6,
+                 "fog-volume values (densities) at or below this are inactive; 0 keeps every nonzero value "
+                 "(then --resume is bit-exact)")
+      .min(0.0);
   outputs.boolean("png", true, "preview picture per frame");
   outputs.boolean("mp4", true, "movie of the previews at the end (needs ffmpeg)");
   Schema preview = Schema::object("the per-frame preview picture");

@@ -138,13 +138,12 @@ class SmokePhenomenon final : public Phenomenon {
   // density, temperature (and fuel, flame) for users; "vel" at cell centres in 3D for tools; the
   // face velocities vel_face_x.. and the pressure (the next solve's warm start) make --resume exact;
   // "obstacle_distance" (signed, at cell centres) lets renderers draw the obstacles.
-  void writeVolume(const std::filesystem::path& vdbFile) const override {
-    io::VdbWriter writer;
+  void writeVolume(io::VdbWriter& writer) const override {
     // With turbulence the smoke lives on the fine grid; the coarse scalars are its averages.
-    writer.addFloatGrid("density", turbulence_ ? turbulence_->density() : solver_.density());
+    writer.addFogVolume("density", turbulence_ ? turbulence_->density() : solver_.density());
     writer.addFloatGrid("temperature", turbulence_ ? turbulence_->temperature() : solver_.temperature());
     if (turbulence_) writer.addFloatGrid("turbulent_energy", turbulence_->energy().energy());
-    for (std::size_t i = 0; i < solver_.scalarCount(); ++i) writer.addFloatGrid(solver_.scalarName(i), solver_.scalar(i));
+    for (std::size_t i = 0; i < solver_.scalarCount(); ++i) writer.addFogVolume(solver_.scalarName(i), solver_.scalar(i));
     if constexpr (D == 3) {
       if (turbulence_ && turbulence_->params().writeVelocity)
         writer.addVectorGrid("vel", turbulence_->fineVelocity(solver_.velocity()));
@@ -153,8 +152,7 @@ class SmokePhenomenon final : public Phenomenon {
     }
     for (int a = 0; a < D; ++a) writer.addFloatGrid(faceGridName(a), faceAsCells(solver_.velocity().component(a)));
     writer.addFloatGrid("pressure", solver_.pressure());
-    if (!obstacles_.empty()) writer.addFloatGrid("obstacle_distance", obstacles_.cellDistance(time_));
-    writer.write(vdbFile);
+    if (!obstacles_.empty()) writer.addLevelSet("obstacle_distance", obstacles_.cellDistance(time_));
   }
 
   io::Image preview() const override {
