@@ -1,6 +1,7 @@
 // Global planning (Narain 2011 ch. 4.3.1) on a 120 x 108 m scene with 120 rotated square
 // obstacles: navigation field build at 0.25 m cells (one goal and four goals in parallel), roadmap
-// build (CDT + Floyd-Warshall), and per-agent query cost (direction) for both planners.
+// build (CDT + Floyd-Warshall), and per-agent query cost (direction) for both planners. The
+// roadmap's benchmarks are in builds with the optional roadmap planner (-DMSIM_WITH_CGAL=ON).
 #include <benchmark/benchmark.h>
 
 #include <cmath>
@@ -10,7 +11,9 @@
 
 #include "msim/core/rng.hpp"
 #include "msim/crowd/navigation_field.hpp"
-#include "msim/crowd/roadmap.hpp"
+#if MSIM_WITH_ROADMAP
+#include "msim/crowd/roadmap/roadmap.hpp"
+#endif
 
 using namespace msim;
 using namespace msim::crowd;
@@ -68,12 +71,14 @@ NavigationFieldOptions fieldOptions() {
   return o;
 }
 
+#if MSIM_WITH_ROADMAP
 RoadmapOptions roadmapOptions() {
   RoadmapOptions o;
   o.lo = kLo, o.hi = kHi;
   o.spacing = 0;  // the seed's bare triangulation: the Steiner lattice would need > 10k vertices here
   return o;
 }
+#endif
 
 void BM_NavigationFieldBuild(benchmark::State& state) {
   for (auto _ : state) {
@@ -93,6 +98,7 @@ void BM_NavigationFieldDirection(benchmark::State& state) {
 }
 BENCHMARK(BM_NavigationFieldDirection);
 
+#if MSIM_WITH_ROADMAP
 void BM_RoadmapBuild(benchmark::State& state) {
   for (auto _ : state) {
     const Roadmap roadmap(goals(1), obstacles(), roadmapOptions());
@@ -109,5 +115,6 @@ void BM_RoadmapDirection(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * xs.size());
 }
 BENCHMARK(BM_RoadmapDirection);
+#endif
 
 }  // namespace

@@ -7,7 +7,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config ccache
   libtbb-dev libeigen3-dev nlohmann-json3-dev libcli11-dev libspdlog-dev libfmt-dev
-  libpng-dev libopenexr-dev libopenvdb-dev libboost-iostreams-dev libgtest-dev libgmock-dev libbenchmark-dev libcgal-dev libkissfft-dev libxxhash-dev
+  libpng-dev libopenexr-dev libopenvdb-dev libboost-dev libboost-iostreams-dev libgtest-dev libgmock-dev libbenchmark-dev libkissfft-dev libxxhash-dev
   ffmpeg
   libopenvdb-tools  # vdb_print: the tests check that OpenVDB's own tools read msim's frames
 )

@@ -1,18 +1,42 @@
 #include "msim/crowd/agents.hpp"
 
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/hilbert_sort.h>
+#include <algorithm>
 
 namespace msim::crowd {
 
-void sortSpatially(std::vector<Vec2>& points) {
-  using Point = CGAL::Exact_predicates_inexact_constructions_kernel::Point_2;
-  std::vector<Point> sorted;
-  sorted.reserve(points.size());
-  for (const Vec2& p : points) sorted.emplace_back(p.x(), p.y());
-  CGAL::hilbert_sort(sorted.begin(), sorted.end());  // median policy: no randomness
-  for (std::size_t i = 0; i < points.size(); ++i) points[i] = Vec2(sorted[i].x(), sorted[i].y());
+namespace {
+
+// Reorders [begin, end) so that it is split at its middle position along `axis`: ascending, or
+// descending when `descending`.
+std::vector<Vec2>::iterator medianSplit(std::vector<Vec2>::iterator begin, std::vector<Vec2>::iterator end, int axis,
+                                        bool descending) {
+  const auto middle = begin + (end - begin) / 2;
+  std::nth_element(begin, middle, end, [&](const Vec2& p, const Vec2& q) {
+    return descending ? q[axis] < p[axis] : p[axis] < q[axis];
+  });
+  return middle;
 }
+
+// The median Hilbert sort: halve the points at the median along `first`, each half at its median
+// along the other axis (in opposite directions), and visit the four quarters in the order of the
+// Hilbert curve, recursing with the axes and directions the curve's turns give each quarter.
+// Median splits adapt to any distribution of points and need no grid or bounding box.
+void hilbertSort(std::vector<Vec2>::iterator begin, std::vector<Vec2>::iterator end, int first, bool reverseFirst,
+                 bool reverseSecond) {
+  if (end - begin <= 1) return;
+  const int second = 1 - first;
+  const auto half = medianSplit(begin, end, first, reverseFirst);
+  const auto quarter = medianSplit(begin, half, second, reverseSecond);
+  const auto threeQuarters = medianSplit(half, end, second, !reverseSecond);
+  hilbertSort(begin, quarter, second, reverseSecond, reverseFirst);
+  hilbertSort(quarter, half, first, reverseFirst, reverseSecond);
+  hilbertSort(half, threeQuarters, first, reverseFirst, reverseSecond);
+  hilbertSort(threeQuarters, end, second, !reverseSecond, !reverseFirst);
+}
+
+}  // namespace
+
+void sortSpatially(std::vector<Vec2>& points) { hilbertSort(points.begin(), points.end(), 0, false, false); }
 
 void Agents::reserve(std::size_t n) {
   position.reserve(n);

@@ -29,7 +29,7 @@ struct AgentSpec {
   std::uint32_t group = 0;         // user label (inflow, spawn region), for metrics and colours
 };
 
-// Orders points along a Hilbert curve (CGAL's hilbert_sort), so that agents added in this order
+// Orders points along a Hilbert curve (median splits), so that agents added in this order
 // are stored next to their neighbours: the per-agent passes of a step (splat, gather, collision
 // buckets) then read memory nearly in order instead of at random. Agents placed at random get
 // their ids in this order; it lasts as long as neighbours stay neighbours.

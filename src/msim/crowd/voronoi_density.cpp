@@ -1,5 +1,5 @@
-// The only translation unit that includes CGAL (its headers are heavy): the Delaunay
-// triangulation gives each agent's Voronoi neighbours, the cells themselves are built here by
+// Boost.Polygon's Voronoi diagram (Fortune's sweep with exact predicates on integer sites) gives
+// each agent's Voronoi neighbours; the cells themselves are built here from the exact positions by
 // half-plane clipping, which also handles the unbounded cells at the edge of the crowd.
 #include "msim/crowd/voronoi_density.hpp"
 
@@ -10,19 +10,17 @@
 #include <string>
 #include <utility>
 
-#include <CGAL/Delaunay_triangulation_2.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Triangulation_vertex_base_with_info_2.h>
+#include <boost/polygon/voronoi.hpp>
 
 #include "msim/core/parallel.hpp"
 
 namespace msim::crowd {
 namespace {
 
-using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using VertexBase = CGAL::Triangulation_vertex_base_with_info_2<std::uint32_t, Kernel>;
-using Tds = CGAL::Triangulation_data_structure_2<VertexBase>;
-using Delaunay = CGAL::Delaunay_triangulation_2<Kernel, Tds>;
+// Boost.Polygon's Voronoi builder takes 32-bit integer coordinates: positions are scaled so the
+// crowd's extent spans 2^31 units around its centre.
+using Site = boost::polygon::point_data<std::int32_t>;
+constexpr double kSiteUnits = 2147483648.0;  // 2^31
 
 double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
 
@@ -112,38 +110,42 @@ VoronoiCells voronoiCells(std::span<const Vec2f> positions, const VoronoiOptions
         throw std::invalid_argument("voronoiCells: agent " + std::to_string(i) + " lies outside the domain box");
   }
 
-  // One Delaunay vertex per distinct position: sort, then group equal positions.
+  // One site per distinct position (to 2^-31 of the crowd's extent): sort, then group equal sites.
+  Vec2 first = Vec2::Constant(std::numeric_limits<double>::infinity()), last = -first;
+  for (const Vec2& x : out.centres) first = first.cwiseMin(x), last = last.cwiseMax(x);
+  const Vec2 middle = 0.5 * (first + last);
+  const double scale = n > 0 && (last - first).maxCoeff() > 0.0 ? kSiteUnits / (last - first).maxCoeff() : 1.0;
+  std::vector<Site> sites(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec2 s = ((out.centres[i] - middle) * scale).array().round();  // within +-2^30
+    sites[i] = Site(static_cast<std::int32_t>(s.x()), static_cast<std::int32_t>(s.y()));
+  }
   std::vector<std::uint32_t> order(n);
   for (std::size_t i = 0; i < n; ++i) order[i] = static_cast<std::uint32_t>(i);
   const auto less = [&](std::uint32_t a, std::uint32_t b) {
-    return std::pair(out.centres[a].x(), out.centres[a].y()) < std::pair(out.centres[b].x(), out.centres[b].y());
+    return std::pair(sites[a].x(), sites[a].y()) < std::pair(sites[b].x(), sites[b].y());
   };
   std::sort(order.begin(), order.end(), less);
   std::vector<std::uint32_t> groupOf(n), groupStart;
   for (std::size_t k = 0; k < n; ++k) {
-    if (k == 0 || out.centres[order[k]] != out.centres[order[k - 1]]) groupStart.push_back(static_cast<std::uint32_t>(k));
+    if (k == 0 || sites[order[k]] != sites[order[k - 1]]) groupStart.push_back(static_cast<std::uint32_t>(k));
     groupOf[order[k]] = static_cast<std::uint32_t>(groupStart.size() - 1);
   }
   const std::size_t groups = groupStart.size();
   groupStart.push_back(static_cast<std::uint32_t>(n));
 
-  std::vector<std::pair<Kernel::Point_2, std::uint32_t>> sites(groups);
-  for (std::size_t g = 0; g < groups; ++g) {
-    const Vec2& x = out.centres[order[groupStart[g]]];
-    sites[g] = {Kernel::Point_2(x.x(), x.y()), static_cast<std::uint32_t>(g)};
-  }
-  Delaunay triangulation;
-  triangulation.insert(sites.begin(), sites.end());
+  std::vector<Site> groupSites(groups);
+  for (std::size_t g = 0; g < groups; ++g) groupSites[g] = sites[order[groupStart[g]]];
+  boost::polygon::voronoi_diagram<double> diagram;
+  boost::polygon::construct_voronoi(groupSites.begin(), groupSites.end(), &diagram);
 
-  // Delaunay neighbours suffice: the Voronoi cell is the intersection of their bisector
-  // half-planes. In dimension 1 (collinear sites) the edges are (f, 2) and this still holds.
+  // The Voronoi cell is the intersection of the bisector half-planes of the sites it shares an
+  // edge with (its Delaunay neighbours); each edge is stored twice, once per side.
   std::vector<std::vector<std::uint32_t>> neighbours(groups);
-  for (auto e = triangulation.finite_edges_begin(); e != triangulation.finite_edges_end(); ++e) {
-    const auto face = e->first;
-    const std::uint32_t a = face->vertex(face->cw(e->second))->info();
-    const std::uint32_t b = face->vertex(face->ccw(e->second))->info();
-    neighbours[a].push_back(b);
-    neighbours[b].push_back(a);
+  for (const auto& edge : diagram.edges()) {
+    const auto a = static_cast<std::uint32_t>(edge.cell()->source_index());
+    const auto b = static_cast<std::uint32_t>(edge.twin()->cell()->source_index());
+    if (a != b) neighbours[a].push_back(b);
   }
 
   std::vector<Polygon> groupCells(groups);

@@ -22,8 +22,8 @@ struct VoronoiOptions {
   std::optional<Vec2> domainLo, domainHi;
 };
 
-// The clipped Voronoi cells of a frame. Agents at the same position share one cell (CGAL keeps
-// one vertex per point), so each of them owns 1/multiplicity of it.
+// The clipped Voronoi cells of a frame. Agents at the same position (to 2^-31 of the crowd's
+// extent) share one cell, so each of them owns 1/multiplicity of it.
 struct VoronoiCells {
   std::vector<Vec2> centres;               // agent positions [m]
   std::vector<Polygon> cells;              // Voronoi cell ∩ domain box ∩ the disc's bounding square
@@ -34,7 +34,7 @@ struct VoronoiCells {
   double area(std::size_t i) const;
 };
 
-// Delaunay triangulation (CGAL) of the positions, then each cell as the box clipped by the
+// Voronoi diagram of the positions (Boost.Polygon), then each cell as the box clipped by the
 // bisectors to the Delaunay neighbours. std::invalid_argument for non-finite positions, R <= 0,
 // an empty box or an agent outside it. Parallel over agents.
 VoronoiCells voronoiCells(std::span<const Vec2f> positions, const VoronoiOptions& options = {});

@@ -10,7 +10,9 @@
 #include "msim/crowd/direct_planner.hpp"
 #include "msim/crowd/navigation_field.hpp"
 #include "msim/crowd/obstacle_index.hpp"
-#include "msim/crowd/roadmap.hpp"
+#if MSIM_WITH_ROADMAP
+#include "msim/crowd/roadmap/roadmap.hpp"
+#endif
 #include "msim/scene/json_vectors.hpp"
 #include "msim/scene/scene_file.hpp"
 
@@ -85,7 +87,9 @@ Schema crowdKeys() {
   orca.number("time_horizon_obstacles", "s", 1.0, "avoid obstacles this far ahead in time").min(0.0, Bound::Exclusive);
   c.field("orca", orca);
   Schema planner = Schema::object("global planning (ch. 4.3.1)");
-  planner.string("type", "auto", "auto: direct without obstacles, else navigation_field; roadmap: the seed's CDT roadmap")
+  planner.string("type", "auto",
+                 "auto: direct without obstacles, else navigation_field; roadmap: the seed's CDT roadmap (in builds "
+                 "with -DMSIM_WITH_CGAL=ON)")
       .choices({"auto", "direct", "navigation_field", "roadmap"});
   planner.number("cell_size", "m", 0.25, "navigation field cell").min(0.0, Bound::Exclusive);
   c.field("planner", planner);
@@ -413,11 +417,17 @@ struct Builder {
       fail("crowd.planner.type", fmt::format("'{}' plans for a few shared goals, but groups with goal 'opposite' give every "
                                              "agent its own; use 'direct' (scenes without obstacles)", type));
     if (type == "roadmap") {
+#if MSIM_WITH_ROADMAP
       crowd::RoadmapOptions o;
       o.lo = out.settings.lo;
       o.hi = out.settings.hi;
       out.planner = std::make_shared<crowd::Roadmap>(out.goals, out.obstacles, o);
       return;
+#else
+      fail("crowd.planner.type",
+           "'roadmap' needs the optional roadmap planner, which this build leaves out (it triangulates with CGAL, "
+           "whose 2D triangulations are GPL-3): build with -DMSIM_WITH_CGAL=ON, or use 'navigation_field'");
+#endif
     }
     crowd::NavigationFieldOptions o;
     o.lo = out.settings.lo;

@@ -1,4 +1,4 @@
-#include "msim/crowd/roadmap.hpp"
+#include "msim/crowd/roadmap/roadmap.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // Roadmap planner (Narain 2011 ch. 4.3.1). CGAL stays in this file: the triangulation is only
 // needed while building; queries use the roadmap tables and two uniform grids.
-#include "msim/crowd/roadmap.hpp"
+#include "msim/crowd/roadmap/roadmap.hpp"
 
 #include <algorithm>
 #include <cmath>
