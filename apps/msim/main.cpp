@@ -84,6 +84,8 @@ int main(int argc, char** argv) {
   render->add_option("input", renderInput, "a folder written by 'msim run', or a .vdb file")->required();
   render->add_option("--out", renderOutput, "output folder (run; default <run>/render) or file (.vdb; default <file>.png)");
   render->add_option("--set", overrides, "override a render key: render.key.path=value (repeatable)");
+  bool renderLast = false;
+  render->add_flag("--last", renderLast, "a run folder: render only its last frame");
 
   scene::SpectrumJob spectrumJob;
   auto* spectrum = app.add_subcommand("spectrum", "kinetic energy spectrum of saved 3D velocity fields (.vdb), as CSV and PNG");
@@ -131,6 +133,7 @@ int main(int argc, char** argv) {
       scene::RenderJob job;
       job.input = renderInput;
       job.output = renderOutput;
+      job.lastFrameOnly = renderLast;
       job.overrides = overrides;
       job.showProgress = !quiet;
       const auto written = scene::renderSavedFrames(job);

@@ -74,6 +74,15 @@ TEST(RenderCli, LastFrameOnlyAndTheRunListsWhatItWrote) {
   EXPECT_NE(r.output.find((dir / "out" / "run.json").string()), std::string::npos) << r.output;
 }
 
+TEST(RenderCli, LastRendersOnlyTheRunsLastFrame) {
+  const fs::path dir = simulate("render_last_flag", R"(, "render": {"camera": {"width": 32, "height": 32}})");
+  const Result r = runMsim("render " + (dir / "out").string() + " --last -q --out " + (dir / "pictures").string());
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "pictures" / "tiny3d_0001.png"));
+  EXPECT_TRUE(fs::exists(dir / "pictures" / "tiny3d_0002.png"));
+  EXPECT_EQ(msim::io::readPng(dir / "pictures" / "tiny3d_0002.png").width, 32);  // the run's own camera keys
+}
+
 TEST(RenderCli, CameraInsideAnObstacleIsRefused) {
   const fs::path dir = simulate("render_inside", R"(, "obstacles": [{"shape": {"type": "sphere", "center": [0.5, 0.75, 0.5],
       "radius": 0.15}}])");

@@ -124,6 +124,7 @@ std::vector<fs::path> renderSavedFrames(const RenderJob& job) {
         if (e.path().extension() == ".vdb") frames.push_back(e.path());
     std::sort(frames.begin(), frames.end());
     if (frames.empty()) throw InputError(source + ": the run has no VDB frames (was outputs.vdb false?)");
+    if (job.lastFrameOnly) frames.erase(frames.begin(), frames.end() - 1);
     outDir = job.output.empty() ? job.input / "render" : job.output;
   } else if (job.input.extension() == ".vdb") {
     if (!fs::exists(job.input)) throw InputError(source + ": no such file");

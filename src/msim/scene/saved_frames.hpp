@@ -24,10 +24,11 @@ struct RenderJob {
   std::filesystem::path output;  // folder for a run (default <input>/render), file for a .vdb (default <input>.png)
                                  // (with render.exr, an .exr of the same name beside each picture)
   std::vector<std::string> overrides;  // "render.key=value" changes to the stored keys
+  bool lastFrameOnly = false;          // a run folder: render only its last frame
   bool showProgress = true;
 };
 
-// Renders every frame of the job; returns the pictures written. InputError for a path that is
+// Renders every frame of the job (or the last); returns the pictures written. InputError for a path that is
 // neither, a run folder without run.json or frames, or bad keys.
 std::vector<std::filesystem::path> renderSavedFrames(const RenderJob& job);
 
