@@ -7,8 +7,9 @@
 # Each scene runs into out/gallery/<scene> with the settings of its gallery row (frame count and
 # --set overrides, listed below); the preview of its last frame becomes docs/images/<scene>.png and,
 # for gases and smoke, `msim render --last` of the run (its own render keys: camera, lights, medium)
-# docs/images/render_<scene>.png (2D scenes render as slabs). Needs the release build (make app). The whole table takes about
-# an hour on 2 cores; the slow rows say so.
+# docs/images/render_<scene>.png (2D scenes render as slabs). Needs the release build (make app).
+# The whole table takes about 30 minutes on 2 cores, most of it the large crowds, the turbulent
+# smoke and the hourglasses.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 msim=build/release/bin/msim
