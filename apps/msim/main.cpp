@@ -16,6 +16,8 @@
 #include "msim/core/float_environment.hpp"
 #include "msim/core/log.hpp"
 #include "msim/core/system_memory.hpp"
+#include "msim/io/png.hpp"
+#include "msim/render/image_detail.hpp"
 #include "msim/scene/interrupt.hpp"
 #include "msim/scene/runner.hpp"
 #include "msim/scene/saved_frames.hpp"
@@ -93,6 +95,15 @@ int main(int argc, char** argv) {
   spectrum->add_option("--grid", spectrumJob.grid, "the vector grid (default vel)");
   spectrum->add_option("--out", spectrumJob.output, "prefix of the CSV files and the chart (default <first file>_spectrum)");
 
+  std::vector<std::string> detailPictures;
+  std::vector<int> detailCrop;
+  auto* detail = app.add_subcommand(
+      "detail", "share of a picture's spectral energy above half the Nyquist frequency (fine detail, 0..1)");
+  detail->add_option("pictures", detailPictures, "one or more .png pictures")->required();
+  detail->add_option("--crop", detailCrop, "measure only the pixels X0 <= x < X1, Y0 <= y < Y1 (y from the top)")
+      ->expected(4)
+      ->allow_extra_args(false);
+
   std::string phenomenonName;
   auto* schema = app.add_subcommand("schema", "print the Markdown reference of every scene key of a phenomenon");
   schema->add_option("phenomenon", phenomenonName, "phenomenon name, e.g. gas")->required();
@@ -127,6 +138,19 @@ int main(int argc, char** argv) {
                    fit, r.at("csv").get<std::string>());
       }
       fmt::print("chart: {}\n", result.at("png").get<std::string>());
+      return 0;
+    }
+    if (*detail) {
+      for (const std::string& file : detailPictures) {
+        const io::Image picture = io::readPng(file);
+        render::PixelBox box{0, 0, picture.width, picture.height};
+        if (!detailCrop.empty()) box = {detailCrop[0], detailCrop[1], detailCrop[2], detailCrop[3]};
+        try {
+          fmt::print("{:.3e}  {}\n", render::fineDetailShare(picture, box), file);
+        } catch (const std::invalid_argument& e) {
+          throw InputError(file + ": --crop: " + e.what());
+        }
+      }
       return 0;
     }
     if (*render) {

@@ -83,6 +83,25 @@ TEST(RenderCli, LastRendersOnlyTheRunsLastFrame) {
   EXPECT_EQ(msim::io::readPng(dir / "pictures" / "tiny3d_0002.png").width, 32);  // the run's own camera keys
 }
 
+TEST(RenderCli, DetailMeasuresAPictureAndNamesABadCrop) {
+  const fs::path dir =
+      simulate("render_detail", R"(, "render": {"enabled": true, "frames": "last", "camera": {"width": 40, "height": 30}})");
+  const std::string picture = (dir / "out" / "render" / "tiny3d_0002.png").string();
+  const Result r = runMsim("detail --crop 0 0 40 20 " + picture + " " + picture);  // two pictures after the crop
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 2) << r.output;
+  const double share = std::stod(r.output);
+  EXPECT_GE(share, 0.0);
+  EXPECT_LE(share, 1.0);
+  EXPECT_NE(r.output.find(picture), std::string::npos) << r.output;
+  const Result badCrop = runMsim("detail " + picture + " --crop 0 0 41 20");
+  EXPECT_EQ(badCrop.exitCode, 2) << badCrop.output;
+  EXPECT_NE(badCrop.output.find("--crop"), std::string::npos) << badCrop.output;
+  const Result missing = runMsim("detail " + (dir / "nothing.png").string());
+  EXPECT_EQ(missing.exitCode, 2) << missing.output;
+  EXPECT_NE(missing.output.find("nothing.png"), std::string::npos) << missing.output;
+}
+
 TEST(RenderCli, CameraInsideAnObstacleIsRefused) {
   const fs::path dir = simulate("render_inside", R"(, "obstacles": [{"shape": {"type": "sphere", "center": [0.5, 0.75, 0.5],
       "radius": 0.15}}])");
