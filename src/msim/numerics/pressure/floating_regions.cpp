@@ -5,7 +5,7 @@
 namespace msim::numerics {
 
 template <int D>
-FloatingRegions<D>::FloatingRegions(const MacGrid<D>& faceWeight) {
+FloatingRegions<D>::FloatingRegions(const MacGrid<D>& faceWeight, const std::vector<float>& dirichletDiagonal) {
   const GridSpec<D>& spec = faceWeight.spec();
   const Grid<float, D> cells(spec);  // only for its index arithmetic
   std::vector<std::uint8_t> visited(spec.cellCount(), 0);
@@ -28,6 +28,7 @@ FloatingRegions<D>::FloatingRegions(const MacGrid<D>& faceWeight) {
       stack.pop_back();
       const IVec<D> c = cells.coord(cell);
       bool open = false;
+      if (!dirichletDiagonal.empty() && dirichletDiagonal[cell] > 0.0f) open = grounded = true;
       for (int a = 0; a < D; ++a) {
         for (int side = 0; side < 2; ++side) {
           IVec<D> face = c;

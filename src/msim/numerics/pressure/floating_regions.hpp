@@ -17,8 +17,9 @@ class FloatingRegions {
  public:
   FloatingRegions() = default;
   // faceWeight as for PoissonMatrix: cells connect through faces of positive weight; a region
-  // is grounded when one of its domain-boundary faces has positive weight.
-  explicit FloatingRegions(const MacGrid<D>& faceWeight);
+  // is grounded when one of its domain-boundary faces has positive weight, or one of its cells a
+  // positive dirichletDiagonal (PoissonMatrix's: a free surface fixes the pressure as well).
+  explicit FloatingRegions(const MacGrid<D>& faceWeight, const std::vector<float>& dirichletDiagonal = {});
 
   std::size_t count() const { return regions_.size(); }
   const std::vector<std::uint32_t>& cells(std::size_t region) const { return regions_[region]; }

@@ -10,7 +10,11 @@
 namespace msim::numerics {
 
 template <int D>
-PoissonMatrix<D>::PoissonMatrix(const MacGrid<D>& faceWeight) : res_(faceWeight.spec().res) {
+PoissonMatrix<D>::PoissonMatrix(const MacGrid<D>& faceWeight) : PoissonMatrix(faceWeight, {}) {}
+
+template <int D>
+PoissonMatrix<D>::PoissonMatrix(const MacGrid<D>& faceWeight, const std::vector<float>& dirichletDiagonal)
+    : res_(faceWeight.spec().res) {
   const std::size_t n = faceWeight.spec().cellCount();
   std::size_t s = 1;
   for (int a = 0; a < D; ++a) {
@@ -30,6 +34,7 @@ PoissonMatrix<D>::PoissonMatrix(const MacGrid<D>& faceWeight) : res_(faceWeight.
       lower_[a][lin] = w(c);
       d += w(c) + w(up);
     }
+    if (!dirichletDiagonal.empty()) d += dirichletDiagonal[lin];
     diag_[lin] = d;
     invDiag_[lin] = d > 0.0f ? 1.0f / d : 0.0f;
   });

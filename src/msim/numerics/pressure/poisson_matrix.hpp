@@ -26,6 +26,11 @@ class PoissonMatrix {
   PoissonMatrix() = default;
   // faceWeight: the weight of every face including the domain boundary faces (MacGrid layout).
   explicit PoissonMatrix(const MacGrid<D>& faceWeight);
+  // With Dirichlet conditions inside the domain (a free surface): faceWeight couples the cells
+  // that have unknowns, and dirichletDiagonal[i] >= 0 adds the terms of cell i's faces towards
+  // pressures that are given (w_f / theta_f for a ghost-fluid interface at the fraction theta_f of
+  // the way to the neighbour's centre). A cell with no coupling and no Dirichlet term has no unknown.
+  PoissonMatrix(const MacGrid<D>& faceWeight, const std::vector<float>& dirichletDiagonal);
 
   const IVec<D>& res() const { return res_; }
   std::size_t size() const { return diag_.size(); }

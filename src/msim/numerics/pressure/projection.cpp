@@ -1,6 +1,7 @@
 #include "msim/numerics/pressure/projection.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -37,12 +38,73 @@ void PressureProjection<D>::setSolids(const MacGrid<D>& openFraction) {
   }
   matrix_ = PoissonMatrix<D>(weights_);
   floating_ = FloatingRegions<D>(weights_);
+  freeSurface_ = false;
+  inverseTheta_ = MacGrid<D>();
+  buildPreconditioner();
+}
+
+template <int D>
+void PressureProjection<D>::buildPreconditioner() {
   mic0_.reset();
   multigrid_.reset();
-  if (settings_.preconditioner == PressurePreconditioner::Mic0)
+  if (freeSurface_ || settings_.preconditioner == PressurePreconditioner::Mic0)
     mic0_ = std::make_unique<Mic0Preconditioner<D>>(matrix_, settings_.mic0);
   else
     multigrid_ = std::make_unique<MultigridPreconditioner<D>>(matrix_, weights_, settings_.multigrid);
+}
+
+template <int D>
+void PressureProjection<D>::setFreeSurface(const Grid<float, D>& liquidPhi, float minTheta) {
+  if (!liquidPhi.sameLayout(pressure_))
+    throw std::invalid_argument("pressure projection: the liquid's phi must be cell-centred on the pressure grid");
+  auto liquid = [&](std::size_t cell) { return liquidPhi[cell] < 0.0f; };
+  auto theta = [&](std::size_t wet, std::size_t dry) {
+    return std::max(minTheta, liquidPhi[wet] / (liquidPhi[wet] - liquidPhi[dry]));
+  };
+  // Couplings only between liquid cells (a boundary face keeps its weight when its cell is
+  // liquid: the open side's ghost pressure is 0 as before); 1 / theta on the liquid-air faces.
+  MacGrid<D> coupling(spec_, 0.0f);
+  inverseTheta_ = MacGrid<D>(spec_, 1.0f);
+  for (int a = 0; a < D; ++a) {
+    const auto& w = weights_.component(a);
+    auto& c = coupling.component(a);
+    auto& it = inverseTheta_.component(a);
+    parallelForCells(w, [&](const IVec<D>& f, std::size_t lin) {
+      IVec<D> low = f;
+      low[a] -= 1;
+      const bool hasLow = f[a] > 0, hasUp = f[a] < spec_.res[a];
+      const std::size_t up = hasUp ? liquidPhi.index(f) : 0, lo = hasLow ? liquidPhi.index(low) : 0;
+      if (!hasLow || !hasUp) {
+        c[lin] = liquid(hasUp ? up : lo) ? w[lin] : 0.0f;
+      } else if (liquid(lo) && liquid(up)) {
+        c[lin] = w[lin];
+      } else if (liquid(lo) != liquid(up)) {
+        it[lin] = 1.0f / (liquid(lo) ? theta(lo, up) : theta(up, lo));
+      }
+    });
+  }
+  // Each liquid cell's Dirichlet terms: w_f / theta over its faces towards air.
+  std::vector<float> dirichlet(spec_.cellCount(), 0.0f);
+  parallelForCells(liquidPhi, [&](const IVec<D>& c, std::size_t cell) {
+    if (!liquid(cell)) return;
+    float sum = 0.0f;
+    for (int a = 0; a < D; ++a) {
+      for (int side = 0; side < 2; ++side) {
+        IVec<D> face = c;
+        face[a] += side;
+        IVec<D> nb = c;
+        nb[a] += side ? 1 : -1;
+        if (nb[a] < 0 || nb[a] >= spec_.res[a]) continue;
+        const std::size_t n = liquidPhi.index(nb);
+        if (!liquid(n)) sum += weights_.component(a)(face) * inverseTheta_.component(a)(face);
+      }
+    }
+    dirichlet[cell] = sum;
+  });
+  freeSurface_ = true;
+  matrix_ = PoissonMatrix<D>(coupling, dirichlet);
+  floating_ = FloatingRegions<D>(coupling, dirichlet);
+  buildPreconditioner();
 }
 
 template <int D>
@@ -161,6 +223,7 @@ PcgStats PressureProjection<D>::project(MacGrid<D>& velocity, double dt, double 
       float* ur = u.data().data() + base;
       const float* wr = w.data().data() + base;
       const float* usr = us.data().data() + base;
+      const float* itr = freeSurface_ ? inverseTheta_.component(a).data().data() + base : nullptr;
       // Cells above and below each face of the row. A missing one (ghost beyond an open side,
       // p = 0) reads the other row times 0; on walls w = 0 and the face takes the solid velocity.
       IVec<D> low = f;
@@ -170,7 +233,11 @@ PcgStats PressureProjection<D>::project(MacGrid<D>& velocity, double dt, double 
       const float* pLow = p + rowStart(cells, hasLow ? low : f);
       const float kUp = hasUp ? 1.0f : 0.0f, kLow = hasLow ? 1.0f : 0.0f;
       const int shift = a == 0;  // along x, the cell below face i is cell i - 1 of the same row
-      auto update = [&](int i, float up, float lo) { ur[i] = wr[i] > 0.0f ? ur[i] - (up - lo) : usr[i]; };
+      // Across a free surface the air's side reads 0 and the difference is divided by theta.
+      auto update = [&](int i, float up, float lo) {
+        const float scale = itr ? itr[i] : 1.0f;
+        ur[i] = wr[i] > 0.0f ? ur[i] - (up - lo) * scale : usr[i];
+      };
       if (a == 0) {  // the row's ends face the ghosts of the x sides
         update(0, pUp[0], 0.0f);
         update(nx - 1, 0.0f, pLow[nx - 2]);

@@ -71,6 +71,19 @@ class PressureProjection {
   // caller must keep the net inflow zero, or no divergence-free field exists. Ignored on open sides.
   void setWallNormalVelocity(int axis, int side, double velocity);
 
+  // A free surface (liquids): cells with liquidPhi < 0 are liquid, the others air at pressure 0
+  // with no unknown. Between a liquid cell i and an air neighbour j the surface lies at the
+  // fraction theta = phi_i / (phi_i - phi_j) of the way from i to j (phi linear in between), and
+  // the ghost-fluid method (Gibou, Fedkiw, Cheng & Kang 2002, as Enright, Nguyen & Fedkiw 2003
+  // use it for water) extrapolates the pressure linearly to p = 0 there: the face adds
+  // w_f / theta to i's diagonal and the update across it becomes u -= (p_j - p_i) / theta, which
+  // is second order in the surface's position. theta is clamped below at minTheta (a cell whose
+  // centre lies on the surface would otherwise get an unbounded diagonal). Rebuilds the matrix,
+  // its null space (a drop touching no air or open side floats) and the preconditioner, which is
+  // MIC(0) while a free surface is set: the multigrid hierarchy has no Dirichlet cells yet. Faces
+  // between two air cells keep their velocity (the caller extrapolates it).
+  void setFreeSurface(const Grid<float, D>& liquidPhi, float minTheta = 1e-3f);
+
   // Makes `velocity` divergence free; the pressure [Pa] is kept (pressure()) and warm-starts
   // the next call.
   PcgStats project(MacGrid<D>& velocity, double dt, double density);
@@ -99,8 +112,13 @@ class PressureProjection {
   GridSpec<D> spec_;
   DomainSides<D> sides_;
   ProjectionSettings settings_;
+  // Builds the preconditioner chosen by the settings for matrix_ (MIC(0) with a free surface).
+  void buildPreconditioner();
+
   MacGrid<D> weights_;
   MacGrid<D> solidVelocity_;
+  MacGrid<D> inverseTheta_;  // 1 / theta on liquid-air faces, 1 elsewhere; empty without a free surface
+  bool freeSurface_ = false;
   std::array<std::array<float, 2>, D> wallNormalVelocity_{};
   PoissonMatrix<D> matrix_;
   FloatingRegions<D> floating_;
