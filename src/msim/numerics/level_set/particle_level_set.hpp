@@ -1,0 +1,82 @@
+#pragma once
+// ParticleLevelSet<D>: the marker particles of the particle level set method (Enright, Fedkiw,
+// Ferziger & Mitchell 2002), as Selle ch. 4.4.3 tracks water with it. Particles of both signs
+// sit within a band of the interface; they are carried by the flow without numerical diffusion,
+// and where the level set's own advection has smeared the interface they repair it:
+//
+//  - seeding: in every cell of the band, particlesPerCell random positions, each with the sign of
+//    phi there, attracted along the normal, x += (phi_goal - phi(x)) N(x), until phi(x) lies at
+//    a random phi_goal between minSeed and maxSeed (in cells) on its own side;
+//  - radius: r_p = clamp(s_p phi(x_p), minRadius, maxRadius) (s_p the sign);
+//  - escaped particles: on the wrong side by more than their radius, s_p phi(x_p) < -r_p;
+//  - correction: each escaped particle's sphere phi_p(x) = s_p (r_p - |x - x_p|) raises phi+
+//    (positive particles, max) or lowers phi- (negative ones, min) at the samples around it,
+//    starting from phi+ = phi- = phi, and the result keeps the one of smaller magnitude;
+//  - reseeding: particles that left the band are deleted and cells of the band with fewer than
+//    particlesPerCell particles are topped up.
+// The caller advances phi (any advection scheme) and the particles by the same velocity, then
+// corrects, reinitialises, corrects again and adjusts the radii (Enright's step).
+// Particles live in a structure of arrays; all work is deterministic (per-cell random streams).
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "msim/core/grid.hpp"
+#include "msim/core/mac_grid.hpp"
+
+namespace msim::numerics {
+
+struct ParticleLevelSetSettings {
+  int particlesPerCell = 0;     // per cell of the band; 0: 16 in 2D, 32 in 3D
+  double bandCells = 3.0;       // particles are seeded where |phi| < bandCells * dx
+  // Radius bounds [cells]. Enright uses 0.1 and 0.5 dx; with 0.1 the surface may drift by about
+  // 0.2 dx before a particle escapes, which Zalesak's disc shows as a 2.7% area loss after one
+  // turn at 100^2 (0.5% with 0.02).
+  double minRadiusCells = 0.02;
+  double maxRadiusCells = 0.5;
+  double minSeedCells = 0.02;   // phi_goal of new particles, in cells on their own side
+  double maxSeedCells = 3.0;    //   (Enright: from the smallest radius to the band's edge)
+  int attractionIterations = 15;
+  std::uint64_t seed = 1;       // random streams (per cell and reseeding round)
+};
+
+template <int D>
+class ParticleLevelSet {
+ public:
+  // phi lives on the cell centres of spec.
+  ParticleLevelSet(const GridSpec<D>& spec, const ParticleLevelSetSettings& settings = {});
+
+  // Removes every particle and seeds the band of phi afresh.
+  void seed(const Grid<float, D>& phi);
+  // Moves the particles by the MAC velocity over dt (midpoint rule, sampled D-linearly), keeping
+  // them inside the domain.
+  void advect(const MacGrid<D>& velocity, double dt);
+  // Enright's correction of phi by the escaped particles; returns how many there were.
+  std::size_t correct(Grid<float, D>& phi) const;
+  // r_p = clamp(s_p phi(x_p), minRadius, maxRadius).
+  void adjustRadii(const Grid<float, D>& phi);
+  // Deletes particles out of the band or escaped beyond its edge, tops the band's cells up to
+  // particlesPerCell (new particles attracted and sized as in seed).
+  void reseed(const Grid<float, D>& phi);
+
+  std::size_t size() const { return positions_.size(); }
+  const std::vector<Vec<D>>& positions() const { return positions_; }
+  const std::vector<float>& radii() const { return radii_; }
+  const std::vector<std::int8_t>& signs() const { return signs_; }
+  int particlesPerCell() const { return perCell_; }
+
+ private:
+  // Appends up to `count` particles in cell c (random stream `stream`), attracted to phi.
+  void seedCell(const Grid<float, D>& phi, const IVec<D>& c, int count, std::uint64_t stream);
+  std::size_t cellOf(const Vec<D>& x) const;
+
+  GridSpec<D> spec_;
+  ParticleLevelSetSettings settings_;
+  int perCell_;
+  std::uint64_t round_ = 0;  // reseeding rounds so far (new random streams each round)
+  std::vector<Vec<D>> positions_;
+  std::vector<float> radii_;
+  std::vector<std::int8_t> signs_;
+};
+
+}  // namespace msim::numerics
