@@ -1,0 +1,162 @@
+#include "msim/fluid/liquid/flip_particles.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <span>
+#include <stdexcept>
+
+#include "msim/core/interpolation.hpp"
+#include "msim/core/parallel.hpp"
+#include "msim/core/rng.hpp"
+
+namespace msim::fluid {
+
+namespace {
+
+template <int D>
+Vecf<D> insideDomain(const GridSpec<D>& spec, Vecf<D> x) {
+  const double margin = 1e-3 * spec.dx;
+  for (int a = 0; a < D; ++a)
+    x[a] = static_cast<float>(
+        std::clamp(double(x[a]), spec.origin[a] + margin, spec.origin[a] + spec.res[a] * spec.dx - margin));
+  return x;
+}
+
+template <int D>
+std::size_t cellIndex(const GridSpec<D>& spec, const Vecf<D>& x) {
+  std::size_t index = 0, stride = 1;
+  for (int a = 0; a < D; ++a) {
+    const int c = std::clamp(static_cast<int>(std::floor((x[a] - spec.origin[a]) / spec.dx)), 0, spec.res[a] - 1);
+    index += static_cast<std::size_t>(c) * stride;
+    stride *= static_cast<std::size_t>(spec.res[a]);
+  }
+  return index;
+}
+
+}  // namespace
+
+template <int D>
+FlipParticles<D>::FlipParticles(const GridSpec<D>& spec, int perCell, std::uint64_t seed)
+    : spec_(spec), perCell_(perCell > 0 ? perCell : (1 << D)), seed_(seed), radius_(0.5 * spec.dx) {}
+
+template <int D>
+void FlipParticles<D>::seed(const Grid<float, D>& phi, const Grid<float, D>& solid, const MacGrid<D>& velocity) {
+  positions_.clear();
+  velocities_.clear();
+  for (std::size_t cell = 0; cell < phi.count(); ++cell) {
+    if (!(phi[cell] < 0.5f * spec_.dx) || solid[cell] > 0.5f) continue;  // the surface cells too
+    const IVec<D> c = phi.coord(cell);
+    Rng rng = Rng(seed_).split(cell);
+    for (int k = 0; k < perCell_; ++k) {
+      Vec<D> x;
+      // Stratified when perCell is 2^D: one particle per sub-cell, jittered inside it.
+      for (int a = 0; a < D; ++a) {
+        const double sub = perCell_ == (1 << D) ? 0.5 * ((k >> a) & 1) + 0.25 + 0.1 * (rng.uniform() - 0.5) : rng.uniform();
+        x[a] = spec_.origin[a] + (c[a] + sub) * spec_.dx;
+      }
+      if (!(sampleLinear<D>(phi, x) < 0.0f)) continue;
+      positions_.push_back(x.template cast<float>());
+      velocities_.push_back(sampleLinear<D>(velocity, x).template cast<float>());
+    }
+  }
+}
+
+template <int D>
+void FlipParticles<D>::advect(const MacGrid<D>& velocity, double dt, const Grid<float, D>& solid) {
+  parallelFor(0, positions_.size(), [&](std::size_t p) {
+    const Vec<D> x = positions_[p].template cast<double>();
+    const Vec<D> mid = insideDomain<D>(spec_, Vec<D>(x + 0.5 * dt * sampleLinear<D>(velocity, x)).template cast<float>())
+                           .template cast<double>();
+    const Vecf<D> next = insideDomain<D>(spec_, Vec<D>(x + dt * sampleLinear<D>(velocity, mid)).template cast<float>());
+    // A particle does not enter a solid cell: it stays where it was (the wall stops it).
+    if (solid[cellIndex<D>(spec_, next)] <= 0.5f) positions_[p] = next;
+  });
+}
+
+template <int D>
+void FlipParticles<D>::toGrid(MacGrid<D>& velocity) {
+  splatter_.splat(std::span<const Vecf<D>>(positions_), std::span<const Vecf<D>>(velocities_), velocity,
+                  TransferKernel::Linear, SplatMode::Normalized, 0.0f);
+}
+
+template <int D>
+void FlipParticles<D>::fromGrid(const MacGrid<D>& updated, const MacGrid<D>& before, double flipRatio) {
+  gatheredNew_.resize(positions_.size());
+  gatheredOld_.resize(positions_.size());
+  gather<D, 2>({&updated, &before}, std::span<const Vecf<D>>(positions_), TransferKernel::Linear,
+               {std::span<Vecf<D>>(gatheredNew_), std::span<Vecf<D>>(gatheredOld_)});
+  const float r = static_cast<float>(flipRatio);
+  parallelFor(0, positions_.size(), [&](std::size_t p) {
+    velocities_[p] = r * (velocities_[p] + gatheredNew_[p] - gatheredOld_[p]) + (1.0f - r) * gatheredNew_[p];
+  });
+}
+
+template <int D>
+void FlipParticles<D>::bucketByCell() const {
+  const std::size_t cells = spec_.cellCount();
+  cellStart_.assign(cells + 1, 0);
+  std::vector<std::uint32_t> cellOf(positions_.size());
+  for (std::size_t p = 0; p < positions_.size(); ++p) {
+    cellOf[p] = static_cast<std::uint32_t>(cellIndex<D>(spec_, positions_[p]));
+    ++cellStart_[cellOf[p] + 1];
+  }
+  for (std::size_t c = 0; c < cells; ++c) cellStart_[c + 1] += cellStart_[c];
+  order_.resize(positions_.size());
+  std::vector<std::uint32_t> next(cellStart_.begin(), cellStart_.end() - 1);
+  for (std::size_t p = 0; p < positions_.size(); ++p) order_[next[cellOf[p]]++] = static_cast<std::uint32_t>(p);
+}
+
+template <int D>
+void FlipParticles<D>::surface(Grid<float, D>& phi, double bandCells) const {
+  if (!phi.sameLayout(Grid<float, D>(spec_))) throw std::invalid_argument("FLIP surface: phi must be cell-centred");
+  bucketByCell();
+  const float band = static_cast<float>(bandCells * spec_.dx);
+  const double R = 4.0 * radius_;  // kernel radius: 2 dx
+  const int reach = 2;             // cells within R of a cell centre
+  auto count = [&](std::size_t cell) { return cellStart_[cell + 1] - cellStart_[cell]; };
+  parallelForCells(phi, [&](const IVec<D>& c, std::size_t cell) {
+    // Deep inside: the cell and its face and corner neighbours all hold particles.
+    bool deep = true, near = false;
+    IVec<D> lo, hi;
+    for (int a = 0; a < D; ++a) {
+      lo[a] = std::max(0, c[a] - reach);
+      hi[a] = std::min(spec_.res[a] - 1, c[a] + reach);
+    }
+    Vec<D> weighted = Vec<D>::Zero();
+    double weights = 0.0;
+    const Vec<D> x = phi.position(c);
+    IVec<D> n = lo;
+    while (true) {
+      const std::size_t nc = phi.index(n);
+      bool adjacent = true;
+      for (int a = 0; a < D; ++a) adjacent = adjacent && std::abs(n[a] - c[a]) <= 1;
+      if (adjacent && count(nc) == 0) deep = false;
+      for (std::uint32_t k = cellStart_[nc]; k < cellStart_[nc + 1]; ++k) {
+        const Vec<D> xp = positions_[order_[k]].template cast<double>();
+        const double s2 = (xp - x).squaredNorm() / (R * R);
+        if (s2 >= 1.0) continue;
+        const double w = (1.0 - s2) * (1.0 - s2) * (1.0 - s2);
+        weighted += w * xp;
+        weights += w;
+        near = true;
+      }
+      int a = 0;
+      for (; a < D; ++a) {
+        if (++n[a] <= hi[a]) break;
+        n[a] = lo[a];
+      }
+      if (a == D) break;
+    }
+    if (!near)
+      phi[cell] = band;
+    else if (deep)
+      phi[cell] = -band;
+    else
+      phi[cell] = static_cast<float>(std::clamp((x - weighted / weights).norm() - radius_, -double(band), double(band)));
+  });
+}
+
+template class FlipParticles<2>;
+template class FlipParticles<3>;
+
+}  // namespace msim::fluid

@@ -1,0 +1,240 @@
+#include "msim/fluid/liquid/liquid_solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "msim/core/error.hpp"
+#include "msim/core/parallel.hpp"
+#include "msim/core/resample.hpp"
+#include "msim/numerics/level_set/extrapolation.hpp"
+#include "msim/numerics/level_set/fast_marching.hpp"
+#include "msim/numerics/level_set/level_set_measures.hpp"
+#include "msim/numerics/pressure/face_fractions.hpp"
+
+namespace msim::fluid {
+
+template <int D>
+LiquidSolver<D>::LiquidSolver(const GridSpec<D>& spec, const LiquidParams<D>& params)
+    : spec_(spec),
+      params_(params),
+      phi_(spec, static_cast<float>(params.bandCells * spec.dx)),
+      solid_(spec, 0.0f),
+      velocity_(spec),
+      advector_(spec, params.advection),
+      projection_(spec, params.sides, params.projection),
+      particles_(spec, params.particleLevelSet),
+      flip_(spec, params.flipParticlesPerCell, params.seed),
+      pressurePhi_(spec) {
+  if (!(params.density > 0.0) || !(params.cfl > 0.0) || params.maxSubsteps < 1 || params.reseedInterval < 1 ||
+      !(params.bandCells >= 3.0) || !(params.extrapolationCells > 0.0) ||
+      !(params.extrapolationCells < params.bandCells) || !(params.flipRatio >= 0.0 && params.flipRatio <= 1.0))
+    throw std::invalid_argument("liquid solver: density, cfl, substeps and reseeding must be positive, the band at "
+                                "least 3 cells and wider than the velocity extension, the FLIP ratio in [0, 1]");
+  for (int a = 0; a < D; ++a) {
+    const auto& u = velocity_.component(a);
+    facePhi_[a] = Grid<float, D>(spec, u.size(), u.offset());
+    known_[a].assign(u.count(), 0);
+  }
+}
+
+template <int D>
+void LiquidSolver<D>::setObstacles(const Grid<float, D>& nodalSolidPhi) {
+  projection_.setSolids(numerics::openFaceFractions<D>(spec_, nodalSolidPhi));
+  // A cell is solid when the D-linear interpolant of the nodal phi is negative at its centre.
+  parallelForCells(solid_, [&](const IVec<D>& c, std::size_t lin) {
+    double mean = 0.0;
+    for (int k = 0; k < (1 << D); ++k) {
+      IVec<D> n = c;
+      for (int a = 0; a < D; ++a) n[a] += (k >> a) & 1;
+      mean += nodalSolidPhi(n);
+    }
+    solid_[lin] = mean < 0.0 ? 1.0f : 0.0f;
+  });
+  advector_.setSolid(solid_);
+}
+
+template <int D>
+void LiquidSolver<D>::addLiquid(const Grid<float, D>& cellPhi, const Vec<D>& velocity) {
+  if (!cellPhi.sameLayout(phi_)) throw std::invalid_argument("liquid solver: addLiquid needs a cell-centred phi");
+  for (std::size_t i = 0; i < phi_.count(); ++i) phi_[i] = std::min(phi_[i], cellPhi[i]);
+  // Faces with new liquid on a side move with it.
+  for (int a = 0; a < D; ++a) {
+    auto& u = velocity_.component(a);
+    parallelForCells(u, [&](const IVec<D>& f, std::size_t lin) {
+      IVec<D> low = f;
+      low[a] -= 1;
+      const bool wet = (f[a] < spec_.res[a] && cellPhi(f) < 0.0f) || (f[a] > 0 && cellPhi(low) < 0.0f);
+      if (wet) u[lin] = static_cast<float>(velocity[a]);
+    });
+  }
+  started_ = false;
+}
+
+template <int D>
+void LiquidSolver<D>::start() {
+  numerics::reinitializeFastMarching(phi_, params_.bandCells);
+  extendVelocity();
+  if (params_.tracker == InterfaceTracker::Flip)
+    flip_.seed(phi_, solid_, velocity_);
+  else
+    particles_.seed(phi_);
+  started_ = true;
+}
+
+template <int D>
+double LiquidSolver<D>::cflTimestep() const {
+  double speed = 0.0;
+  for (int a = 0; a < D; ++a) {
+    const auto& u = velocity_.component(a);
+    speed = std::max(speed, parallelMax(u.count(), [&](std::size_t i) { return std::abs(u[i]); }));
+  }
+  speed += std::sqrt(params_.gravity.norm() * spec_.dx);
+  return speed > 0.0 ? params_.cfl * spec_.dx / speed : std::numeric_limits<double>::infinity();
+}
+
+template <int D>
+int LiquidSolver<D>::advance(double dt) {
+  const double limit = cflTimestep();
+  const double needed = std::ceil(dt / limit);
+  if (needed > params_.maxSubsteps)
+    throw SimulationError(fmt::format(
+        "liquid: step {} needs {} substeps of {:.3g} s for dt = {:.3g} s (more than time.max_substeps = {}): the "
+        "liquid moves at {:.3g} m/s, {:.3g} cells per substep",
+        steps_ + 1, needed, limit, dt, params_.maxSubsteps, params_.cfl * spec_.dx / limit, params_.cfl));
+  const int n = std::max(1, static_cast<int>(needed));
+  for (int i = 0; i < n; ++i) step(dt / n);
+  return n;
+}
+
+template <int D>
+void LiquidSolver<D>::moveSurface(double dt) {
+  ScopedStage s(timers_, "liquid: surface");
+  advector_.advect(phi_, velocity_, dt);
+  particles_.advect(velocity_, dt);
+  lastEscaped_ = particles_.correct(phi_);
+  numerics::reinitializeFastMarching(phi_, params_.bandCells);
+  particles_.correct(phi_);
+  particles_.adjustRadii(phi_);
+  if ((steps_ + 1) % params_.reseedInterval == 0) particles_.reseed(phi_);
+}
+
+template <int D>
+void LiquidSolver<D>::moveFlipSurface(double dt) {
+  ScopedStage s(timers_, "liquid: surface");
+  flip_.advect(velocity_, dt, solid_);
+  flip_.surface(phi_, params_.bandCells);
+  numerics::reinitializeFastMarching(phi_, params_.bandCells);
+}
+
+template <int D>
+void LiquidSolver<D>::extendVelocity() {
+  ScopedStage s(timers_, "liquid: extend velocity");
+  const MacGrid<D>& weights = projection_.faceWeights();
+  const MacGrid<D>& solidVelocity = projection_.solidVelocity();
+  for (int a = 0; a < D; ++a) {
+    auto& u = velocity_.component(a);
+    auto& known = known_[a];
+    const auto& w = weights.component(a);
+    resampleLinear(phi_, facePhi_[a]);
+    // Given: open faces with liquid on a side (the pressure update set them).
+    parallelForCells(u, [&](const IVec<D>& f, std::size_t lin) {
+      IVec<D> low = f;
+      low[a] -= 1;
+      const bool wet = (f[a] < spec_.res[a] && liquidCell(phi_.index(f))) || (f[a] > 0 && liquidCell(phi_.index(low)));
+      known[lin] = wet && w[lin] > 0.0f;
+    });
+    numerics::extrapolateAlongNormals(u, known, facePhi_[a], params_.extrapolationCells);
+    const auto& us = solidVelocity.component(a);
+    parallelFor(0, u.count(), [&](std::size_t i) {
+      if (w[i] <= 0.0f)
+        u[i] = us[i];
+      else if (!known[i])
+        u[i] = 0.0f;
+    });
+  }
+}
+
+template <int D>
+void LiquidSolver<D>::step(double dt) {
+  if (!started_) start();
+  const bool flip = params_.tracker == InterfaceTracker::Flip;
+  if (flip) {
+    moveFlipSurface(dt);
+    {
+      ScopedStage s(timers_, "liquid: particles to grid");
+      flip_.toGrid(velocity_);
+    }
+    extendVelocity();
+    gridVelocityBefore_ = velocity_;
+  } else {
+    moveSurface(dt);
+    ScopedStage s(timers_, "liquid: advect velocity");
+    advector_.advect(velocity_, velocity_, dt);
+  }
+  {
+    ScopedStage s(timers_, "liquid: gravity");
+    for (int a = 0; a < D; ++a) {
+      const float dv = static_cast<float>(params_.gravity[a] * dt);
+      if (dv == 0.0f) continue;
+      auto& u = velocity_.component(a);
+      parallelFor(0, u.count(), [&](std::size_t i) { u[i] += dv; });
+    }
+  }
+  {
+    ScopedStage s(timers_, "liquid: pressure");
+    parallelFor(0, phi_.count(), [&](std::size_t i) {  // solids hold no liquid
+      pressurePhi_[i] = solid_[i] > 0.5f ? std::max(phi_[i], static_cast<float>(0.5 * spec_.dx)) : phi_[i];
+    });
+    projection_.setFreeSurface(pressurePhi_);
+    lastSolve_ = projection_.project(velocity_, dt, params_.density);
+  }
+  extendVelocity();
+  if (flip) {
+    ScopedStage s(timers_, "liquid: grid to particles");
+    flip_.fromGrid(velocity_, gridVelocityBefore_, params_.flipRatio);
+  }
+  ++steps_;
+}
+
+template <int D>
+LiquidStatistics LiquidSolver<D>::statistics() const {
+  LiquidStatistics s;
+  s.volume = numerics::enclosedVolume(phi_, &solid_);
+  for (int a = 0; a < D; ++a) {
+    const auto& u = velocity_.component(a);
+    s.maxSpeed = std::max(s.maxSpeed, parallelMax(u.count(), [&](std::size_t i) {
+                            const IVec<D> f = u.coord(i);
+                            IVec<D> low = f;
+                            low[a] -= 1;
+                            const bool wet = (f[a] < spec_.res[a] && liquidCell(phi_.index(f))) ||
+                                             (f[a] > 0 && liquidCell(phi_.index(low)));
+                            return wet ? std::abs(u[i]) : 0.0f;
+                          }));
+  }
+  s.kineticEnergy = 0.5 * params_.density * spec_.cellVolume() * parallelSum(phi_.count(), [&](std::size_t i) {
+                      if (!liquidCell(i)) return 0.0;
+                      const IVec<D> c = phi_.coord(i);
+                      double e = 0.0;
+                      for (int a = 0; a < D; ++a) {
+                        IVec<D> up = c;
+                        up[a] += 1;
+                        const double v = 0.5 * (velocity_.component(a)(c) + velocity_.component(a)(up));
+                        e += v * v;
+                      }
+                      return e;
+                    });
+  s.pressureIterations = lastSolve_.iterations;
+  s.pressureConverged = lastSolve_.converged;
+  s.particles = params_.tracker == InterfaceTracker::Flip ? flip_.size() : particles_.size();
+  s.escaped = lastEscaped_;
+  s.step = steps_;
+  return s;
+}
+
+template class LiquidSolver<2>;
+template class LiquidSolver<3>;
+
+}  // namespace msim::fluid

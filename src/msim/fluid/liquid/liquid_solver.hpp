@@ -1,0 +1,138 @@
+#pragma once
+// LiquidSolver<D>: water with a free surface on a MAC grid (Selle ch. 4.4.3, Enright, Marschner &
+// Fedkiw 2002). phi < 0 is liquid. One step of size dt:
+//   1. the surface moves: phi is advected (the velocity's scheme) and corrected by the particle
+//      level set's escaped particles, reinitialised by fast marching, corrected again; the
+//      particles' radii follow phi, and every reseedInterval steps the band is reseeded;
+//   2. the velocity advects itself (it has been extended across the surface, so the back-traces
+//      that leave the liquid read sensible values);
+//   3. gravity;
+//   4. pressure with the free surface (ghost fluid, p = 0 at the surface) and the solids' face
+//      fractions; the liquid cells only carry unknowns;
+//   5. the velocity is extended from the faces next to the liquid along the normals, in increasing
+//      phi, over the band (Selle ch. 4.4.3); faces beyond it are set to 0 and closed faces take
+//      the solid's velocity.
+// With FLIP particles (params.tracker) steps 1-2 become: the particles move through the grid
+// velocity, phi is rebuilt from them and reinitialised, their velocities are splatted onto the
+// faces and extended; after step 5 the particles take the change of the grid velocity (FLIP)
+// blended with the new velocity itself (PIC) by params.flipRatio (Golas ch. 2.7).
+// Obstacles are static solids given by a signed distance at the grid nodes, as for smoke. Storage
+// is float, reductions double; the work arrays live in the object.
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "msim/core/grid.hpp"
+#include "msim/core/mac_grid.hpp"
+#include "msim/core/timer.hpp"
+#include "msim/fluid/liquid/flip_particles.hpp"
+#include "msim/numerics/advection/advector.hpp"
+#include "msim/numerics/level_set/particle_level_set.hpp"
+#include "msim/numerics/pressure/projection.hpp"
+
+namespace msim::fluid {
+
+template <int D>
+Vec<D> standardGravity() {
+  Vec<D> g = Vec<D>::Zero();
+  g[1] = -9.81;
+  return g;
+}
+
+// How the surface is tracked (issue #24): a particle level set, or FLIP particles that carry the
+// liquid and its velocity (phi rebuilt from them every step).
+enum class InterfaceTracker { ParticleLevelSet, Flip };
+
+template <int D>
+struct LiquidParams {
+  InterfaceTracker tracker = InterfaceTracker::ParticleLevelSet;
+  Vec<D> gravity = standardGravity<D>();     // [m/s^2]
+  double density = 1000.0;                   // rho of the liquid [kg/m^3]
+  numerics::AdvectionSettings advection;     // velocity and phi
+  numerics::ProjectionSettings projection;   // MIC(0)-PCG with the free surface
+  numerics::DomainSides<D> sides;            // walls by default
+  numerics::ParticleLevelSetSettings particleLevelSet;
+  int reseedInterval = 20;                   // steps between reseedings of the particle level set
+  double flipRatio = 0.95;                   // FLIP share of the PIC/FLIP blend (1: FLIP, 0: PIC)
+  int flipParticlesPerCell = 0;              // 0: 2 per axis (4 in 2D, 8 in 3D)
+  std::uint64_t seed = 1;                    // FLIP seeding
+  double bandCells = 6.0;                    // phi is a distance within this many cells
+  double extrapolationCells = 5.0;           // velocity extended this far beyond the surface
+  double cfl = 1.0;                          // cells the fastest face may cross per substep
+  int maxSubsteps = 64;                      // advance() refuses to take more (SimulationError)
+};
+
+struct LiquidStatistics {
+  double volume = 0.0;          // liquid volume (smeared Heaviside of phi, outside solids) [m^3]
+  double maxSpeed = 0.0;        // max |u_f| over faces with liquid on a side [m/s]
+  double kineticEnergy = 0.0;   // 1/2 rho sum over liquid cells of |u|^2 dV [J] (per unit depth in 2D)
+  int pressureIterations = 0;   // last projection
+  bool pressureConverged = true;
+  std::size_t particles = 0;    // marker particles
+  std::size_t escaped = 0;      // escaped particles the last correction used
+  long step = 0;
+};
+
+template <int D>
+class LiquidSolver {
+ public:
+  LiquidSolver(const GridSpec<D>& spec, const LiquidParams<D>& params);
+  LiquidSolver(const LiquidSolver&) = delete;
+  LiquidSolver& operator=(const LiquidSolver&) = delete;
+
+  // Static obstacles from a signed distance at the grid nodes (numerics::sampleNodes), negative
+  // inside; cells whose centre is inside are solid.
+  void setObstacles(const Grid<float, D>& nodalSolidPhi);
+  // Adds liquid where cellPhi < 0 (the union with what is there), moving at `velocity`. Before
+  // the first step: the particles are seeded then.
+  void addLiquid(const Grid<float, D>& cellPhi, const Vec<D>& velocity = Vec<D>::Zero());
+
+  // Largest step with (max speed + sqrt(|g| dx)) dt <= cfl dx: the gravity term keeps a liquid at
+  // rest from taking an unbounded first step.
+  double cflTimestep() const;
+  void step(double dt);
+  // Advances by dt in ceil(dt / cflTimestep()) equal substeps; SimulationError (naming the step
+  // and the speed) when that would exceed params.maxSubsteps. Returns the number of substeps.
+  int advance(double dt);
+
+  LiquidStatistics statistics() const;
+  const Grid<float, D>& phi() const { return phi_; }
+  const MacGrid<D>& velocity() const { return velocity_; }
+  MacGrid<D>& velocity() { return velocity_; }
+  const Grid<float, D>& pressure() const { return projection_.pressure(); }
+  const Grid<float, D>& solid() const { return solid_; }
+  const numerics::ParticleLevelSet<D>& levelSetParticles() const { return particles_; }
+  const FlipParticles<D>& flipParticles() const { return flip_; }
+  const GridSpec<D>& spec() const { return spec_; }
+  const LiquidParams<D>& params() const { return params_; }
+  const StageTimers& timers() const { return timers_; }
+
+ private:
+  void start();
+  void moveSurface(double dt);
+  void moveFlipSurface(double dt);
+  void extendVelocity();
+  bool liquidCell(std::size_t cell) const { return phi_[cell] < 0.0f && solid_[cell] <= 0.5f; }
+
+  GridSpec<D> spec_;
+  LiquidParams<D> params_;
+  Grid<float, D> phi_;
+  Grid<float, D> solid_;
+  MacGrid<D> velocity_;
+  numerics::Advector<float, D> advector_;
+  numerics::PressureProjection<D> projection_;
+  numerics::ParticleLevelSet<D> particles_;
+  FlipParticles<D> flip_;
+  MacGrid<D> gridVelocityBefore_;                      // FLIP: the splatted velocity before forces
+  Grid<float, D> pressurePhi_;                         // phi with the solids dry
+  std::array<Grid<float, D>, D> facePhi_;              // phi at each face grid's samples
+  std::array<std::vector<std::uint8_t>, D> known_;     // per face: value given (extension)
+  numerics::PcgStats lastSolve_;
+  std::size_t lastEscaped_ = 0;
+  bool started_ = false;
+  long steps_ = 0;
+  StageTimers timers_;
+};
+
+}  // namespace msim::fluid

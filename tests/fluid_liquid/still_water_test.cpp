@@ -1,0 +1,62 @@
+// Still water in a closed tank stays still (issue #24): after 500 steps the largest speed is below
+// 1e-3 sqrt(g h) and the pressure at the bottom is rho g h within 1%, h the depth of the liquid's
+// surface (phi's zero crossing: the particle level set keeps it where it was put, FLIP's
+// particles, two per axis and cell, resolve it to half a cell); the volume stays put.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "../sanitizer_build.hpp"
+#include "msim/fluid/liquid/liquid_solver.hpp"
+
+using namespace msim;
+using namespace msim::fluid;
+
+namespace {
+
+template <int D>
+void stillTank(int n, int steps, InterfaceTracker tracker = InterfaceTracker::ParticleLevelSet) {
+  const GridSpec<D> spec(Vec<D>::Zero(), 1.0 / n, IVec<D>::Constant(n));
+  const double h = 0.4 + 0.3 * spec.dx, g = 9.81, rho = 1000.0;
+  LiquidParams<D> params;
+  params.tracker = tracker;
+  LiquidSolver<D> solver(spec, params);
+  Grid<float, D> water(spec);
+  for (std::size_t i = 0; i < water.count(); ++i) water[i] = static_cast<float>(water.position(water.coord(i))[1] - h);
+  solver.addLiquid(water);
+  const double dt = 1.0 / 120.0;
+  solver.step(dt);
+  const double volume0 = solver.statistics().volume;
+  for (int s = 1; s < steps; ++s) solver.step(dt);
+  const LiquidStatistics stats = solver.statistics();
+  EXPECT_TRUE(stats.pressureConverged);
+  EXPECT_LT(stats.maxSpeed, 1e-3 * std::sqrt(g * h)) << "after " << steps << " steps";
+  EXPECT_NEAR(stats.volume / volume0, 1.0, 1e-3);
+  // The surface's height in the middle column, from phi's crossing.
+  const Grid<float, D>& phi = solver.phi();
+  IVec<D> c = IVec<D>::Constant(n / 2);
+  double surface = 0.0;
+  for (c[1] = 0; c[1] + 1 < n; ++c[1]) {
+    IVec<D> up = c;
+    up[1] += 1;
+    if (phi(c) < 0.0f && phi(up) >= 0.0f) surface = phi.position(c)[1] + spec.dx * phi(c) / (phi(c) - phi(up));
+  }
+  EXPECT_NEAR(surface, h, tracker == InterfaceTracker::Flip ? 0.6 * spec.dx : 0.05 * spec.dx);
+  // The bottom row's pressure is rho g (surface - y) at its centres: rho g h within 1%.
+  const Grid<float, D>& p = solver.pressure();
+  for (std::size_t i = 0; i < p.count(); ++i) {
+    const IVec<D> c = p.coord(i);
+    if (c[1] != 0) continue;
+    const double y = p.position(c)[1];
+    ASSERT_NEAR(p[i], rho * g * (surface - y), 0.01 * rho * g * h) << "cell " << i;
+  }
+  testing::Test::RecordProperty("max_speed", std::to_string(stats.maxSpeed));
+}
+
+}  // namespace
+
+TEST(LiquidStillWater, TankStaysStill2D) { stillTank<2>(40, 500); }
+
+TEST(LiquidStillWater, TankStaysStill3D) { stillTank<3>(20, test::fullOrSanitized(500, 100)); }
+
+TEST(LiquidStillWater, FlipTankStaysStill2D) { stillTank<2>(40, 500, InterfaceTracker::Flip); }
