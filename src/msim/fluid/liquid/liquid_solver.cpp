@@ -159,6 +159,7 @@ void LiquidSolver<D>::extendVelocity() {
 
 template <int D>
 void LiquidSolver<D>::step(double dt) {
+  if (!(dt > 0.0) || !std::isfinite(dt)) throw std::invalid_argument(fmt::format("liquid solver: step of {} s", dt));
   if (!started_) start();
   const bool flip = params_.tracker == InterfaceTracker::Flip;
   if (flip) {

@@ -22,6 +22,14 @@ PcgStats PcgSolver<D>::solve(const PoissonMatrix<D>& A, const FloatingRegions<D>
   const double target = settings.tolerance * bNorm;
   A.residual(b, x, r_);
   double rNorm = maxAbs(r_);
+  // A warm start farther from the solution than zero (the previous step's pressure after a much
+  // shorter or longer step) would cost the float precision the relative tolerance needs: start
+  // from zero instead.
+  if (rNorm > bNorm) {
+    std::fill(x.begin(), x.end(), 0.0f);
+    r_ = b;
+    rNorm = bNorm;
+  }
   auto finish = [&] {
     nullSpace.removeMeans(x);
     stats.relativeResidual = rNorm / bNorm;

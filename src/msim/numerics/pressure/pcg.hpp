@@ -26,8 +26,9 @@ struct PcgStats {
 template <int D>
 class PcgSolver {
  public:
-  // Solves A x = b starting from x (warm start). b must vanish on excluded cells; its mean is
-  // removed on each floating region (the compatibility condition), and so is x's at exit.
+  // Solves A x = b starting from x (warm start; from zero when x's residual exceeds b). b must
+  // vanish on excluded cells; its mean is removed on each floating region (the compatibility
+  // condition), and so is x's at exit.
   PcgStats solve(const PoissonMatrix<D>& A, const FloatingRegions<D>& nullSpace, Preconditioner& M,
                  std::vector<float>& b, std::vector<float>& x, const PcgSettings& settings);
 

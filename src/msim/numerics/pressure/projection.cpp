@@ -200,6 +200,9 @@ void PressureProjection<D>::divergence(const MacGrid<D>& velocity, Grid<float, D
 
 template <int D>
 PcgStats PressureProjection<D>::project(MacGrid<D>& velocity, double dt, double density) {
+  // The pressure is kept as p dt / (rho dx) in the solve: a zero step would make it infinite.
+  if (!(dt > 0.0) || !(density > 0.0))
+    throw std::invalid_argument("pressure projection: the step and the density must be positive");
   const float toScaled = static_cast<float>(dt / (density * spec_.dx));
   netOutflow(velocity, rhs_);
   parallelFor(0, rhs_.size(), [&](std::size_t i) {
