@@ -74,7 +74,9 @@ void expectNearTheExperiment(double heightRatio, const std::vector<Sample>& samp
   const std::vector<double> z = frontPositions(heightRatio, samples, tracker);
   for (std::size_t k = 0; k < samples.size(); ++k) {
     EXPECT_NEAR(z[k], samples[k].Z, 0.18 * samples[k].Z) << "T = " << samples[k].T;
-    if (samples[k].T > 0.7) EXPECT_GT(z[k], samples[k].Z) << "T = " << samples[k].T;
+    if (samples[k].T > 0.7) {
+      EXPECT_GT(z[k], samples[k].Z) << "T = " << samples[k].T;
+    }
     testing::Test::RecordProperty("Z_at_T_" + std::to_string(samples[k].T), std::to_string(z[k]));
   }
 }

@@ -107,6 +107,7 @@ class LiquidSolver {
   const GridSpec<D>& spec() const { return spec_; }
   const LiquidParams<D>& params() const { return params_; }
   const StageTimers& timers() const { return timers_; }
+  void resetTimers() { timers_.reset(); }
 
  private:
   void start();
