@@ -1,6 +1,7 @@
 #pragma once
 // GridSpec<D>: the geometry of a uniform Cartesian grid (origin of its lower corner, cell size dx,
 // cells per axis). Every sampled field (cell-centred or face-centred) is laid over one of these.
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 
@@ -29,6 +30,18 @@ struct GridSpec {
     for (int a = 0; a < D; ++a)
       if (x[a] < origin[a] || x[a] > origin[a] + res[a] * dx) return false;
     return true;
+  }
+  // Linear index (x fastest) of the cell holding x, clamped into the grid.
+  template <typename Position>
+  std::size_t clampedCellIndex(const Position& x) const {
+    std::size_t index = 0, stride = 1;
+    for (int a = 0; a < D; ++a) {
+      const double s = std::floor((double(x[a]) - origin[a]) / dx);
+      const int c = s < 0.0 ? 0 : (s >= res[a] ? res[a] - 1 : static_cast<int>(s));
+      index += static_cast<std::size_t>(c) * stride;
+      stride *= static_cast<std::size_t>(res[a]);
+    }
+    return index;
   }
   double cellVolume() const {
     double v = 1.0;

@@ -22,17 +22,6 @@ Vecf<D> insideDomain(const GridSpec<D>& spec, Vecf<D> x) {
   return x;
 }
 
-template <int D>
-std::size_t cellIndex(const GridSpec<D>& spec, const Vecf<D>& x) {
-  std::size_t index = 0, stride = 1;
-  for (int a = 0; a < D; ++a) {
-    const int c = std::clamp(static_cast<int>(std::floor((x[a] - spec.origin[a]) / spec.dx)), 0, spec.res[a] - 1);
-    index += static_cast<std::size_t>(c) * stride;
-    stride *= static_cast<std::size_t>(spec.res[a]);
-  }
-  return index;
-}
-
 }  // namespace
 
 template <int D>
@@ -71,7 +60,7 @@ void FlipParticles<D>::advect(const MacGrid<D>& velocity, double dt, const Grid<
                            .template cast<double>();
     const Vecf<D> next = insideDomain<D>(spec_, Vec<D>(x + dt * sampleLinear<D>(velocity, mid)).template cast<float>());
     // A particle does not enter a solid cell: it stays where it was (the wall stops it).
-    if (solid[cellIndex<D>(spec_, next)] <= 0.5f) positions_[p] = next;
+    if (solid[spec_.clampedCellIndex(next)] <= 0.5f) positions_[p] = next;
   });
 }
 
@@ -99,7 +88,7 @@ void FlipParticles<D>::bucketByCell() const {
   cellStart_.assign(cells + 1, 0);
   std::vector<std::uint32_t> cellOf(positions_.size());
   for (std::size_t p = 0; p < positions_.size(); ++p) {
-    cellOf[p] = static_cast<std::uint32_t>(cellIndex<D>(spec_, positions_[p]));
+    cellOf[p] = static_cast<std::uint32_t>(spec_.clampedCellIndex(positions_[p]));
     ++cellStart_[cellOf[p] + 1];
   }
   for (std::size_t c = 0; c < cells; ++c) cellStart_[c + 1] += cellStart_[c];

@@ -43,16 +43,7 @@ LiquidSolver<D>::LiquidSolver(const GridSpec<D>& spec, const LiquidParams<D>& pa
 template <int D>
 void LiquidSolver<D>::setObstacles(const Grid<float, D>& nodalSolidPhi) {
   projection_.setSolids(numerics::openFaceFractions<D>(spec_, nodalSolidPhi));
-  // A cell is solid when the D-linear interpolant of the nodal phi is negative at its centre.
-  parallelForCells(solid_, [&](const IVec<D>& c, std::size_t lin) {
-    double mean = 0.0;
-    for (int k = 0; k < (1 << D); ++k) {
-      IVec<D> n = c;
-      for (int a = 0; a < D; ++a) n[a] += (k >> a) & 1;
-      mean += nodalSolidPhi(n);
-    }
-    solid_[lin] = mean < 0.0 ? 1.0f : 0.0f;
-  });
+  numerics::solidCellsFromNodes(nodalSolidPhi, solid_);
   advector_.setSolid(solid_);
 }
 

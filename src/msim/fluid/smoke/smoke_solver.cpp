@@ -42,17 +42,7 @@ SmokeSolver<D>::SmokeSolver(const GridSpec<D>& spec, const SmokeParams<D>& param
 template <int D>
 void SmokeSolver<D>::setObstacles(const Grid<float, D>& nodalSolidPhi) {
   projection_.setSolids(numerics::openFaceFractions<D>(spec_, nodalSolidPhi));
-  // A cell is solid for advection and forces when the D-linear interpolant of phi is negative at
-  // its centre, i.e. the mean of its 2^D corners.
-  parallelForCells(solid_, [&](const IVec<D>& c, std::size_t lin) {
-    double phi = 0.0;
-    for (int k = 0; k < (1 << D); ++k) {
-      IVec<D> n = c;
-      for (int a = 0; a < D; ++a) n[a] += (k >> a) & 1;
-      phi += nodalSolidPhi(n);
-    }
-    solid_[lin] = phi < 0.0 ? 1.0f : 0.0f;
-  });
+  numerics::solidCellsFromNodes(nodalSolidPhi, solid_);  // solid for advection and forces
   advector_.setSolid(solid_);
   updateSealed();
   findCutFaces();

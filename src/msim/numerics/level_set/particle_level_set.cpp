@@ -44,17 +44,6 @@ ParticleLevelSet<D>::ParticleLevelSet(const GridSpec<D>& spec, const ParticleLev
 }
 
 template <int D>
-std::size_t ParticleLevelSet<D>::cellOf(const Vec<D>& x) const {
-  std::size_t index = 0, stride = 1;
-  for (int a = 0; a < D; ++a) {
-    const int c = std::clamp(static_cast<int>(std::floor((x[a] - spec_.origin[a]) / spec_.dx)), 0, spec_.res[a] - 1);
-    index += static_cast<std::size_t>(c) * stride;
-    stride *= static_cast<std::size_t>(spec_.res[a]);
-  }
-  return index;
-}
-
-template <int D>
 void ParticleLevelSet<D>::seedCell(const Grid<float, D>& phi, const IVec<D>& c, int count, std::uint64_t stream) {
   Rng rng = Rng(settings_.seed).split(round_).split(stream);
   const double dx = spec_.dx;
@@ -157,7 +146,7 @@ void ParticleLevelSet<D>::reseed(const Grid<float, D>& phi) {
     positions_[kept] = positions_[p];
     radii_[kept] = radii_[p];
     signs_[kept] = signs_[p];
-    ++count[cellOf(positions_[kept])];
+    ++count[spec_.clampedCellIndex(positions_[kept])];
     ++kept;
   }
   positions_.resize(kept);

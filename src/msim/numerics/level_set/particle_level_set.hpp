@@ -68,7 +68,6 @@ class ParticleLevelSet {
  private:
   // Appends up to `count` particles in cell c (random stream `stream`), attracted to phi.
   void seedCell(const Grid<float, D>& phi, const IVec<D>& c, int count, std::uint64_t stream);
-  std::size_t cellOf(const Vec<D>& x) const;
 
   GridSpec<D> spec_;
   ParticleLevelSetSettings settings_;

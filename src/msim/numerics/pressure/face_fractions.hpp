@@ -34,6 +34,21 @@ Grid<float, D> sampleNodes(const GridSpec<D>& spec, F&& sdf) {
 template <int D>
 MacGrid<D> openFaceFractions(const GridSpec<D>& spec, const Grid<float, D>& nodalSolidPhi);
 
+// Solid cell mask (1 solid, 0 fluid) from nodal solid phi: a cell is solid when the D-linear
+// interpolant of phi is negative at its centre, i.e. the mean of its 2^D corners is.
+template <int D>
+void solidCellsFromNodes(const Grid<float, D>& nodalSolidPhi, Grid<float, D>& solid) {
+  parallelForCells(solid, [&](const IVec<D>& c, std::size_t lin) {
+    double mean = 0.0;
+    for (int k = 0; k < (1 << D); ++k) {
+      IVec<D> n = c;
+      for (int a = 0; a < D; ++a) n[a] += (k >> a) & 1;
+      mean += nodalSolidPhi(n);
+    }
+    solid[lin] = mean < 0.0 ? 1.0f : 0.0f;
+  });
+}
+
 // Open fractions for a solid given as a signed distance function of world position.
 template <int D, typename F>
 MacGrid<D> openFaceFractionsFromSdf(const GridSpec<D>& spec, F&& sdf) {
