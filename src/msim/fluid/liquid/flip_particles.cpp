@@ -4,6 +4,7 @@
 #include <cmath>
 #include <span>
 #include <stdexcept>
+#include <utility>
 
 #include "msim/core/interpolation.hpp"
 #include "msim/core/parallel.hpp"
@@ -50,6 +51,14 @@ void FlipParticles<D>::seed(const Grid<float, D>& phi, const Grid<float, D>& sol
       velocities_.push_back(sampleLinear<D>(velocity, x).template cast<float>());
     }
   }
+}
+
+template <int D>
+void FlipParticles<D>::assign(std::vector<Vecf<D>> positions, std::vector<Vecf<D>> velocities) {
+  if (velocities.size() != positions.size())
+    throw std::invalid_argument("FLIP particles: positions and velocities differ in length");
+  positions_ = std::move(positions);
+  velocities_ = std::move(velocities);
 }
 
 template <int D>

@@ -38,6 +38,10 @@ class FlipParticles {
   // the liquid -band (the reinitialisation that follows fills in the distances).
   void surface(Grid<float, D>& phi, double bandCells) const;
 
+  // Replaces the particles (a resumed run's saved ones); std::invalid_argument for mismatched
+  // lengths.
+  void assign(std::vector<Vecf<D>> positions, std::vector<Vecf<D>> velocities);
+
   std::size_t size() const { return positions_.size(); }
   const std::vector<Vecf<D>>& positions() const { return positions_; }
   const std::vector<Vecf<D>>& velocities() const { return velocities_; }

@@ -65,6 +65,20 @@ void LiquidSolver<D>::addLiquid(const Grid<float, D>& cellPhi, const Vec<D>& vel
 }
 
 template <int D>
+void LiquidSolver<D>::restore(const Grid<float, D>& phi, const MacGrid<D>& velocity, long steps) {
+  if (!phi.sameLayout(phi_)) throw std::invalid_argument("liquid solver: restore needs a cell-centred phi");
+  phi_ = phi;
+  for (int a = 0; a < D; ++a) {
+    if (!velocity.component(a).sameLayout(velocity_.component(a)))
+      throw std::invalid_argument("liquid solver: restore needs the grid's face velocities");
+    velocity_.component(a) = velocity.component(a);
+  }
+  steps_ = steps;
+  started_ = true;
+  if (params_.tracker == InterfaceTracker::ParticleLevelSet && particles_.size() == 0) particles_.seed(phi_);
+}
+
+template <int D>
 void LiquidSolver<D>::start() {
   numerics::reinitializeFastMarching(phi_, params_.bandCells);
   extendVelocity();

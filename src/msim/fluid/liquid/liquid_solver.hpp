@@ -88,6 +88,11 @@ class LiquidSolver {
   // the first step: the particles are seeded then.
   void addLiquid(const Grid<float, D>& cellPhi, const Vec<D>& velocity = Vec<D>::Zero());
 
+  // A saved state (--resume): phi, the face velocities and the number of steps taken. Assign the
+  // saved particles first (levelSetParticles() / flipParticles()); a particle level set left
+  // empty is seeded afresh from phi.
+  void restore(const Grid<float, D>& phi, const MacGrid<D>& velocity, long steps);
+
   // Largest step with (max speed + sqrt(|g| dx)) dt <= cfl dx: the gravity term keeps a liquid at
   // rest from taking an unbounded first step.
   double cflTimestep() const;
@@ -103,7 +108,9 @@ class LiquidSolver {
   const Grid<float, D>& pressure() const { return projection_.pressure(); }
   const Grid<float, D>& solid() const { return solid_; }
   const numerics::ParticleLevelSet<D>& levelSetParticles() const { return particles_; }
+  numerics::ParticleLevelSet<D>& levelSetParticles() { return particles_; }
   const FlipParticles<D>& flipParticles() const { return flip_; }
+  FlipParticles<D>& flipParticles() { return flip_; }
   const GridSpec<D>& spec() const { return spec_; }
   const LiquidParams<D>& params() const { return params_; }
   const StageTimers& timers() const { return timers_; }

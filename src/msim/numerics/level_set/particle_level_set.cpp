@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 #include "msim/core/interpolation.hpp"
 #include "msim/core/parallel.hpp"
@@ -86,6 +87,16 @@ void ParticleLevelSet<D>::seed(const Grid<float, D>& phi) {
   const float band = static_cast<float>(settings_.bandCells * spec_.dx);
   for (std::size_t i = 0; i < phi.count(); ++i)
     if (std::abs(phi[i]) < band) seedCell(phi, phi.coord(i), perCell_, i);
+}
+
+template <int D>
+void ParticleLevelSet<D>::assign(std::vector<Vec<D>> positions, std::vector<float> radii,
+                                 std::vector<std::int8_t> signs) {
+  if (radii.size() != positions.size() || signs.size() != positions.size())
+    throw std::invalid_argument("particle level set: positions, radii and signs differ in length");
+  positions_ = std::move(positions);
+  radii_ = std::move(radii);
+  signs_ = std::move(signs);
 }
 
 template <int D>

@@ -59,6 +59,10 @@ class ParticleLevelSet {
   // particlesPerCell (new particles attracted and sized as in seed).
   void reseed(const Grid<float, D>& phi);
 
+  // Replaces the particles (a resumed run's saved ones); std::invalid_argument for mismatched
+  // lengths.
+  void assign(std::vector<Vec<D>> positions, std::vector<float> radii, std::vector<std::int8_t> signs);
+
   std::size_t size() const { return positions_.size(); }
   const std::vector<Vec<D>>& positions() const { return positions_; }
   const std::vector<float>& radii() const { return radii_; }
