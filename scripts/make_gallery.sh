@@ -45,6 +45,8 @@ granular_hourglass_liquid | preview | --frames 96
 granular_column     | preview | --frames 30 --set domain.resolution=40
 granular_impacts    | preview | --set domain.resolution=50
 granular_explosion  | preview | --frames 14 --set domain.resolution=40
+dam_break_2d        | preview | --frames 10
+dam_break_3d        | preview | --frames 10
 "
 
 wanted=("$@")

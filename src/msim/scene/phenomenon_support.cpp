@@ -1,5 +1,6 @@
 #include "msim/scene/phenomenon_support.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -57,6 +58,29 @@ render::PreviewSettings previewSettings(const Scene& scene) {
   return s;
 }
 
+namespace {
+
+std::string faceGridName(int axis) { return std::string("vel_face_") + "xyz"[axis]; }
+
+}  // namespace
+
+template <int D>
+void writeFaceVelocities(io::VdbWriter& writer, const MacGrid<D>& velocity) {
+  for (int a = 0; a < D; ++a) {
+    const Grid<float, D>& face = velocity.component(a);
+    GridSpec<D> spec = face.spec();
+    spec.res = face.size();
+    Grid<float, D> cells(spec);
+    std::copy(face.data().begin(), face.data().end(), cells.data().begin());
+    writer.addFloatGrid(faceGridName(a), cells);
+  }
+}
+
+template <int D>
+void restoreFaceVelocities(const io::VdbFile& saved, MacGrid<D>& velocity, const std::string& sceneSource) {
+  for (int a = 0; a < D; ++a) restoreGrid(saved, faceGridName(a), velocity.component(a), sceneSource);
+}
+
 template <int D>
 std::unique_ptr<geometry::Shape<D>> sceneShape(const Scene& scene, const nlohmann::json& shapeJson,
                                                const std::string& key) {
@@ -80,6 +104,8 @@ std::vector<std::pair<std::size_t, float>> coveredOpenCells(const Scene& scene, 
   template void requireFinite<D>(const Grid<float, D>&, const std::string&, long, double);                          \
   template void restoreGrid<D>(const io::VdbFile&, const std::string&, Grid<float, D>&,                             \
                                const std::string&);                                                              \
+  template void writeFaceVelocities<D>(io::VdbWriter&, const MacGrid<D>&);                                         \
+  template void restoreFaceVelocities<D>(const io::VdbFile&, MacGrid<D>&, const std::string&);                      \
   template std::unique_ptr<geometry::Shape<D>> sceneShape<D>(const Scene&, const nlohmann::json&,                  \
                                                              const std::string&);                                 \
   template std::vector<std::pair<std::size_t, float>> coveredOpenCells<D>(const Scene&, const geometry::Shape<D>&, \

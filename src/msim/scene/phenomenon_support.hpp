@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "msim/core/grid.hpp"
+#include "msim/core/mac_grid.hpp"
 #include "msim/geometry/shape.hpp"
 #include "msim/io/vdb.hpp"
 #include "msim/io/point_cloud.hpp"
@@ -29,6 +30,13 @@ void requireFinite(const Grid<float, D>& grid, const std::string& field, long st
 template <int D>
 void restoreGrid(const io::VdbFile& saved, const std::string& name, Grid<float, D>& target,
                  const std::string& sceneSource);
+
+// MAC face velocities in a frame for --resume: component a as the cell grid "vel_face_<x|y|z>"
+// of its own size (VDB files hold cell grids; tools should use the cell-centred "vel").
+template <int D>
+void writeFaceVelocities(io::VdbWriter& writer, const MacGrid<D>& velocity);
+template <int D>
+void restoreFaceVelocities(const io::VdbFile& saved, MacGrid<D>& velocity, const std::string& sceneSource);
 
 // Point attribute `name` of a cloud read back from a saved frame for --resume; InputError naming
 // the scene and file when the cloud has points but not the attribute (an empty list for an empty

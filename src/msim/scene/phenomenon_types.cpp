@@ -1,6 +1,7 @@
 #include "msim/scene/crowd_phenomenon.hpp"
 #include "msim/scene/gas_phenomenon.hpp"
 #include "msim/scene/granular_phenomenon.hpp"
+#include "msim/scene/liquid_phenomenon.hpp"
 #include "msim/scene/phenomenon.hpp"
 #include "msim/scene/smoke_phenomenon.hpp"
 
@@ -8,7 +9,7 @@ namespace msim::scene {
 
 const std::vector<PhenomenonType>& phenomenonTypes() {
   static const std::vector<PhenomenonType> types = {gasPhenomenonType(), smokePhenomenonType(), crowdPhenomenonType(),
-                                                    granularPhenomenonType()};
+                                                    granularPhenomenonType(), liquidPhenomenonType()};
   return types;
 }
 

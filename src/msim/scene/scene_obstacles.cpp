@@ -13,8 +13,18 @@
 #include "msim/scene/json_vectors.hpp"
 #include "msim/scene/phenomenon_support.hpp"
 #include "msim/scene/scene_file.hpp"
+#include "msim/scene/schema/shape_schema.hpp"
 
 namespace msim::scene {
+
+Schema sceneObstacleSchema(const std::string& description) {
+  Schema obstacle = Schema::object(description);
+  obstacle.field("shape", shapeSchema());
+  obstacle.vector("velocity", "m/s", {0.0, 0.0, 0.0}, "v of the motion x(t) = x0 + v t + A sin(2 pi f t)").lengths({2, 3});
+  obstacle.vector("oscillation", "m", {0.0, 0.0, 0.0}, "amplitude A of the motion").lengths({2, 3});
+  obstacle.number("frequency", "1/s", 0.0, "f of the motion").min(0.0);
+  return obstacle;
+}
 
 template <int D>
 Vec<D> SceneObstacles<D>::Obstacle::offset(double t) const {

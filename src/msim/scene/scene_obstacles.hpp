@@ -1,5 +1,5 @@
 #pragma once
-// The obstacles[] of a smoke scene: static solids and rigidly moving ones, with motion
+// The obstacles[] of a smoke or liquid scene: static solids and rigidly moving ones, with motion
 // x(t) = x0 + v t + A sin(2 pi f t). They give the solver, at any time, the nodal signed distance
 // of the union of all solids and the velocity of the solid at every face (the moving-obstacle
 // boundary condition of the projection).
@@ -10,10 +10,14 @@
 #include "msim/core/grid.hpp"
 #include "msim/core/mac_grid.hpp"
 #include "msim/geometry/shape.hpp"
+#include "msim/scene/schema/schema.hpp"
 
 namespace msim::scene {
 
 struct Scene;
+
+// The keys of one obstacles[] entry that SceneObstacles reads: shape and rigid motion.
+Schema sceneObstacleSchema(const std::string& description);
 
 template <int D>
 class SceneObstacles {

@@ -150,7 +150,7 @@ class SmokePhenomenon final : public Phenomenon {
       else
         writer.addVectorGrid("vel", solver_.velocity());
     }
-    for (int a = 0; a < D; ++a) writer.addFloatGrid(faceGridName(a), faceAsCells(solver_.velocity().component(a)));
+    writeFaceVelocities(writer, solver_.velocity());
     writer.addFloatGrid("pressure", solver_.pressure());
     if (!obstacles_.empty()) writer.addLevelSet("obstacle_distance", obstacles_.cellDistance(time_));
   }
@@ -183,7 +183,7 @@ class SmokePhenomenon final : public Phenomenon {
     }
     for (std::size_t i = 0; i < solver_.scalarCount(); ++i)
       restoreGrid(saved, solver_.scalarName(i), solver_.scalar(i), source_);
-    for (int a = 0; a < D; ++a) restoreGrid(saved, faceGridName(a), solver_.velocity().component(a), source_);
+    restoreFaceVelocities(saved, solver_.velocity(), source_);
     restoreGrid(saved, "pressure", solver_.pressure(), source_);
   }
 
@@ -216,17 +216,6 @@ class SmokePhenomenon final : public Phenomenon {
   }
 
  private:
-  static std::string faceGridName(int axis) { return std::string("vel_face_") + "xyz"[axis]; }
-  // A face component as a cell grid of its own size (one more sample along its axis): VDB files
-  // hold cell grids. Only --resume reads it back; tools should use "vel".
-  static Grid<float, D> faceAsCells(const Grid<float, D>& face) {
-    GridSpec<D> spec = face.spec();
-    spec.res = face.size();
-    Grid<float, D> cells(spec);
-    std::copy(face.data().begin(), face.data().end(), cells.data().begin());
-    return cells;
-  }
-
   static double maxValue(const Grid<float, D>& g) {
     return parallelMax(g.count(), [&](std::size_t i) { return double(g[i]); });
   }

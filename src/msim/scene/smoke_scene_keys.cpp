@@ -7,6 +7,7 @@
 #include "msim/core/error.hpp"
 #include "msim/scene/json_vectors.hpp"
 #include "msim/scene/scene_file.hpp"
+#include "msim/scene/scene_obstacles.hpp"
 #include "msim/scene/schema/shape_schema.hpp"
 #include "msim/scene/turbulent_wind_keys.hpp"
 
@@ -128,12 +129,8 @@ void declareSmokeKeys(Schema& root) {
   source.number("stop", "s", 0.0, "emits until this time; 0 = to the end").min(0.0);
   root.array("sources", source, "emitters");
 
-  Schema obstacle = Schema::object("a solid the smoke flows around (face fractions: no stair-step leaks)");
-  obstacle.field("shape", shapeSchema());
-  obstacle.vector("velocity", "m/s", {0.0, 0.0, 0.0}, "v of the motion x(t) = x0 + v t + A sin(2 pi f t)").lengths({2, 3});
-  obstacle.vector("oscillation", "m", {0.0, 0.0, 0.0}, "amplitude A of the motion").lengths({2, 3});
-  obstacle.number("frequency", "1/s", 0.0, "f of the motion").min(0.0);
-  root.array("obstacles", obstacle, "static or moving solids");
+  root.array("obstacles", sceneObstacleSchema("a solid the smoke flows around (face fractions: no stair-step leaks)"),
+             "static or moving solids");
   declareTurbulentWinds(root);
 }
 

@@ -44,6 +44,13 @@ Vec<D> standardGravity() {
 // liquid and its velocity (phi rebuilt from them every step).
 enum class InterfaceTracker { ParticleLevelSet, Flip };
 
+// The marker particles of a liquid: escaped ones are deleted at reseeding (see the setting).
+inline numerics::ParticleLevelSetSettings liquidParticleSettings() {
+  numerics::ParticleLevelSetSettings s;
+  s.deleteEscapedOnReseed = true;
+  return s;
+}
+
 template <int D>
 struct LiquidParams {
   InterfaceTracker tracker = InterfaceTracker::ParticleLevelSet;
@@ -52,8 +59,10 @@ struct LiquidParams {
   numerics::AdvectionSettings advection;     // velocity and phi
   numerics::ProjectionSettings projection;   // MIC(0)-PCG with the free surface
   numerics::DomainSides<D> sides;            // walls by default
-  numerics::ParticleLevelSetSettings particleLevelSet;
-  int reseedInterval = 20;                   // steps between reseedings of the particle level set
+  numerics::ParticleLevelSetSettings particleLevelSet = liquidParticleSettings();
+  // Steps between reseedings of the particle level set (each also deletes the escaped particles):
+  // in the 2D dam break (scenes/dam_break_2d.json) 5 keeps 93% of the water after 2.5 s, 20 87%.
+  int reseedInterval = 5;
   double flipRatio = 0.95;                   // FLIP share of the PIC/FLIP blend (1: FLIP, 0: PIC)
   int flipParticlesPerCell = 0;              // 0: 2 per axis (4 in 2D, 8 in 3D)
   std::uint64_t seed = 1;                    // FLIP seeding
@@ -113,6 +122,7 @@ class LiquidSolver {
   FlipParticles<D>& flipParticles() { return flip_; }
   const GridSpec<D>& spec() const { return spec_; }
   const LiquidParams<D>& params() const { return params_; }
+  const numerics::PcgStats& lastPressureSolve() const { return lastSolve_; }
   const StageTimers& timers() const { return timers_; }
   void resetTimers() { timers_.reset(); }
 

@@ -153,7 +153,9 @@ void ParticleLevelSet<D>::reseed(const Grid<float, D>& phi) {
   std::size_t kept = 0;
   std::vector<int> count(phi.count(), 0);
   for (std::size_t p = 0; p < positions_.size(); ++p) {
-    if (std::abs(sampleLinear<D>(phi, positions_[p])) > band) continue;
+    const float value = sampleLinear<D>(phi, positions_[p]);
+    if (std::abs(value) > band) continue;
+    if (settings_.deleteEscapedOnReseed && signs_[p] * value < -radii_[p]) continue;
     positions_[kept] = positions_[p];
     radii_[kept] = radii_[p];
     signs_[kept] = signs_[p];

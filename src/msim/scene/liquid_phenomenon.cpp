@@ -1,0 +1,295 @@
+#include "msim/scene/liquid_phenomenon.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+
+#include <fmt/format.h>
+
+#include "msim/core/error.hpp"
+#include "msim/core/log.hpp"
+#include "msim/core/parallel.hpp"
+#include "msim/fluid/liquid/liquid_solver.hpp"
+#include "msim/io/level_set_mesh.hpp"
+#include "msim/io/ply.hpp"
+#include "msim/io/vdb.hpp"
+#include "msim/numerics/level_set/level_set_measures.hpp"
+#include "msim/scene/json_vectors.hpp"
+#include "msim/scene/phenomenon_support.hpp"
+#include "msim/scene/scene_file.hpp"
+#include "msim/scene/scene_obstacles.hpp"
+#include "msim/scene/schema/shape_schema.hpp"
+
+namespace msim::scene {
+
+namespace {
+
+using nlohmann::json;
+
+constexpr const char* kPhi = "liquid_phi";
+constexpr const char* kLevelSetParticles = "level_set_particles";
+constexpr const char* kFlipParticles = "flip_particles";
+
+void declareLiquid(Schema& root) {
+  Schema liquid = Schema::object("the liquid and how its surface is tracked (docs/liquid.md)");
+  liquid.string("tracker", "particle_level_set",
+                "particle_level_set: level set corrected by marker particles (Selle ch. 4.4.3); flip: PIC/FLIP "
+                "particles carry the liquid (Golas ch. 2.7)")
+      .choices({"particle_level_set", "flip"});
+  liquid.number("density", "kg/m^3", 1000.0, "rho of the liquid").min(0.0, Bound::Exclusive);
+  liquid.vector("gravity", "m/s^2", {0.0, -9.81, 0.0}, "acceleration of gravity").lengths({2, 3});
+  liquid.number("flip_ratio", "", 0.95, "FLIP share of the PIC/FLIP blend: 1 FLIP, 0 PIC").min(0.0).max(1.0);
+  liquid.integer("reseed_interval", 5, "steps between reseedings of the particle level set (and deletions of its escaped particles)").min(1);
+  root.field("liquid", liquid);
+
+  Schema body = Schema::object("liquid present at the start");
+  body.field("shape", shapeSchema());
+  body.vector("velocity", "m/s", {0.0, 0.0, 0.0}, "initial velocity of this body").lengths({2, 3});
+  root.array("initial_liquid", body, "bodies of liquid at t = 0 (their union)");
+  root.array("obstacles", sceneObstacleSchema("a static solid the liquid flows around"), "static solids");
+}
+
+double liquidBytesPerCell(int dimensions, const json& resolved) {
+  // phi, solid, pressure phi, pressure, the matrix (D + 2), MIC(0) (2), PCG (4 + 2), face phi,
+  // velocity, its copy, weights, solid velocity, 1/theta and the advector's scratch (about 6
+  // face grids), known flags (bytes): ~ 18 + 12 D floats. Particles: the particle level set keeps
+  // 16 (2D) or 32 (3D) of 29 bytes in each band cell, about a tenth of the cells; FLIP 2^D of 24
+  // bytes in each liquid cell, about half of them.
+  const bool flip = resolved.at("liquid").at("tracker").get<std::string>() == "flip";
+  const double particles = flip ? 0.5 * (1 << dimensions) * 24.0 : 0.1 * (dimensions == 2 ? 16 : 32) * 29.0;
+  return 4.0 * (18 + 12 * dimensions) + particles;
+}
+
+template <int D>
+Vec<D> vectorKey(const json& v) {
+  const Vec3 p = paddedVec3(v);
+  Vec<D> out;
+  for (int a = 0; a < D; ++a) out[a] = p[a];
+  return out;
+}
+
+template <int D>
+fluid::LiquidParams<D> liquidParams(const Scene& scene) {
+  const json& l = scene.resolved.at("liquid");
+  fluid::LiquidParams<D> p;
+  p.tracker = l.at("tracker").get<std::string>() == "flip" ? fluid::InterfaceTracker::Flip
+                                                           : fluid::InterfaceTracker::ParticleLevelSet;
+  p.density = l.at("density").get<double>();
+  p.gravity = vectorKey<D>(l.at("gravity"));
+  p.flipRatio = l.at("flip_ratio").get<double>();
+  p.reseedInterval = l.at("reseed_interval").get<int>();
+  p.cfl = scene.resolved.at("time").at("cfl").get<double>();
+  p.sides = numerics::DomainSides<D>::allWalls();
+  const json& sides = scene.resolved.at("domain").at("boundaries");
+  const char* names[3][2] = {{"x_min", "x_max"}, {"y_min", "y_max"}, {"z_min", "z_max"}};
+  for (int a = 0; a < D; ++a)
+    for (int s = 0; s < 2; ++s)
+      if (sides.at(names[a][s]).get<std::string>() == "open") p.sides.side[a][s] = numerics::DomainSide::Open;
+  return p;
+}
+
+template <int D>
+class LiquidPhenomenon final : public Phenomenon {
+ public:
+  LiquidPhenomenon(const Scene& scene, StageTimers& timers)
+      : source_(scene.file.string()),
+        name_(scene.resolved.at("name").get<std::string>()),
+        timers_(timers),
+        obstacles_(scene, scene.gridSpec<D>()),
+        solver_(scene.gridSpec<D>(), liquidParams<D>(scene)) {
+    const GridSpec<D> spec = scene.gridSpec<D>();
+    const json& sides = scene.resolved.at("domain").at("boundaries");
+    for (const char* side : {"x_min", "x_max", "y_min", "y_max", "z_min", "z_max"}) {
+      if ((D == 2 && side[0] == 'z') || sides.at(side).get<std::string>() != "open") continue;
+      logger().warn("{}: 'domain.boundaries.{}' is open: the pressure is 0 there and the liquid flows out through it "
+                    "(set it to \"closed\" for a tank wall)",
+                    source_, side);
+    }
+    if (obstacles_.moving())
+      throw InputError(fmt::format("{}: 'obstacles': moving obstacles are not supported by the liquid phenomenon yet "
+                                   "(give them no velocity, oscillation or frequency)",
+                                   source_));
+    if (!obstacles_.empty()) {
+      solver_.setObstacles(obstacles_.nodalDistance(0.0));
+      obstacleDistance_ = obstacles_.cellDistance(0.0);
+    }
+    const json& bodies = scene.resolved.at("initial_liquid");
+    if (bodies.empty())
+      throw InputError(fmt::format("{}: 'initial_liquid' is empty: a liquid scene needs at least one body of liquid",
+                                   source_));
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      const std::string key = fmt::format("initial_liquid[{}].shape", i);
+      const auto shape = sceneShape<D>(scene, bodies[i].at("shape"), key);
+      coveredOpenCells<D>(scene, *shape, solver_.solid(), key);  // InputError when it holds no open cell
+      solver_.addLiquid(shape->distanceField(spec), vectorKey<D>(bodies[i].at("velocity")));
+    }
+    preview_ = previewSettings(scene);
+    fraction_ = Grid<float, D>(spec);
+  }
+
+  double stableTimestep() const override { return solver_.cflTimestep(); }
+
+  void step(double dt) override {
+    {
+      ScopedStage stage(timers_, "liquid: step");
+      solver_.step(dt);
+    }
+    ScopedStage stage(timers_, "liquid: volume check");
+    const long index = solver_.statistics().step;
+    if (!solver_.lastPressureSolve().converged) {
+      ++unconverged_;
+      logger().warn("liquid: the pressure solve of step {} did not converge ({} iterations, relative residual {:.2g})",
+                    index, solver_.lastPressureSolve().iterations, solver_.lastPressureSolve().relativeResidual);
+    }
+    const double before = volume_, after = volume();
+    volume_ = after;
+    if (before > 0.0 && after < 0.9 * before)
+      throw SimulationError(fmt::format("liquid: step {} lost {:.1f}% of the liquid's volume ({:.4g} -> {:.4g} m^{}): "
+                                        "the flow is too violent for the grid",
+                                        index, 100.0 * (1.0 - after / before), before, after, D));
+  }
+
+  void checkFinite(long stepIndex, double time) const override {
+    requireFinite(solver_.phi(), "liquid phi", stepIndex, time);
+    static const char* axes[] = {"velocity x", "velocity y", "velocity z"};
+    for (int a = 0; a < D; ++a) requireFinite(solver_.velocity().component(a), axes[a], stepIndex, time);
+  }
+
+  // liquid_phi (a level set), "vel" at the cell centres in 3D for tools, the face velocities for
+  // --resume, the particles (their positions and radii or velocities), the obstacles' distance.
+  void writeVolume(io::VdbWriter& writer) const override {
+    writer.addLevelSet(kPhi, solver_.phi(), 3);
+    if constexpr (D == 3) writer.addVectorGrid("vel", solver_.velocity());
+    writeFaceVelocities(writer, solver_.velocity());
+    if (solver_.params().tracker == fluid::InterfaceTracker::Flip)
+      writer.addPoints(kFlipParticles, flipCloud(), solver_.spec().dx);
+    else
+      writer.addPoints(kLevelSetParticles, levelSetCloud(), solver_.spec().dx);
+    if (obstacleDistance_) writer.addLevelSet("obstacle_distance", *obstacleDistance_);
+  }
+
+  // The surface as a triangle mesh (3D): mesh/<name>_NNNN.ply.
+  void writeFrameData(const std::filesystem::path& runDir, int frame) const override {
+    if constexpr (D == 3) {
+      const std::filesystem::path dir = runDir / "mesh";
+      std::filesystem::create_directories(dir);
+      io::writePlyMesh(dir / fmt::format("{}_{:04d}.ply", name_, frame), io::levelSetMesh(solver_.phi()));
+    }
+  }
+
+  io::Image preview() const override {
+    const double eps = 1.5 * solver_.spec().dx;
+    parallelFor(0, fraction_.count(), [&](std::size_t i) {
+      fraction_[i] = static_cast<float>(numerics::smearedInside(solver_.phi()[i], eps));
+    });
+    return render::renderDensityPreview(fraction_, preview_, obstacles_.empty() ? nullptr : &solver_.solid());
+  }
+
+  // The resumed run continues from the saved surface, velocity and particles; the pressure's warm
+  // start is not saved, so it is close to but not bit-equal with an uninterrupted run.
+  void restore(const std::filesystem::path& vdbFile, double /*time*/) override {
+    const io::VdbFile saved(vdbFile, io::VdbProvenance::MsimRun);
+    Grid<float, D> phi(solver_.spec());
+    restoreGrid(saved, kPhi, phi, source_);
+    MacGrid<D> velocity(solver_.spec());
+    restoreFaceVelocities(saved, velocity, source_);
+    if (solver_.params().tracker == fluid::InterfaceTracker::Flip) {
+      const io::PointCloud cloud = saved.points(kFlipParticles);
+      std::vector<Vecf<D>> positions(cloud.positions.size()), velocities(cloud.positions.size());
+      const char* names[3] = {"vx", "vy", "vz"};
+      for (std::size_t p = 0; p < positions.size(); ++p)
+        for (int a = 0; a < D; ++a) positions[p][a] = cloud.positions[p][a];
+      for (int a = 0; a < D; ++a) {
+        const auto& v = savedPointAttribute(cloud, names[a], vdbFile, source_);
+        for (std::size_t p = 0; p < positions.size(); ++p) velocities[p][a] = v[p];
+      }
+      solver_.flipParticles().assign(std::move(positions), std::move(velocities));
+    } else {
+      const io::PointCloud cloud = saved.points(kLevelSetParticles);
+      const auto& radius = savedPointAttribute(cloud, "radius", vdbFile, source_);
+      const auto& sign = savedPointAttribute(cloud, "sign", vdbFile, source_);
+      std::vector<Vec<D>> positions(cloud.positions.size());
+      std::vector<std::int8_t> signs(sign.size());
+      for (std::size_t p = 0; p < positions.size(); ++p) {
+        for (int a = 0; a < D; ++a) positions[p][a] = cloud.positions[p][a];
+        signs[p] = sign[p] < 0.0f ? -1 : 1;
+      }
+      solver_.levelSetParticles().assign(std::move(positions), radius, std::move(signs));
+    }
+    solver_.restore(phi, velocity, 0);
+    volume_ = volume();
+  }
+
+  json statistics() const override {
+    const fluid::LiquidStatistics s = solver_.statistics();
+    return {{"volume_m3", s.volume},
+            {"max_speed_m_s", s.maxSpeed},
+            {"kinetic_energy_J", s.kineticEnergy},
+            {"pressure_iterations", s.pressureIterations},
+            {"pressure_unconverged_steps", unconverged_},
+            {"particles", s.particles},
+            {"escaped_particles", s.escaped}};
+  }
+
+ private:
+  double volume() const { return numerics::enclosedVolume(solver_.phi(), &solver_.solid()); }
+
+  io::PointCloud levelSetCloud() const {
+    const auto& lp = solver_.levelSetParticles();
+    io::PointCloud cloud;
+    cloud.positions.reserve(lp.size());
+    io::PointAttribute radius{"radius", {}}, sign{"sign", {}};
+    for (std::size_t p = 0; p < lp.size(); ++p) {
+      Vecf<3> x = Vecf<3>::Zero();
+      for (int a = 0; a < D; ++a) x[a] = static_cast<float>(lp.positions()[p][a]);
+      cloud.positions.push_back(x);
+      radius.values.push_back(lp.radii()[p]);
+      sign.values.push_back(lp.signs()[p]);
+    }
+    cloud.attributes = {std::move(radius), std::move(sign)};
+    return cloud;
+  }
+
+  io::PointCloud flipCloud() const {
+    const auto& fp = solver_.flipParticles();
+    io::PointCloud cloud;
+    std::vector<io::PointAttribute> v = {{"vx", {}}, {"vy", {}}, {"vz", {}}};
+    for (std::size_t p = 0; p < fp.size(); ++p) {
+      Vecf<3> x = Vecf<3>::Zero();
+      for (int a = 0; a < D; ++a) x[a] = fp.positions()[p][a];
+      cloud.positions.push_back(x);
+      for (int a = 0; a < 3; ++a) v[a].values.push_back(a < D ? fp.velocities()[p][a] : 0.0f);
+    }
+    cloud.attributes = std::move(v);
+    return cloud;
+  }
+
+  std::string source_, name_;
+  StageTimers& timers_;
+  SceneObstacles<D> obstacles_;
+  fluid::LiquidSolver<D> solver_;
+  std::optional<Grid<float, D>> obstacleDistance_;
+  render::PreviewSettings preview_;
+  mutable Grid<float, D> fraction_;  // the preview's liquid fraction (smeared Heaviside of phi)
+  long unconverged_ = 0;
+  double volume_ = 0.0;  // after the last step (0 before the first)
+};
+
+template <int D>
+std::unique_ptr<Phenomenon> createLiquid(const Scene& scene, StageTimers& timers) {
+  return std::make_unique<LiquidPhenomenon<D>>(scene, timers);
+}
+
+std::unique_ptr<Phenomenon> createLiquidFor(const Scene& scene, StageTimers& timers) {
+  return scene.dimensions == 2 ? createLiquid<2>(scene, timers) : createLiquid<3>(scene, timers);
+}
+
+}  // namespace
+
+PhenomenonType liquidPhenomenonType() {
+  return {"liquid", "water with a free surface: particle level set or FLIP (Selle ch. 4.4.3, Golas ch. 2.7)",
+          &declareLiquid, &liquidBytesPerCell, &createLiquidFor};
+}
+
+}  // namespace msim::scene
