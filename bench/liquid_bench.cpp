@@ -44,4 +44,10 @@ void BM_LiquidDamBreakStep3D(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK(BM_LiquidDamBreakStep3D)->Args({64, 0})->Args({64, 1})->Unit(benchmark::kMillisecond)->Iterations(5);
+BENCHMARK(BM_LiquidDamBreakStep3D)
+    ->Args({64, 0})
+    ->Args({64, 1})
+    ->Args({128, 0})
+    ->Args({128, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(3);

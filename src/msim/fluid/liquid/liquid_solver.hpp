@@ -57,7 +57,7 @@ struct LiquidParams {
   Vec<D> gravity = standardGravity<D>();     // [m/s^2]
   double density = 1000.0;                   // rho of the liquid [kg/m^3]
   numerics::AdvectionSettings advection;     // velocity and phi
-  numerics::ProjectionSettings projection;   // MIC(0)-PCG with the free surface
+  numerics::ProjectionSettings projection;   // MG-PCG with the free surface
   numerics::DomainSides<D> sides;            // walls by default
   numerics::ParticleLevelSetSettings particleLevelSet = liquidParticleSettings();
   // Steps between reseedings of the particle level set (each also deletes the escaped particles):

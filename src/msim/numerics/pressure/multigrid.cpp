@@ -55,11 +55,36 @@ MacGrid<D> coarsenFaceWeights(const MacGrid<D>& fine) {
 }
 
 template <int D>
+std::vector<float> coarsenDirichletDiagonal(const std::vector<float>& fine, const IVec<D>& fineRes) {
+  if (fine.empty()) return {};
+  const IVec<D> res = fineRes / 2;
+  std::size_t n = 1;
+  for (int a = 0; a < D; ++a) n *= static_cast<std::size_t>(res[a]);
+  std::vector<float> coarse(n, 0.0f);
+  constexpr float kShare = 1.0f / (1 << (D - 1));
+  parallelForCells<D>(res, [&](const IVec<D>& C, std::size_t lin) {
+    float sum = 0.0f;
+    for (int k = 0; k < (1 << D); ++k) {
+      std::size_t f = 0, stride = 1;
+      for (int a = 0; a < D; ++a) {
+        f += static_cast<std::size_t>(2 * C[a] + ((k >> a) & 1)) * stride;
+        stride *= static_cast<std::size_t>(fineRes[a]);
+      }
+      sum += fine[f];
+    }
+    coarse[lin] = sum * kShare;
+  });
+  return coarse;
+}
+
+template <int D>
 MultigridPreconditioner<D>::MultigridPreconditioner(const PoissonMatrix<D>& fine, const MacGrid<D>& fineFaceWeight,
-                                                    const MultigridSettings& settings)
+                                                    const MultigridSettings& settings,
+                                                    const std::vector<float>& fineDirichletDiagonal)
     : settings_(settings) {
   MacGrid<D> weights;
   const MacGrid<D>* current = &fineFaceWeight;
+  std::vector<float> dirichlet = fineDirichletDiagonal;
   IVec<D> res = fine.res();
   int levels = 1;
   while (canCoarsen<D>(res, settings.coarsestMinCells)) {
@@ -69,9 +94,10 @@ MultigridPreconditioner<D>::MultigridPreconditioner(const PoissonMatrix<D>& fine
   coarse_.reserve(levels - 1);  // matrices_ points into coarse_, which must not reallocate
   matrices_.push_back(&fine);
   for (int l = 1; l < levels; ++l) {
+    dirichlet = coarsenDirichletDiagonal<D>(dirichlet, current->spec().res);
     weights = coarsenFaceWeights(*current);
     current = &weights;
-    coarse_.emplace_back(weights);
+    coarse_.emplace_back(weights, dirichlet);
     matrices_.push_back(&coarse_.back());
   }
   transfer_.resize(levels - 1);
@@ -307,6 +333,8 @@ void MultigridPreconditioner<D>::prolongAdd(int fineLevel, std::vector<float>& f
 
 template MacGrid<2> coarsenFaceWeights<2>(const MacGrid<2>&);
 template MacGrid<3> coarsenFaceWeights<3>(const MacGrid<3>&);
+template std::vector<float> coarsenDirichletDiagonal<2>(const std::vector<float>&, const IVec<2>&);
+template std::vector<float> coarsenDirichletDiagonal<3>(const std::vector<float>&, const IVec<3>&);
 template class MultigridPreconditioner<2>;
 template class MultigridPreconditioner<3>;
 

@@ -34,13 +34,20 @@ struct MultigridSettings {
 // Face weights of the grid with half the resolution (res must be even on every axis).
 template <int D>
 MacGrid<D> coarsenFaceWeights(const MacGrid<D>& fine);
+// Dirichlet diagonal terms of the grid with half the resolution: the children's sum over 2^(D-1).
+template <int D>
+std::vector<float> coarsenDirichletDiagonal(const std::vector<float>& fine, const IVec<D>& fineRes);
 
 template <int D>
 class MultigridPreconditioner final : public Preconditioner {
  public:
-  // `fine` (the matrix of `fineFaceWeight`) must outlive the preconditioner.
+  // `fine` (the matrix of `fineFaceWeight` and `fineDirichletDiagonal`) must outlive the
+  // preconditioner. With a free surface (PoissonMatrix's Dirichlet terms) each coarse cell takes
+  // the sum of its children's Dirichlet terms over 2^(D-1), the coarse face's share of them as a
+  // coarse face weight is the mean of its fine faces; air cells (no coupling, no Dirichlet term)
+  // have no unknown on any level.
   MultigridPreconditioner(const PoissonMatrix<D>& fine, const MacGrid<D>& fineFaceWeight,
-                          const MultigridSettings& settings = {});
+                          const MultigridSettings& settings = {}, const std::vector<float>& fineDirichletDiagonal = {});
   void apply(const std::vector<float>& r, std::vector<float>& z) override;
 
   int levelCount() const { return static_cast<int>(matrices_.size()); }

@@ -47,8 +47,10 @@ template <int D>
 void PressureProjection<D>::buildPreconditioner() {
   mic0_.reset();
   multigrid_.reset();
-  if (freeSurface_ || settings_.preconditioner == PressurePreconditioner::Mic0)
+  if (settings_.preconditioner == PressurePreconditioner::Mic0)
     mic0_ = std::make_unique<Mic0Preconditioner<D>>(matrix_, settings_.mic0);
+  else if (freeSurface_)
+    multigrid_ = std::make_unique<MultigridPreconditioner<D>>(matrix_, coupling_, settings_.multigrid, dirichlet_);
   else
     multigrid_ = std::make_unique<MultigridPreconditioner<D>>(matrix_, weights_, settings_.multigrid);
 }
@@ -63,7 +65,8 @@ void PressureProjection<D>::setFreeSurface(const Grid<float, D>& liquidPhi, floa
   };
   // Couplings only between liquid cells (a boundary face keeps its weight when its cell is
   // liquid: the open side's ghost pressure is 0 as before); 1 / theta on the liquid-air faces.
-  MacGrid<D> coupling(spec_, 0.0f);
+  MacGrid<D>& coupling = coupling_;
+  coupling = MacGrid<D>(spec_, 0.0f);
   inverseTheta_ = MacGrid<D>(spec_, 1.0f);
   for (int a = 0; a < D; ++a) {
     const auto& w = weights_.component(a);
@@ -84,7 +87,8 @@ void PressureProjection<D>::setFreeSurface(const Grid<float, D>& liquidPhi, floa
     });
   }
   // Each liquid cell's Dirichlet terms: w_f / theta over its faces towards air.
-  std::vector<float> dirichlet(spec_.cellCount(), 0.0f);
+  std::vector<float>& dirichlet = dirichlet_;
+  dirichlet.assign(spec_.cellCount(), 0.0f);
   parallelForCells(liquidPhi, [&](const IVec<D>& c, std::size_t cell) {
     if (!liquid(cell)) return;
     float sum = 0.0f;

@@ -79,9 +79,9 @@ class PressureProjection {
   // w_f / theta to i's diagonal and the update across it becomes u -= (p_j - p_i) / theta, which
   // is second order in the surface's position. theta is clamped below at minTheta (a cell whose
   // centre lies on the surface would otherwise get an unbounded diagonal). Rebuilds the matrix,
-  // its null space (a drop touching no air or open side floats) and the preconditioner, which is
-  // MIC(0) while a free surface is set: the multigrid hierarchy has no Dirichlet cells yet. Faces
-  // between two air cells keep their velocity (the caller extrapolates it).
+  // its null space (a drop touching no air or open side floats) and the preconditioner (the
+  // multigrid hierarchy coarsens the Dirichlet terms too). Faces between two air cells keep their
+  // velocity (the caller extrapolates it).
   void setFreeSurface(const Grid<float, D>& liquidPhi, float minTheta = 1e-3f);
 
   // Makes `velocity` divergence free; the pressure [Pa] is kept (pressure()) and warm-starts
@@ -112,12 +112,14 @@ class PressureProjection {
   GridSpec<D> spec_;
   DomainSides<D> sides_;
   ProjectionSettings settings_;
-  // Builds the preconditioner chosen by the settings for matrix_ (MIC(0) with a free surface).
+  // Builds the preconditioner chosen by the settings for matrix_.
   void buildPreconditioner();
 
   MacGrid<D> weights_;
   MacGrid<D> solidVelocity_;
   MacGrid<D> inverseTheta_;  // 1 / theta on liquid-air faces, 1 elsewhere; empty without a free surface
+  MacGrid<D> coupling_;      // with a free surface: the weights between cells that have unknowns
+  std::vector<float> dirichlet_;  // with a free surface: PoissonMatrix's Dirichlet terms
   bool freeSurface_ = false;
   std::array<std::array<float, 2>, D> wallNormalVelocity_{};
   PoissonMatrix<D> matrix_;
