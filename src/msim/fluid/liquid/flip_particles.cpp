@@ -115,22 +115,42 @@ void FlipParticles<D>::surface(Grid<float, D>& phi, double bandCells) const {
   const int reach = 2;             // cells within R of a cell centre
   auto count = [&](std::size_t cell) { return cellStart_[cell + 1] - cellStart_[cell]; };
   parallelForCells(phi, [&](const IVec<D>& c, std::size_t cell) {
-    // Deep inside: the cell and its face and corner neighbours all hold particles.
-    bool deep = true, near = false;
     IVec<D> lo, hi;
     for (int a = 0; a < D; ++a) {
       lo[a] = std::max(0, c[a] - reach);
       hi[a] = std::min(spec_.res[a] - 1, c[a] + reach);
     }
+    // Visits the cells of the box [lo, hi] (D-linear index order).
+    auto forBox = [&](const IVec<D>& from, const IVec<D>& to, auto&& f) {
+      IVec<D> n = from;
+      while (true) {
+        f(n);
+        int a = 0;
+        for (; a < D; ++a) {
+          if (++n[a] <= to[a]) break;
+          n[a] = from[a];
+        }
+        if (a == D) return;
+      }
+    };
+    // Deep inside: the cell and its face and corner neighbours all hold particles (their kernel
+    // sums would only give about -r; the reinitialisation fills in the distance).
+    IVec<D> lo1, hi1;
+    for (int a = 0; a < D; ++a) {
+      lo1[a] = std::max(0, c[a] - 1);
+      hi1[a] = std::min(spec_.res[a] - 1, c[a] + 1);
+    }
+    bool deep = true;
+    forBox(lo1, hi1, [&](const IVec<D>& n) { deep = deep && count(phi.index(n)) > 0; });
+    if (deep) {
+      phi[cell] = -band;
+      return;
+    }
     Vec<D> weighted = Vec<D>::Zero();
     double weights = 0.0;
     const Vec<D> x = phi.position(c);
-    IVec<D> n = lo;
-    while (true) {
+    forBox(lo, hi, [&](const IVec<D>& n) {
       const std::size_t nc = phi.index(n);
-      bool adjacent = true;
-      for (int a = 0; a < D; ++a) adjacent = adjacent && std::abs(n[a] - c[a]) <= 1;
-      if (adjacent && count(nc) == 0) deep = false;
       for (std::uint32_t k = cellStart_[nc]; k < cellStart_[nc + 1]; ++k) {
         const Vec<D> xp = positions_[order_[k]].template cast<double>();
         const double s2 = (xp - x).squaredNorm() / (R * R);
@@ -138,21 +158,11 @@ void FlipParticles<D>::surface(Grid<float, D>& phi, double bandCells) const {
         const double w = (1.0 - s2) * (1.0 - s2) * (1.0 - s2);
         weighted += w * xp;
         weights += w;
-        near = true;
       }
-      int a = 0;
-      for (; a < D; ++a) {
-        if (++n[a] <= hi[a]) break;
-        n[a] = lo[a];
-      }
-      if (a == D) break;
-    }
-    if (!near)
-      phi[cell] = band;
-    else if (deep)
-      phi[cell] = -band;
-    else
-      phi[cell] = static_cast<float>(std::clamp((x - weighted / weights).norm() - radius_, -double(band), double(band)));
+    });
+    phi[cell] = weights > 0.0 ? static_cast<float>(std::clamp((x - weighted / weights).norm() - radius_, -double(band),
+                                                              double(band)))
+                              : band;
   });
 }
 
