@@ -91,10 +91,9 @@ fluid::MotionField motionField(const json& fields) {
 template <int D>
 numerics::TransportBoundaries<D> boundaries(const json& sides) {
   numerics::TransportBoundaries<D> b;
-  const char* names[3][2] = {{"x_min", "x_max"}, {"y_min", "y_max"}, {"z_min", "z_max"}};
   for (int a = 0; a < D; ++a)
     for (int s = 0; s < 2; ++s)
-      b.side[a][s] = sides.at(names[a][s]).get<std::string>() == "open" ? numerics::BoundaryKind::Open
+      b.side[a][s] = sides.at(kDomainSideKeys[a][s]).get<std::string>() == "open" ? numerics::BoundaryKind::Open
                                                                         : numerics::BoundaryKind::Closed;
   return b;
 }

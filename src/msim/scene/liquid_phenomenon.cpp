@@ -62,30 +62,21 @@ double liquidBytesPerCell(int dimensions, const json& resolved) {
 }
 
 template <int D>
-Vec<D> vectorKey(const json& v) {
-  const Vec3 p = paddedVec3(v);
-  Vec<D> out;
-  for (int a = 0; a < D; ++a) out[a] = p[a];
-  return out;
-}
-
-template <int D>
 fluid::LiquidParams<D> liquidParams(const Scene& scene) {
   const json& l = scene.resolved.at("liquid");
   fluid::LiquidParams<D> p;
   p.tracker = l.at("tracker").get<std::string>() == "flip" ? fluid::InterfaceTracker::Flip
                                                            : fluid::InterfaceTracker::ParticleLevelSet;
   p.density = l.at("density").get<double>();
-  p.gravity = vectorKey<D>(l.at("gravity"));
+  p.gravity = sceneVector<D>(l.at("gravity"));
   p.flipRatio = l.at("flip_ratio").get<double>();
   p.reseedInterval = l.at("reseed_interval").get<int>();
   p.cfl = scene.resolved.at("time").at("cfl").get<double>();
-  p.sides = numerics::DomainSides<D>::allWalls();
   const json& sides = scene.resolved.at("domain").at("boundaries");
-  const char* names[3][2] = {{"x_min", "x_max"}, {"y_min", "y_max"}, {"z_min", "z_max"}};
   for (int a = 0; a < D; ++a)
     for (int s = 0; s < 2; ++s)
-      if (sides.at(names[a][s]).get<std::string>() == "open") p.sides.side[a][s] = numerics::DomainSide::Open;
+      p.sides.side[a][s] = sides.at(kDomainSideKeys[a][s]).get<std::string>() == "open" ? numerics::DomainSide::Open
+                                                                                       : numerics::DomainSide::Wall;
   return p;
 }
 
@@ -99,13 +90,12 @@ class LiquidPhenomenon final : public Phenomenon {
         obstacles_(scene, scene.gridSpec<D>()),
         solver_(scene.gridSpec<D>(), liquidParams<D>(scene)) {
     const GridSpec<D> spec = scene.gridSpec<D>();
-    const json& sides = scene.resolved.at("domain").at("boundaries");
-    for (const char* side : {"x_min", "x_max", "y_min", "y_max", "z_min", "z_max"}) {
-      if ((D == 2 && side[0] == 'z') || sides.at(side).get<std::string>() != "open") continue;
-      logger().warn("{}: 'domain.boundaries.{}' is open: the pressure is 0 there and the liquid flows out through it "
-                    "(set it to \"closed\" for a tank wall)",
-                    source_, side);
-    }
+    for (int a = 0; a < D; ++a)
+      for (int s = 0; s < 2; ++s)
+        if (solver_.params().sides.side[a][s] == numerics::DomainSide::Open)
+          logger().warn("{}: 'domain.boundaries.{}' is open: the pressure is 0 there and the liquid flows out through "
+                        "it (set it to \"closed\" for a tank wall)",
+                        source_, kDomainSideKeys[a][s]);
     if (obstacles_.moving())
       throw InputError(fmt::format("{}: 'obstacles': moving obstacles are not supported by the liquid phenomenon yet "
                                    "(give them no velocity, oscillation or frequency)",
@@ -122,7 +112,7 @@ class LiquidPhenomenon final : public Phenomenon {
       const std::string key = fmt::format("initial_liquid[{}].shape", i);
       const auto shape = sceneShape<D>(scene, bodies[i].at("shape"), key);
       coveredOpenCells<D>(scene, *shape, solver_.solid(), key);  // InputError when it holds no open cell
-      solver_.addLiquid(shape->distanceField(spec), vectorKey<D>(bodies[i].at("velocity")));
+      solver_.addLiquid(shape->distanceField(spec), sceneVector<D>(bodies[i].at("velocity")));
     }
     preview_ = previewSettings(scene);
     fraction_ = Grid<float, D>(spec);
@@ -136,7 +126,7 @@ class LiquidPhenomenon final : public Phenomenon {
       solver_.step(dt);
     }
     ScopedStage stage(timers_, "liquid: volume check");
-    const long index = solver_.statistics().step;
+    const long index = solver_.steps();
     if (!solver_.lastPressureSolve().converged) {
       ++unconverged_;
       logger().warn("liquid: the pressure solve of step {} did not converge ({} iterations, relative residual {:.2g})",

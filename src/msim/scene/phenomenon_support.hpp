@@ -44,6 +44,9 @@ void restoreFaceVelocities(const io::VdbFile& saved, MacGrid<D>& velocity, const
 const std::vector<float>& savedPointAttribute(const io::PointCloud& cloud, const std::string& name,
                                               const std::filesystem::path& vdbFile, const std::string& sceneSource);
 
+// The keys of domain.boundaries, per axis and side (0 lower, 1 upper).
+inline constexpr const char* kDomainSideKeys[3][2] = {{"x_min", "x_max"}, {"y_min", "y_max"}, {"z_min", "z_max"}};
+
 // outputs.preview of a resolved scene.
 render::PreviewSettings previewSettings(const Scene& scene);
 

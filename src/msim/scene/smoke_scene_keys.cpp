@@ -6,6 +6,7 @@
 
 #include "msim/core/error.hpp"
 #include "msim/scene/json_vectors.hpp"
+#include "msim/scene/phenomenon_support.hpp"
 #include "msim/scene/scene_file.hpp"
 #include "msim/scene/scene_obstacles.hpp"
 #include "msim/scene/schema/shape_schema.hpp"
@@ -16,7 +17,6 @@ namespace msim::scene {
 namespace {
 
 using nlohmann::json;
-constexpr const char* kSides[3][2] = {{"x_min", "x_max"}, {"y_min", "y_max"}, {"z_min", "z_max"}};
 
 Schema advectionKeys() {
   Schema a = Schema::object("how velocity and scalars are carried by the flow (Selle ch. 2)");
@@ -85,7 +85,7 @@ Schema smokeKeys() {
   smoke.field("turbulence", turbulence);
   smoke.vector("initial_velocity", "m/s", {0.0, 0.0, 0.0}, "velocity of the air at t = 0").lengths({2, 3});
   Schema walls = Schema::object("velocity of each closed side of the domain");
-  for (const auto& axis : kSides)
+  for (const auto& axis : kDomainSideKeys)
     for (const char* side : axis)
       walls.vector(side, "m/s", {0.0, 0.0, 0.0},
                    "normal part: inflow/outflow wall (Selle ch. 2.9); tangential part drags viscous air (a lid)")
@@ -183,7 +183,7 @@ fluid::SmokeParams<D> smokeParams(const Scene& scene) {
   bool allWalls = true;
   for (int axis = 0; axis < D; ++axis)
     for (int side = 0; side < 2; ++side) {
-      const char* name = kSides[axis][side];
+      const char* name = kDomainSideKeys[axis][side];
       const bool open = sides.at(name) == "open";
       p.sides.side[axis][side] = open ? numerics::DomainSide::Open : numerics::DomainSide::Wall;
       const Vec3 v = paddedVec3(walls.at(name));

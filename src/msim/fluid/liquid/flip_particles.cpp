@@ -93,17 +93,19 @@ void FlipParticles<D>::fromGrid(const MacGrid<D>& updated, const MacGrid<D>& bef
 
 template <int D>
 void FlipParticles<D>::bucketByCell() const {
+  // A counting sort by cell (core's BucketSort keeps a histogram per block and bucket, too large
+  // with a bucket per cell).
   const std::size_t cells = spec_.cellCount();
   cellStart_.assign(cells + 1, 0);
-  std::vector<std::uint32_t> cellOf(positions_.size());
-  for (std::size_t p = 0; p < positions_.size(); ++p) {
-    cellOf[p] = static_cast<std::uint32_t>(spec_.clampedCellIndex(positions_[p]));
-    ++cellStart_[cellOf[p] + 1];
-  }
+  cellOf_.resize(positions_.size());
+  parallelFor(0, positions_.size(), [&](std::size_t p) {
+    cellOf_[p] = static_cast<std::uint32_t>(spec_.clampedCellIndex(positions_[p]));
+  });
+  for (const std::uint32_t c : cellOf_) ++cellStart_[c + 1];
   for (std::size_t c = 0; c < cells; ++c) cellStart_[c + 1] += cellStart_[c];
   order_.resize(positions_.size());
-  std::vector<std::uint32_t> next(cellStart_.begin(), cellStart_.end() - 1);
-  for (std::size_t p = 0; p < positions_.size(); ++p) order_[next[cellOf[p]]++] = static_cast<std::uint32_t>(p);
+  next_.assign(cellStart_.begin(), cellStart_.end() - 1);
+  for (std::size_t p = 0; p < positions_.size(); ++p) order_[next_[cellOf_[p]]++] = static_cast<std::uint32_t>(p);
 }
 
 template <int D>

@@ -58,6 +58,7 @@ class FlipParticles {
   std::vector<Vecf<D>> gatheredNew_, gatheredOld_;
   Splatter<D> splatter_;
   mutable std::vector<std::uint32_t> cellStart_, order_;  // particles grouped by cell
+  mutable std::vector<std::uint32_t> cellOf_, next_;      // the grouping's work storage
 };
 
 }  // namespace msim::fluid

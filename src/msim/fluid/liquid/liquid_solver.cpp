@@ -48,6 +48,14 @@ void LiquidSolver<D>::setObstacles(const Grid<float, D>& nodalSolidPhi) {
 }
 
 template <int D>
+template <typename IsLiquid>
+bool LiquidSolver<D>::faceTouches(int axis, const IVec<D>& f, IsLiquid&& isLiquid) const {
+  IVec<D> low = f;
+  low[axis] -= 1;
+  return (f[axis] < spec_.res[axis] && isLiquid(phi_.index(f))) || (f[axis] > 0 && isLiquid(phi_.index(low)));
+}
+
+template <int D>
 void LiquidSolver<D>::addLiquid(const Grid<float, D>& cellPhi, const Vec<D>& velocity) {
   if (!cellPhi.sameLayout(phi_)) throw std::invalid_argument("liquid solver: addLiquid needs a cell-centred phi");
   for (std::size_t i = 0; i < phi_.count(); ++i) phi_[i] = std::min(phi_[i], cellPhi[i]);
@@ -55,10 +63,8 @@ void LiquidSolver<D>::addLiquid(const Grid<float, D>& cellPhi, const Vec<D>& vel
   for (int a = 0; a < D; ++a) {
     auto& u = velocity_.component(a);
     parallelForCells(u, [&](const IVec<D>& f, std::size_t lin) {
-      IVec<D> low = f;
-      low[a] -= 1;
-      const bool wet = (f[a] < spec_.res[a] && cellPhi(f) < 0.0f) || (f[a] > 0 && cellPhi(low) < 0.0f);
-      if (wet) u[lin] = static_cast<float>(velocity[a]);
+      if (faceTouches(a, f, [&](std::size_t cell) { return cellPhi[cell] < 0.0f; }))
+        u[lin] = static_cast<float>(velocity[a]);
     });
   }
   started_ = false;
@@ -91,12 +97,7 @@ void LiquidSolver<D>::start() {
 
 template <int D>
 double LiquidSolver<D>::cflTimestep() const {
-  double speed = 0.0;
-  for (int a = 0; a < D; ++a) {
-    const auto& u = velocity_.component(a);
-    speed = std::max(speed, parallelMax(u.count(), [&](std::size_t i) { return std::abs(u[i]); }));
-  }
-  speed += std::sqrt(params_.gravity.norm() * spec_.dx);
+  const double speed = maxFaceSpeed(velocity_) + std::sqrt(params_.gravity.norm() * spec_.dx);
   return speed > 0.0 ? params_.cfl * spec_.dx / speed : std::numeric_limits<double>::infinity();
 }
 
@@ -146,10 +147,7 @@ void LiquidSolver<D>::extendVelocity() {
     resampleLinear(phi_, facePhi_[a]);
     // Given: open faces with liquid on a side (the pressure update set them).
     parallelForCells(u, [&](const IVec<D>& f, std::size_t lin) {
-      IVec<D> low = f;
-      low[a] -= 1;
-      const bool wet = (f[a] < spec_.res[a] && liquidCell(phi_.index(f))) || (f[a] > 0 && liquidCell(phi_.index(low)));
-      known[lin] = wet && w[lin] > 0.0f;
+      known[lin] = w[lin] > 0.0f && faceTouches(a, f, [&](std::size_t cell) { return liquidCell(cell); });
     });
     numerics::extrapolateAlongNormals(u, known, facePhi_[a], params_.extrapolationCells);
     const auto& us = solidVelocity.component(a);
@@ -212,11 +210,7 @@ LiquidStatistics LiquidSolver<D>::statistics() const {
   for (int a = 0; a < D; ++a) {
     const auto& u = velocity_.component(a);
     s.maxSpeed = std::max(s.maxSpeed, parallelMax(u.count(), [&](std::size_t i) {
-                            const IVec<D> f = u.coord(i);
-                            IVec<D> low = f;
-                            low[a] -= 1;
-                            const bool wet = (f[a] < spec_.res[a] && liquidCell(phi_.index(f))) ||
-                                             (f[a] > 0 && liquidCell(phi_.index(low)));
+                            const bool wet = faceTouches(a, u.coord(i), [&](std::size_t cell) { return liquidCell(cell); });
                             return wet ? std::abs(u[i]) : 0.0f;
                           }));
   }

@@ -123,6 +123,7 @@ class LiquidSolver {
   const GridSpec<D>& spec() const { return spec_; }
   const LiquidParams<D>& params() const { return params_; }
   const numerics::PcgStats& lastPressureSolve() const { return lastSolve_; }
+  long steps() const { return steps_; }
   const StageTimers& timers() const { return timers_; }
   void resetTimers() { timers_.reset(); }
 
@@ -132,6 +133,9 @@ class LiquidSolver {
   void moveFlipSurface(double dt);
   void extendVelocity();
   bool liquidCell(std::size_t cell) const { return phi_[cell] < 0.0f && solid_[cell] <= 0.5f; }
+  // Whether face f of `axis` has a cell on either side for which isLiquid(cell index) holds.
+  template <typename IsLiquid>
+  bool faceTouches(int axis, const IVec<D>& f, IsLiquid&& isLiquid) const;
 
   GridSpec<D> spec_;
   LiquidParams<D> params_;

@@ -140,11 +140,7 @@ std::size_t SmokeSolver<D>::addScalar(std::string name, double dissipation, floa
 
 template <int D>
 double SmokeSolver<D>::cflTimestep() const {
-  double speed = 0.0;
-  for (int a = 0; a < D; ++a) {
-    const auto& u = velocity_.component(a);
-    speed = std::max(speed, parallelMax(u.count(), [&](std::size_t i) { return std::abs(u[i]); }));
-  }
+  const double speed = maxFaceSpeed(velocity_);
   double dt = speed > 0.0 ? params_.cfl * spec_.dx / speed : std::numeric_limits<double>::infinity();
   // Explicit diffusion is stable for nu dt / dx^2 <= 1 / (2 D) (the Laplacian's largest eigenvalue).
   if (params_.viscosity > 0.0 && params_.viscosityMode == ViscosityMode::Explicit)
@@ -430,8 +426,8 @@ SmokeStatistics SmokeSolver<D>::statistics() const {
     s.kineticEnergy += 0.5 * params_.fluidDensity * dV * parallelSum(u.count(), [&](std::size_t i) {
       return double(w[i]) * u[i] * u[i];
     });
-    s.maxSpeed = std::max(s.maxSpeed, parallelMax(u.count(), [&](std::size_t i) { return std::abs(u[i]); }));
   }
+  s.maxSpeed = maxFaceSpeed(velocity_);
   // The cells each transport keeps scalars in: the Advector overwrites solid cells with their
   // neighbours' mean every step, the conservative transport owns every cell with an open face.
   const Grid<float, D>& excluded = params_.scalarTransport == ScalarTransport::Conservative ? sealed_ : solid_;

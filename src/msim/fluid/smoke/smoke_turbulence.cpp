@@ -77,11 +77,7 @@ void SmokeTurbulence<D>::markBand(const MacGrid<D>& velocity, double dt, const G
   // step), gets the full u'; the potential then falls linearly to zero over kTaper more cells, so
   // the band's edge makes no sheet of velocity (cutting psi off from one fine node to the next
   // would put about twice the eddies' speed on it).
-  double fastest = 0.0;
-  for (int a = 0; a < D; ++a) {
-    const auto& u = velocity.component(a);
-    fastest = std::max(fastest, parallelMax(u.count(), [&](std::size_t i) { return std::abs(u[i]); }));
-  }
+  const double fastest = maxFaceSpeed(velocity);
   constexpr int kTaper = 2;
   const int reach = std::min(200, 1 + static_cast<int>(std::ceil(fastest * dt / coarse_.dx)));
   const int far = reach + kTaper;

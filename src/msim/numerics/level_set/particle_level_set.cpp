@@ -110,11 +110,16 @@ void ParticleLevelSet<D>::advect(const MacGrid<D>& velocity, double dt) {
 
 template <int D>
 std::size_t ParticleLevelSet<D>::correct(Grid<float, D>& phi) const {
-  std::vector<std::size_t> escaped;
+  std::vector<std::size_t>& escaped = escaped_;
+  escaped.clear();
   for (std::size_t p = 0; p < positions_.size(); ++p)
     if (signs_[p] * sampleLinear<D>(phi, positions_[p]) < -radii_[p]) escaped.push_back(p);
   if (escaped.empty()) return 0;
-  Grid<float, D> plus = phi, minus = phi;
+  // phi+ and phi- start as phi (copied into storage kept across steps).
+  Grid<float, D>& plus = plus_;
+  Grid<float, D>& minus = minus_;
+  plus = phi;
+  minus = phi;
   for (const std::size_t p : escaped) {
     const Vec<D> x = positions_[p];
     // The 2^D cell centres around the particle (those its interpolation reads).

@@ -86,6 +86,9 @@ class ParticleLevelSet {
   std::vector<Vec<D>> positions_;
   std::vector<float> radii_;
   std::vector<std::int8_t> signs_;
+  // correct()'s work storage, kept so that steady stepping allocates nothing.
+  mutable std::vector<std::size_t> escaped_;
+  mutable Grid<float, D> plus_, minus_;
 };
 
 }  // namespace msim::numerics

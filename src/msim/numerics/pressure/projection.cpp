@@ -65,9 +65,14 @@ void PressureProjection<D>::setFreeSurface(const Grid<float, D>& liquidPhi, floa
   };
   // Couplings only between liquid cells (a boundary face keeps its weight when its cell is
   // liquid: the open side's ghost pressure is 0 as before); 1 / theta on the liquid-air faces.
+  // Storage kept across calls (the liquid sets its surface every step).
   MacGrid<D>& coupling = coupling_;
-  coupling = MacGrid<D>(spec_, 0.0f);
-  inverseTheta_ = MacGrid<D>(spec_, 1.0f);
+  if (!freeSurface_) {
+    coupling = MacGrid<D>(spec_);
+    inverseTheta_ = MacGrid<D>(spec_);
+  }
+  coupling.fill(0.0f);
+  inverseTheta_.fill(1.0f);
   for (int a = 0; a < D; ++a) {
     const auto& w = weights_.component(a);
     auto& c = coupling.component(a);
