@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -78,6 +79,23 @@ Camera frameBox(const Vec3& lo, const Vec3& hi, int width, int height, int upAxi
   const double nearDistance = std::max(half[upAxis] / tanV, half[rightAxis] / tanH) / 0.9;
   c.position = centre + (half[viewAxis] + nearDistance) * Vec3::Unit(viewAxis);
   return c;
+}
+
+bool intersectBox(const Ray& r, const Vec3& lo, const Vec3& hi, double& t0, double& t1) {
+  t0 = 0.0;
+  t1 = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    if (r.direction[a] == 0.0) {
+      if (r.origin[a] < lo[a] || r.origin[a] > hi[a]) return false;
+      continue;
+    }
+    const double inv = 1.0 / r.direction[a];
+    double ta = (lo[a] - r.origin[a]) * inv, tb = (hi[a] - r.origin[a]) * inv;
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+  }
+  return t0 < t1;
 }
 
 }  // namespace msim::render

@@ -25,6 +25,10 @@ struct Ray {
   Vec3 direction;  // unit length
 };
 
+// Parameter interval [t0, t1] of a ray inside the box [lo, hi], t0 >= 0 (slab method); false if
+// it misses.
+bool intersectBox(const Ray& r, const Vec3& lo, const Vec3& hi, double& t0, double& t1);
+
 // The view basis of a validated camera, computed once: primary rays and the inverse projection.
 class CameraRays {
  public:

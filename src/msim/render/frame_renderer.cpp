@@ -64,6 +64,7 @@ FrameResult renderFrame(const FrameRenderConfig& config, const Grid<float, 3>& d
   input.surfaceDistance = surfaces.distance;
   input.meshes = surfaces.meshes;
   input.points = surfaces.points;
+  input.liquid = surfaces.liquid;
   result.render = renderVolume(input, camera, lights, config.medium, config.settings);
   result.timings.march = result.render.stats.secondsMarch;
   return result;

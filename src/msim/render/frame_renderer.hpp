@@ -39,12 +39,14 @@ struct FrameResult {
   FrameTimings timings;
 };
 
-// Opaque surfaces of a frame (VolumeInput's fields of the same names): solid obstacles as a
-// cell-centred signed distance (negative inside) of the density's layout, meshes, point sets.
+// Surfaces of a frame (VolumeInput's fields of the same names): solid obstacles as a cell-centred
+// signed distance (negative inside) of the density's layout, meshes, point sets, and a liquid's
+// level set of that layout (negative inside), drawn as a dielectric with config.settings.liquid.
 struct FrameSurfaces {
   const Grid<float, 3>* distance = nullptr;
   std::vector<const TriangleMesh*> meshes = {};
   std::vector<PointSet> points = {};
+  const Grid<float, 3>* liquid = nullptr;
 };
 
 // `temperature` and `emitter` may be null (no fire). std::invalid_argument for bad settings, grids

@@ -16,6 +16,8 @@
 
 #include "msim/core/parallel.hpp"
 #include "msim/render/blackbody.hpp"
+#include "msim/render/grid_sampler.hpp"
+#include "msim/render/liquid_tracer.hpp"
 #include "msim/render/phase_function.hpp"
 
 namespace msim::render {
@@ -41,54 +43,6 @@ void checkSameLayout(const Grid<float, 3>& density, const Grid<float, 3>* g, con
                                 " grid does not have the density grid's layout (spec, size, offset)");
 }
 
-// Trilinear interpolation weights of one point, shared by every grid of one layout.
-struct Trilinear {
-  std::size_t base = 0;
-  std::ptrdiff_t ox = 0, oy = 0, oz = 0;  // memory offsets to the upper neighbour on each axis
-  float tx = 0, ty = 0, tz = 0;
-
-  float operator()(const float* g) const {
-    const float* p = g + base;
-    const auto lerp = [](float a, float b, float t) { return a + t * (b - a); };
-    const float c00 = lerp(p[0], p[ox], tx), c10 = lerp(p[oy], p[oy + ox], tx);
-    const float c01 = lerp(p[oz], p[oz + ox], tx), c11 = lerp(p[oz + oy], p[oz + oy + ox], tx);
-    return lerp(lerp(c00, c10, ty), lerp(c01, c11, ty), tz);
-  }
-};
-
-// Trilinear sampling of cell-centred grids of one layout: cell centre c sits at sample coordinate
-// c; positions beyond the outer centres clamp onto them (the border value extends to the faces).
-class Sampler {
- public:
-  explicit Sampler(const Grid<float, 3>& g)
-      : origin_(g.spec().origin), invDx_(1.0 / g.spec().dx), n_(g.size()) {
-    for (int a = 0; a < 3; ++a) stride_[a] = g.stride(a);
-  }
-
-  Trilinear at(const Vec3& x) const {
-    Trilinear w;
-    std::ptrdiff_t* offset[3] = {&w.ox, &w.oy, &w.oz};
-    float* t[3] = {&w.tx, &w.ty, &w.tz};
-    for (int a = 0; a < 3; ++a) {
-      if (n_[a] < 2) continue;  // a single layer: constant along this axis
-      const double hi = n_[a] - 1;
-      double s = (x[a] - origin_[a]) * invDx_ - 0.5;
-      s = s > 0.0 ? (s < hi ? s : hi) : 0.0;  // a NaN lands on 0 and can never index outside
-      const int i0 = std::min(static_cast<int>(s), n_[a] - 2);
-      w.base += static_cast<std::size_t>(i0 * stride_[a]);
-      *offset[a] = stride_[a];
-      *t[a] = static_cast<float>(s - i0);
-    }
-    return w;
-  }
-
- private:
-  Vec3 origin_;
-  double invDx_;
-  IVec3 n_;
-  std::ptrdiff_t stride_[3];
-};
-
 // Distance along the unit direction d from x (inside the box) to the box's boundary.
 double exitDistance(const Vec3& x, const Vec3& d, const Vec3& lo, const Vec3& hi) {
   double t = std::numeric_limits<double>::infinity();
@@ -97,24 +51,6 @@ double exitDistance(const Vec3& x, const Vec3& d, const Vec3& lo, const Vec3& hi
     if (d[a] < 0.0) t = std::min(t, (lo[a] - x[a]) / d[a]);
   }
   return std::max(t, 0.0);
-}
-
-// Parameter interval [t0, t1] of a ray inside the box (slab method); false if it misses.
-bool intersectBox(const Ray& r, const Vec3& lo, const Vec3& hi, double& t0, double& t1) {
-  t0 = 0.0;
-  t1 = std::numeric_limits<double>::infinity();
-  for (int a = 0; a < 3; ++a) {
-    if (r.direction[a] == 0.0) {
-      if (r.origin[a] < lo[a] || r.origin[a] > hi[a]) return false;
-      continue;
-    }
-    const double inv = 1.0 / r.direction[a];
-    double ta = (lo[a] - r.origin[a]) * inv, tb = (hi[a] - r.origin[a]) * inv;
-    if (ta > tb) std::swap(ta, tb);
-    t0 = std::max(t0, ta);
-    t1 = std::min(t1, tb);
-  }
-  return t0 < t1;
 }
 
 // Interpolation of the optical depth towards a directional light along one lateral axis of a slice
@@ -551,6 +487,9 @@ void VolumeRenderSettings::validate() const {
     throw std::invalid_argument("volume render settings: ambient must be finite and non-negative");
   if (!finiteNonNegative(surfaceAlbedo) || (surfaceAlbedo.array() > 1.0).any())
     throw std::invalid_argument("volume render settings: surfaceAlbedo must be in [0, 1]");
+  sky.validate();
+  floor.validate();
+  liquid.validate();
 }
 
 void VolumeInput::validate() const {
@@ -564,6 +503,7 @@ void VolumeInput::validate() const {
   if (emitter && !temperature)
     throw std::invalid_argument("volume renderer: an emitter grid needs a temperature grid for its colour");
   checkSameLayout(*density, surfaceDistance, "surface distance");
+  checkSameLayout(*density, liquid, "liquid level set");
 }
 
 double signedDistanceAt(const Grid<float, 3>& distance, const Vec3& x) {
@@ -626,6 +566,193 @@ Grid<float, 3> firstScatterSource(const Grid<float, 3>& density, const std::vect
   return out;
 }
 
+namespace {
+
+// One frame as the camera's rays see it (see the header): the medium's march, the opaque surfaces
+// and their shading, the sky. Camera rays ask it directly, or through the liquid tracer along their
+// reflected and refracted rays.
+class VolumeScene final : public TracedScene {
+ public:
+  VolumeScene(const VolumeInput& input, const std::vector<Light>& lights, const Medium& medium,
+              const VolumeRenderSettings& settings, const std::vector<Grid<float, 3>>& transmittance,
+              const SurfaceScene& surfaces, const LiquidTracer* liquid)
+      : lights_(lights),
+        medium_(medium),
+        settings_(settings),
+        surfaces_(surfaces),
+        liquid_(liquid),
+        occupancy_(*input.density, input.emitter),
+        sampler_(*input.density),
+        lo_(input.density->spec().origin),
+        hi_(input.density->spec().upper()),
+        dx_(input.density->spec().dx),
+        ds_(settings.stepCells * dx_),
+        phase_(medium.phaseG) {
+    rho_ = input.density->data().data();
+    temperature_ = input.temperature ? input.temperature->data().data() : nullptr;
+    emitter_ = input.emitter ? input.emitter->data().data() : nullptr;
+    fluence_ = input.fluence ? input.fluence->data().data() : nullptr;
+    distance_ = input.surfaceDistance ? input.surfaceDistance->data().data() : nullptr;
+    if (temperature_) blackbody_.emplace(medium.emissionReference);
+    // Emitter form: emissionScale * emitter * B; Stam's form: sigma_t rho (1 - Omega) emissionScale B.
+    emissionWeight_ = emitter_ ? medium.emissionScale : medium.extinction * (1.0 - medium.albedo) * medium.emissionScale;
+    // Chromaticity given to the (luminance) fluence: the lights' summed colour at unit luminance.
+    Vec3 sum = Vec3::Zero();
+    for (const Light& l : lights) sum += l.intensity * l.colour;
+    if (luminance(sum) > 0.0) fluenceTint_ = sum / luminance(sum);
+    for (const Grid<float, 3>& t : transmittance) lightT_.push_back(t.data().data());
+  }
+
+  // The distance grid's solids, the floor, then anything nearer in the BVH.
+  bool opaqueHit(const Ray& ray, double tMax, SurfaceHit& hit) const override {
+    double tSurface = tMax, t0, t1;
+    bool found = false;
+    if (distance_ && intersectBox(ray, lo_, hi_, t0, t1) && t0 < tMax &&
+        traceDistance(sampler_, distance_, ray, t0, std::min(t1, tMax), ds_, tSurface)) {
+      found = true;
+      const Vec3 p = ray.origin + tSurface * ray.direction;
+      Vec3 g = Vec3::Zero();  // gradient of the trilinear distance, central differences over a cell
+      for (int a = 0; a < 3; ++a) {
+        const Vec3 e = 0.5 * dx_ * Vec3::Unit(a);
+        g[a] = sampler_.at(p + e)(distance_) - sampler_.at(p - e)(distance_);
+      }
+      // A ray entering the box inside a solid (one that meets the domain's side) sees the box face.
+      hit.normal = tSurface == t0 && t0 > 0.0 ? entryFaceNormal(ray, lo_, hi_)
+                   : g.norm() > 0.0           ? Vec3(g.normalized())
+                                              : Vec3(-ray.direction);
+      if (hit.normal.dot(ray.direction) > 0.0) hit.normal = -hit.normal;
+      hit.offsetNormal = hit.normal;
+      hit.albedo = settings_.surfaceAlbedo;
+      hit.t = tSurface;
+    }
+    if (settings_.floor.intersect(ray, tSurface, hit)) {
+      found = true;
+      tSurface = hit.t;
+    }
+    if (!surfaces_.empty() && surfaces_.intersect(ray, tSurface, hit)) found = true;
+    return found;
+  }
+
+  // Lambertian radiance of a surface point p (eq. 5.8's boundary radiance), see the header.
+  Vec3 opaqueRadiance(const Vec3& p, const SurfaceHit& hit) const override {
+    ++surfaceHits_;
+    Vec3 L = hit.albedo.cwiseProduct(settings_.ambient);
+    const Vec3 lightSample = p + 2.0 * dx_ * hit.normal, shadowOrigin = p + 1e-4 * dx_ * hit.offsetNormal;
+    for (std::size_t l = 0; l < lights_.size(); ++l) {
+      const LightSample s = illuminate(lights_[l], p, 0.5 * dx_);
+      const double cosine = hit.normal.dot(s.toLight);
+      if (!(cosine > 0.0)) continue;
+      const double Tl = gridTransmittance(l, lightSample, s.toLight, s.distance);
+      if (!(Tl > 0.0) || surfaces_.occluded(shadowOrigin, s.toLight, s.distance)) continue;
+      Vec3 E = s.irradiance;
+      if (liquid_) E = E.cwiseProduct(liquid_->lightTransmittance(shadowOrigin, s.toLight, s.distance));
+      L += (cosine * Tl / std::numbers::pi) * hit.albedo.cwiseProduct(E);
+    }
+    return L;
+  }
+
+  // Eq. 5.8 marched front to back over [0, tEnd] inside the box (see the header).
+  Segment medium(const Ray& ray, double tEnd) const override {
+    Segment out;
+    double t0, t1;
+    if (!intersectBox(ray, lo_, hi_, t0, t1) || !(t0 < tEnd)) return out;
+    t1 = std::min(t1, tEnd);
+    // Per ray: irradiance * phase / 4 pi of each directional light (constant along a ray).
+    thread_local std::vector<Vec3> directional;
+    directional.assign(lights_.size(), Vec3::Zero());
+    for (std::size_t l = 0; l < lights_.size(); ++l)
+      if (lights_[l].type == Light::Type::Directional)
+        // mu between the light's and the seen light's directions of travel (towards the camera).
+        directional[l] = lights_[l].intensity * lights_[l].colour *
+                         (phase_(lights_[l].direction.normalized().dot(-ray.direction)) * kInv4Pi);
+    const double sigmaT = medium_.extinction, sigmaS = medium_.albedo * medium_.extinction;
+    Vec3& radiance = out.radiance;
+    double& T = out.transmittance;
+    long long samples = 0;
+    const long long steps = static_cast<long long>(std::ceil((t1 - t0) / ds_));
+    for (long long k = 0; k < steps;) {
+      const double a = t0 + k * ds_, b = std::min(a + ds_, t1), len = b - a, tm = 0.5 * (a + b);
+      const Vec3 x = ray.origin + tm * ray.direction;
+      double tExit;
+      if (occupancy_.emptyExit(x, ray.direction, tm, tExit)) {
+        // Next step whose midpoint is past the brick (samples in it add exactly nothing).
+        k = std::max(k + 1, static_cast<long long>(std::ceil((tExit - t0) / ds_ - 0.5)));
+        continue;
+      }
+      ++k;
+      ++samples;
+      const Trilinear w = sampler_.at(x);
+      const double rho = std::max(w(rho_), 0.0f);
+      Vec3 source = Vec3::Zero();  // sigma_t rho J of eq. 5.9, per metre
+      if (blackbody_) {
+        const double amount = emissionWeight_ * (emitter_ ? std::max(w(emitter_), 0.0f) : rho);
+        if (amount > 0.0) {
+          const auto bb = (*blackbody_)(w(temperature_));
+          source += amount * Vec3(bb[0], bb[1], bb[2]);
+        }
+      }
+      if (rho > 0.0 && sigmaS > 0.0) {
+        Vec3 inScatter = settings_.ambient;
+        for (std::size_t l = 0; l < lights_.size(); ++l) {
+          const double Tl = w(lightT_[l]);
+          if (lights_[l].type == Light::Type::Directional) {
+            inScatter += Tl * directional[l];
+          } else if (Tl > 0.0) {
+            const LightSample s = illuminate(lights_[l], x, 0.5 * dx_);
+            inScatter += (Tl * phase_(s.toLight.dot(ray.direction)) * kInv4Pi) * s.irradiance;
+          }
+        }
+        if (fluence_) inScatter += (w(fluence_) * kInv4Pi) * fluenceTint_;
+        source += sigmaS * rho * inScatter;
+      }
+      // Exact integral over the step of a constant medium: int_0^len exp(-sigma_t rho u) du.
+      const double tau = sigmaT * rho * len;
+      const double segmentT = std::exp(-tau);
+      const double weight = tau > 1e-6 ? (1.0 - segmentT) / (sigmaT * rho) : len * (1.0 - 0.5 * tau);
+      radiance += (T * weight) * source;
+      T *= segmentT;
+      if (T < kMinTransmittance) break;
+    }
+    samples_ += samples;
+    return out;
+  }
+
+  Vec3 sky(const Vec3& direction) const override {
+    return settings_.sky.radiance(direction, lights_, settings_.background);
+  }
+
+  long long samples() const { return samples_.load(); }
+  long long surfaceHits() const { return surfaceHits_.load(); }
+
+ private:
+  // T_l of a surface point's light sample x' (see the header): the grid at the point where the path
+  // from x' to the light enters the box, 1 if it misses the box (no medium, no solids outside it).
+  double gridTransmittance(std::size_t l, const Vec3& x, const Vec3& toLight, double lightDistance) const {
+    double a, b;
+    if (!intersectBox({x, toLight}, lo_, hi_, a, b) || !(a < lightDistance)) return 1.0;
+    return static_cast<double>(sampler_.at(x + a * toLight)(lightT_[l]));
+  }
+
+  const std::vector<Light>& lights_;
+  const Medium& medium_;
+  const VolumeRenderSettings& settings_;
+  const SurfaceScene& surfaces_;
+  const LiquidTracer* liquid_;
+  const Occupancy occupancy_;
+  const Sampler sampler_;
+  Vec3 lo_, hi_;
+  double dx_, ds_;
+  HenyeyGreenstein phase_;
+  const float *rho_, *temperature_, *emitter_, *fluence_, *distance_;
+  std::optional<BlackbodyTable> blackbody_;
+  double emissionWeight_ = 0.0;
+  Vec3 fluenceTint_ = Vec3::Ones();
+  std::vector<const float*> lightT_;
+  mutable std::atomic<long long> samples_{0}, surfaceHits_{0};
+};
+
+}  // namespace
+
 RenderResult renderVolume(const VolumeInput& input, const Camera& camera, const std::vector<Light>& lights,
                           const Medium& medium, const VolumeRenderSettings& settings) {
   input.validate();
@@ -652,150 +779,21 @@ RenderResult renderVolume(const VolumeInput& input, const Camera& camera, const 
   result.stats.secondsLightGrids = secondsSince(start);
 
   start = std::chrono::steady_clock::now();
-  const Occupancy occupancy(density, input.emitter);
-  const Sampler sampler(density);
-  const Vec3 lo = density.spec().origin, hi = density.spec().upper();
-  const double dx = density.spec().dx, ds = settings.stepCells * dx;
-  const double sigmaT = medium.extinction, sigmaS = medium.albedo * medium.extinction;
-  const HenyeyGreenstein phase(medium.phaseG);
-  const float* rhoData = density.data().data();
-  const float* temperature = input.temperature ? input.temperature->data().data() : nullptr;
-  const float* emitter = input.emitter ? input.emitter->data().data() : nullptr;
-  const float* fluence = input.fluence ? input.fluence->data().data() : nullptr;
-  const std::optional<BlackbodyTable> blackbody =
-      temperature ? std::optional<BlackbodyTable>(BlackbodyTable(medium.emissionReference)) : std::nullopt;
-  // Emitter form: emissionScale * emitter * B; Stam's form: sigma_t rho (1 - Omega) emissionScale B.
-  const double emissionWeight = emitter ? medium.emissionScale : sigmaT * (1.0 - medium.albedo) * medium.emissionScale;
-  // Chromaticity given to the (luminance) fluence: the lights' summed colour at unit luminance.
-  Vec3 fluenceTint = Vec3::Ones();
-  {
-    Vec3 sum = Vec3::Zero();
-    for (const Light& l : lights) sum += l.intensity * l.colour;
-    if (luminance(sum) > 0.0) fluenceTint = sum / luminance(sum);
+  std::optional<LiquidSurface> liquidSurface;
+  std::optional<LiquidTracer> liquid;
+  if (input.liquid) {
+    liquidSurface.emplace(*input.liquid, settings.stepCells);
+    liquid.emplace(*liquidSurface, settings.liquid);
   }
-  std::vector<const float*> lightT(lights.size());
-  for (std::size_t l = 0; l < lights.size(); ++l) lightT[l] = transmittance[l].data().data();
-  const double minDistance = 0.5 * dx;
-  const float* distance = input.surfaceDistance ? input.surfaceDistance->data().data() : nullptr;
-
-  // T_l of a surface point's light sample x' (see the header): the grid at the point where the path
-  // from x' to the light enters the box, 1 if it misses the box (no medium, no solids outside it).
-  const auto gridTransmittance = [&](std::size_t l, const Vec3& x, const Vec3& toLight, double lightDistance) {
-    double a, b;
-    if (!intersectBox({x, toLight}, lo, hi, a, b) || !(a < lightDistance)) return 1.0;
-    return static_cast<double>(sampler.at(x + a * toLight)(lightT[l]));
-  };
-  // Lambertian radiance of a surface point p (eq. 5.8's boundary radiance), see the header.
-  const double lightSampleOffset = 2.0 * dx, shadowRayOffset = 1e-4 * dx;
-  const auto shade = [&](const Vec3& p, const SurfaceHit& hit) {
-    Vec3 L = hit.albedo.cwiseProduct(settings.ambient);
-    const Vec3 lightSample = p + lightSampleOffset * hit.normal, shadowOrigin = p + shadowRayOffset * hit.offsetNormal;
-    for (std::size_t l = 0; l < lights.size(); ++l) {
-      const LightSample s = illuminate(lights[l], p, minDistance);
-      const double cosine = hit.normal.dot(s.toLight);
-      if (!(cosine > 0.0)) continue;
-      const double Tl = gridTransmittance(l, lightSample, s.toLight, s.distance);
-      if (!(Tl > 0.0) || surfaces.occluded(shadowOrigin, s.toLight, s.distance)) continue;
-      L += (cosine * Tl / std::numbers::pi) * hit.albedo.cwiseProduct(s.irradiance);
-    }
-    return L;
-  };
-
+  const VolumeScene scene(input, lights, medium, settings, transmittance, surfaces, liquid ? &*liquid : nullptr);
   result.radiance = FloatImage(camera.width, camera.height);
-  std::atomic<long long> samples{0}, surfaceHits{0};
   parallelFor(0, static_cast<std::size_t>(camera.height), [&](std::size_t row) {
-    // Per ray: irradiance * phase / 4 pi of each directional light (constant along a ray).
-    std::vector<Vec3> directional(lights.size(), Vec3::Zero());
-    long long rowSamples = 0, rowHits = 0;
     for (int px = 0; px < camera.width; ++px) {
       const Ray ray = rays.ray(px + 0.5, static_cast<double>(row) + 0.5);
-      Vec3 radiance = Vec3::Zero();
-      double T = 1.0;
-      double t0, t1;
-      const bool inBox = intersectBox(ray, lo, hi, t0, t1);
-      // The nearest opaque surface: the distance grid's solids, then anything nearer in the BVH.
-      double tSurface = std::numeric_limits<double>::infinity();
-      SurfaceHit hit;
-      if (distance && inBox && traceDistance(sampler, distance, ray, t0, t1, ds, tSurface)) {
-        const Vec3 p = ray.origin + tSurface * ray.direction;
-        Vec3 g = Vec3::Zero();  // gradient of the trilinear distance, central differences over a cell
-        for (int a = 0; a < 3; ++a) {
-          const Vec3 e = 0.5 * dx * Vec3::Unit(a);
-          g[a] = sampler.at(p + e)(distance) - sampler.at(p - e)(distance);
-        }
-        // A ray entering the box inside a solid (one that meets the domain's side) sees the box face.
-        hit.normal = tSurface == t0 && t0 > 0.0 ? entryFaceNormal(ray, lo, hi)
-                     : g.norm() > 0.0           ? Vec3(g.normalized())
-                                                : Vec3(-ray.direction);
-        if (hit.normal.dot(ray.direction) > 0.0) hit.normal = -hit.normal;
-        hit.offsetNormal = hit.normal;
-        hit.albedo = settings.surfaceAlbedo;
-        hit.t = tSurface;
-      }
-      if (!surfaces.empty() && surfaces.intersect(ray, tSurface, hit)) tSurface = hit.t;
-      if (inBox && t0 < tSurface) {
-        t1 = std::min(t1, tSurface);
-        for (std::size_t l = 0; l < lights.size(); ++l)
-          if (lights[l].type == Light::Type::Directional)
-            // mu between the light's and the seen light's directions of travel (towards the camera).
-            directional[l] = lights[l].intensity * lights[l].colour *
-                             (phase(lights[l].direction.normalized().dot(-ray.direction)) * kInv4Pi);
-        const long long steps = static_cast<long long>(std::ceil((t1 - t0) / ds));
-        for (long long k = 0; k < steps;) {
-          const double a = t0 + k * ds, b = std::min(a + ds, t1), len = b - a, tm = 0.5 * (a + b);
-          const Vec3 x = ray.origin + tm * ray.direction;
-          double tExit;
-          if (occupancy.emptyExit(x, ray.direction, tm, tExit)) {
-            // Next step whose midpoint is past the brick (samples in it add exactly nothing).
-            k = std::max(k + 1, static_cast<long long>(std::ceil((tExit - t0) / ds - 0.5)));
-            continue;
-          }
-          ++k;
-          ++rowSamples;
-          const Trilinear w = sampler.at(x);
-          const double rho = std::max(w(rhoData), 0.0f);
-          Vec3 source = Vec3::Zero();  // sigma_t rho J of eq. 5.9, per metre
-          if (blackbody) {
-            const double amount = emissionWeight * (emitter ? std::max(w(emitter), 0.0f) : rho);
-            if (amount > 0.0) {
-              const auto bb = (*blackbody)(w(temperature));
-              source += amount * Vec3(bb[0], bb[1], bb[2]);
-            }
-          }
-          if (rho > 0.0 && sigmaS > 0.0) {
-            Vec3 inScatter = settings.ambient;
-            for (std::size_t l = 0; l < lights.size(); ++l) {
-              const double Tl = w(lightT[l]);
-              if (lights[l].type == Light::Type::Directional) {
-                inScatter += Tl * directional[l];
-              } else if (Tl > 0.0) {
-                const LightSample s = illuminate(lights[l], x, minDistance);
-                inScatter += (Tl * phase(s.toLight.dot(ray.direction)) * kInv4Pi) * s.irradiance;
-              }
-            }
-            if (fluence) inScatter += (w(fluence) * kInv4Pi) * fluenceTint;
-            source += sigmaS * rho * inScatter;
-          }
-          // Exact integral over the step of a constant medium: int_0^len exp(-sigma_t rho u) du.
-          const double tau = sigmaT * rho * len;
-          const double segmentT = std::exp(-tau);
-          const double weight = tau > 1e-6 ? (1.0 - segmentT) / (sigmaT * rho) : len * (1.0 - 0.5 * tau);
-          radiance += (T * weight) * source;
-          T *= segmentT;
-          if (T < kMinTransmittance) break;
-        }
-      }
-      if (std::isfinite(tSurface)) {
-        ++rowHits;
-        if (T >= kMinTransmittance) radiance += T * shade(ray.origin + tSurface * ray.direction, hit);
-      } else {
-        radiance += T * settings.background;
-      }
+      const Vec3 radiance = liquid ? liquid->radiance(ray, scene) : tracedRadiance(ray, scene);
       float* out = result.radiance.pixel(px, static_cast<int>(row));
       for (int ch = 0; ch < 3; ++ch) out[ch] = static_cast<float>(radiance[ch]);
     }
-    samples += rowSamples;
-    surfaceHits += rowHits;
   }, 1);
 
   FloatImage display = result.radiance;
@@ -806,8 +804,8 @@ RenderResult renderVolume(const VolumeInput& input, const Camera& camera, const 
   result.image = display.toImage8(settings.gamma);
   result.stats.secondsMarch = secondsSince(start);
   result.stats.primaryRays = static_cast<long long>(camera.width) * camera.height;
-  result.stats.samples = samples.load();
-  result.stats.surfaceHits = surfaceHits.load();
+  result.stats.samples = scene.samples();
+  result.stats.surfaceHits = scene.surfaceHits();
   return result;
 }
 

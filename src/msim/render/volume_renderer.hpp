@@ -44,7 +44,9 @@
 #include "msim/core/grid.hpp"
 #include "msim/io/png.hpp"
 #include "msim/render/camera.hpp"
+#include "msim/render/environment.hpp"
 #include "msim/render/light.hpp"
+#include "msim/render/liquid_tracer.hpp"
 #include "msim/render/surfaces.hpp"
 
 namespace msim::render {
@@ -77,9 +79,12 @@ struct VolumeRenderSettings {
   double gamma = 2.2;                          // display gamma of the 8-bit image
   bool toneMap = true;                         // x / (1 + x) per channel; otherwise clamp to [0, 1]
   Vec3 surfaceAlbedo = Vec3::Constant(0.6);    // Lambert albedo of obstacles (surfaceDistance) and meshes
+  Sky sky;                                     // when enabled, what rays leaving the scene see instead of background
+  Floor floor;                                 // a floor under the box, when enabled
+  LiquidOptics liquid;                         // of VolumeInput::liquid
 
   // std::invalid_argument for stepCells, exposure or gamma not positive, negative or non-finite
-  // background or ambient, or a surfaceAlbedo outside [0, 1].
+  // background or ambient, a surfaceAlbedo outside [0, 1], or an invalid sky, floor or liquid.
   void validate() const;
 };
 
@@ -99,6 +104,9 @@ struct VolumeInput {
   const Grid<float, 3>* surfaceDistance = nullptr;
   std::vector<const TriangleMesh*> meshes = {};
   std::vector<PointSet> points = {};
+  // Optional liquid: a level set at the cell centres [m], negative inside (the liquid solver's
+  // "liquid_phi"), drawn as a clear dielectric by liquid_tracer.hpp with settings.liquid.
+  const Grid<float, 3>* liquid = nullptr;
 
   void validate() const;
 };
@@ -106,7 +114,7 @@ struct VolumeInput {
 struct RenderStats {
   long long primaryRays = 0;
   long long samples = 0;  // density samples taken by the camera rays (skipped empty bricks not counted)
-  long long surfaceHits = 0;  // camera rays that ended on a surface
+  long long surfaceHits = 0;  // camera rays (and their reflected and refracted rays) that ended on a surface
   double secondsLightGrids = 0.0, secondsMarch = 0.0;
 };
 
