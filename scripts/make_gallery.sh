@@ -6,7 +6,7 @@
 #
 # Each scene runs into out/gallery/<scene> with the settings of its gallery row (frame count and
 # --set overrides, listed below); the preview of its last frame becomes docs/images/<scene>.png and,
-# for gases and smoke, `msim render --last` of the run (its own render keys: camera, lights, medium)
+# for gases, smoke and liquids, `msim render --last` of the run (its own render keys: camera, lights, medium)
 # docs/images/render_<scene>.png (2D scenes render as slabs). Needs the release build (make app).
 # The whole table takes about 30 minutes on 2 cores, most of it the large crowds, the turbulent
 # smoke and the hourglasses.
@@ -46,7 +46,7 @@ granular_column     | preview | --frames 30 --set domain.resolution=40
 granular_impacts    | preview | --set domain.resolution=50
 granular_explosion  | preview | --frames 14 --set domain.resolution=40
 dam_break_2d        | preview | --frames 10
-dam_break_3d        | preview | --frames 10
+dam_break_3d        | render  | --frames 10
 "
 
 wanted=("$@")

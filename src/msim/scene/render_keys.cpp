@@ -1,6 +1,8 @@
 #include "msim/scene/render_keys.hpp"
 
+#include <functional>
 #include <stdexcept>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -70,6 +72,41 @@ Schema pointsSchema() {
   return points;
 }
 
+Schema liquidSchema() {
+  Schema liquid = Schema::object("a liquid's surface (render.grids.liquid) drawn as a clear dielectric: Fresnel reflection "
+                                 "and refraction, Beer-Lambert absorption inside (docs/render.md)");
+  liquid.number("ior", "", 1.33, "refractive index relative to air (water 1.33)").min(1.0, Bound::Exclusive).max(4.0);
+  liquid.vector("absorption", "1/m", {0.26, 0.057, 0.011},
+                "absorption coefficient per linear RGB channel (pure water, Pope & Fry 1997); larger tints a small "
+                "tank as a deeper body of water")
+      .lengths({3})
+      .min(0.0);
+  liquid.integer("max_bounces", 8, "reflections and refractions followed per camera ray").min(1).max(32);
+  return liquid;
+}
+
+Schema skySchema() {
+  Schema sky = Schema::object("a clear sky seen by rays that leave the scene (instead of background), with the "
+                              "directional lights as sun disks: reflections and highlights on liquids");
+  sky.boolean("enabled", false, "draw the sky; otherwise rays leaving the scene see background");
+  sky.vector("zenith", "", {0.25, 0.4, 0.75}, "radiance straight up, linear RGB").lengths({3}).min(0.0);
+  sky.vector("horizon", "", {0.7, 0.78, 0.9}, "radiance at and below the horizon, linear RGB").lengths({3}).min(0.0);
+  sky.number("sun_radius", "deg", 2.0, "angular radius of each directional light's disk (the sun: 0.27)")
+      .min(0.0, Bound::Exclusive)
+      .max(30.0);
+  return sky;
+}
+
+Schema floorSchema() {
+  Schema floor = Schema::object("a horizontal floor under the domain (y up), seen from above");
+  floor.boolean("enabled", false, "draw the floor");
+  floor.number("height", "m", 0.0, "its y");
+  floor.vector("albedo", "", {0.6, 0.6, 0.6}, "diffuse colour, linear RGB").lengths({3}).min(0.0).max(1.0);
+  floor.number("tile", "m", 0.0, "side of square tiles alternating albedo and tile_albedo; 0 for one colour").min(0.0);
+  floor.vector("tile_albedo", "", {0.3, 0.3, 0.3}, "the other tiles' colour").lengths({3}).min(0.0).max(1.0);
+  return floor;
+}
+
 std::filesystem::path resolvedPath(const std::filesystem::path& base, const std::string& file) {
   const std::filesystem::path p(file);
   return p.is_absolute() || base.empty() ? p : base / p;
@@ -131,11 +168,15 @@ Schema renderSchema() {
   r.integer("slab_cells", 8, "2D scenes render as a slab this many cells thick, seen face-on").min(1).max(256);
   r.array("meshes", meshSchema(), "triangle meshes drawn with every frame, shaded with surface_albedo");
   r.field("points", pointsSchema());
+  r.field("liquid", liquidSchema());
+  r.field("sky", skySchema());
+  r.field("floor", floorSchema());
   Schema grids = Schema::object("names of the grids in the saved frames");
   grids.string("density", "density", "scattering and absorbing density");
   grids.string("temperature", "temperature", "temperature [K] for fire emission; '' for none");
   grids.string("emitter", "flame", "emission weight (flame density); '' for none");
   grids.string("obstacle_distance", "obstacle_distance", "signed distance of opaque obstacles [m]; '' for none");
+  grids.string("liquid", "liquid_phi", "level set of a liquid [m], negative inside, drawn as its surface; '' for none");
   r.field("grids", grids);
   return r;
 }
@@ -193,6 +234,32 @@ RenderKeys renderKeys(const json& r, const std::string& source, const std::files
   c.settings.stepCells = r.at("step").get<double>();
   k.slabCells = r.at("slab_cells").get<int>();
   c.multipleScattering = r.at("multiple_scattering").get<bool>();
+  const json& liquid = r.at("liquid");
+  c.settings.liquid.ior = liquid.at("ior").get<double>();
+  c.settings.liquid.absorption = paddedVec3(liquid.at("absorption"));
+  c.settings.liquid.maxBounces = liquid.at("max_bounces").get<int>();
+  const json& sky = r.at("sky");
+  c.settings.sky.enabled = sky.at("enabled").get<bool>();
+  c.settings.sky.zenith = paddedVec3(sky.at("zenith"));
+  c.settings.sky.horizon = paddedVec3(sky.at("horizon"));
+  c.settings.sky.sunRadiusDegrees = sky.at("sun_radius").get<double>();
+  const json& floor = r.at("floor");
+  c.settings.floor.enabled = floor.at("enabled").get<bool>();
+  c.settings.floor.height = floor.at("height").get<double>();
+  c.settings.floor.albedo = paddedVec3(floor.at("albedo"));
+  c.settings.floor.tile = floor.at("tile").get<double>();
+  c.settings.floor.tileAlbedo = paddedVec3(floor.at("tile_albedo"));
+  // The schema's ranges cover every value; this keeps the keys and the renderer's checks in step.
+  const std::pair<const char*, std::function<void()>> checks[] = {{"render.liquid", [&] { c.settings.liquid.validate(); }},
+                                                                  {"render.sky", [&] { c.settings.sky.validate(); }},
+                                                                  {"render.floor", [&] { c.settings.floor.validate(); }}};
+  for (const auto& [key, check] : checks) {
+    try {
+      check();
+    } catch (const std::invalid_argument& e) {
+      throw InputError(fmt::format("{}: '{}': {}", source, key, e.what()));
+    }
+  }
   if (c.camera) {
     try {
       c.camera->validate();
@@ -205,6 +272,7 @@ RenderKeys renderKeys(const json& r, const std::string& source, const std::files
   k.temperatureGrid = g.at("temperature");
   k.emitterGrid = g.at("emitter");
   k.obstacleGrid = g.at("obstacle_distance");
+  k.liquidGrid = g.at("liquid");
   if (k.densityGrid.empty()) throw InputError(source + ": 'render.grids.density' must name a grid");
   k.geometry = loadGeometry(r, source, baseDirectory);
   return k;

@@ -32,7 +32,7 @@ struct RenderKeys {
   bool exr = false;  // also write the linear radiance as OpenEXR next to each PNG
   int slabCells = 8;  // a 2D frame is rendered as a slab this many cells thick
   render::FrameRenderConfig config;
-  std::string densityGrid, temperatureGrid, emitterGrid, obstacleGrid;  // "" = not used
+  std::string densityGrid, temperatureGrid, emitterGrid, obstacleGrid, liquidGrid;  // "" = not used
   std::shared_ptr<const RenderGeometry> geometry;  // never null; may be empty
 };
 

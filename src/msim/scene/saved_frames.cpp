@@ -67,10 +67,16 @@ void renderSavedFrame(const io::VdbFile& frame, const RenderKeys& keys, const fs
                       render::FrameTimings* timings) {
   const std::vector<std::string> grids = frame.gridNames();
   const std::string vdbFile = frame.path().string();
-  if (!hasGrid(grids, keys.densityGrid))
-    throw InputError(fmt::format("{}: no grid '{}' to render (the file has: {}); set render.grids.density", vdbFile,
-                                 keys.densityGrid, fmt::join(grids, ", ")));
-  const Grid<float, 3> density = readForRender(frame, keys.densityGrid, keys.slabCells);
+  std::optional<Grid<float, 3>> liquid;
+  if (hasGrid(grids, keys.liquidGrid)) liquid = readForRender(frame, keys.liquidGrid, keys.slabCells);
+  if (!hasGrid(grids, keys.densityGrid) && !liquid)
+    throw InputError(fmt::format("{}: no grid '{}' or '{}' to render (the file has: {}); set render.grids.density or "
+                                 "render.grids.liquid",
+                                 vdbFile, keys.densityGrid, keys.liquidGrid, fmt::join(grids, ", ")));
+  // A liquid run has no smoke: an empty medium of the liquid's layout.
+  const Grid<float, 3> density = hasGrid(grids, keys.densityGrid)
+                                     ? readForRender(frame, keys.densityGrid, keys.slabCells)
+                                     : Grid<float, 3>(liquid->spec(), liquid->size(), liquid->offset());
   std::optional<Grid<float, 3>> temperature, emitter;
   if (hasGrid(grids, keys.temperatureGrid)) temperature = readForRender(frame, keys.temperatureGrid, keys.slabCells);
   if (temperature && hasGrid(grids, keys.emitterGrid)) emitter = readForRender(frame, keys.emitterGrid, keys.slabCells);
@@ -78,6 +84,7 @@ void renderSavedFrame(const io::VdbFile& frame, const RenderKeys& keys, const fs
   if (hasGrid(grids, keys.obstacleGrid)) obstacles = readForRender(frame, keys.obstacleGrid, keys.slabCells);
   render::FrameSurfaces surfaces;
   surfaces.distance = obstacles ? &*obstacles : nullptr;
+  surfaces.liquid = liquid ? &*liquid : nullptr;
   for (const TriangleMesh& mesh : keys.geometry->meshes) surfaces.meshes.push_back(&mesh);
   if (!keys.geometry->points.empty()) {
     render::PointSet points;
