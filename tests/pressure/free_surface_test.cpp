@@ -165,3 +165,30 @@ TEST(FreeSurfaceProjection, RefusesAPhiOfAnotherLayout) {
   PressureProjection<2> projection(unitBox<2>(16), DomainSides<2>::allWalls());
   EXPECT_THROW(projection.setFreeSurface(Grid<float, 2>(unitBox<2>(17), -1.0f)), std::invalid_argument);
 }
+
+// Volume control's target divergence (Kim et al. 2007): a pool at rest asked for div u = c keeps
+// exactly c in every liquid cell, and its volume flux through the surface is c times its volume.
+TEST(FreeSurfaceProjection, LiquidCellsKeepTheTargetDivergence) {
+  const GridSpec<2> spec = unitBox<2>(32);
+  const double c = 0.05, h = 0.4 + 0.3 * spec.dx;
+  PressureProjection<2> projection(spec, DomainSides<2>::allWalls(), tightSettings());
+  const Grid<float, 2> phi = cellPhi<2>(spec, [&](const Vec2& x) { return x[1] - h; });
+  projection.setFreeSurface(phi);
+  projection.setTargetDivergence(c);
+  MacGrid<2> u(spec);
+  EXPECT_TRUE(projection.project(u, 0.01, 1000.0).converged);
+  Grid<float, 2> div(spec);
+  projection.divergence(u, div);
+  double worst = 0.0, liquidArea = 0.0, surfaceFlux = 0.0;
+  for (std::size_t i = 0; i < div.count(); ++i) {
+    if (phi[i] >= 0.0f) continue;
+    worst = std::max(worst, std::abs(div[i] - c));
+    liquidArea += spec.cellVolume();
+    const IVec2 cell = div.coord(i);
+    if (phi(IVec2(cell[0], cell[1] + 1)) >= 0.0f) surfaceFlux += u.component(1)(IVec2(cell[0], cell[1] + 1)) * spec.dx;
+  }
+  EXPECT_LT(worst, 1e-4 * c);
+  EXPECT_NEAR(surfaceFlux, c * liquidArea, 1e-4 * c * liquidArea);
+  // The upward speed at the surface is c times the depth of the liquid cells below it.
+  EXPECT_GT(surfaceFlux, 0.0);
+}

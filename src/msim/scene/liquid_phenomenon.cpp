@@ -41,6 +41,9 @@ void declareLiquid(Schema& root) {
   liquid.vector("gravity", "m/s^2", {0.0, -9.81, 0.0}, "acceleration of gravity").lengths({2, 3});
   liquid.number("flip_ratio", "", 0.95, "FLIP share of the PIC/FLIP blend: 1 FLIP, 0 PIC").min(0.0).max(1.0);
   liquid.integer("reseed_interval", 5, "steps between reseedings of the particle level set (and deletions of its escaped particles)").min(1);
+  liquid.boolean("volume_control", true,
+                 "hold the liquid's volume: the pressure solve asks the liquid for the divergence that undoes the "
+                 "measured volume error (Kim et al. 2007)");
   root.field("liquid", liquid);
 
   Schema body = Schema::object("liquid present at the start");
@@ -71,6 +74,7 @@ fluid::LiquidParams<D> liquidParams(const Scene& scene) {
   p.gravity = sceneVector<D>(l.at("gravity"));
   p.flipRatio = l.at("flip_ratio").get<double>();
   p.reseedInterval = l.at("reseed_interval").get<int>();
+  p.volumeControl = l.at("volume_control").get<bool>();
   p.cfl = scene.resolved.at("time").at("cfl").get<double>();
   const json& sides = scene.resolved.at("domain").at("boundaries");
   for (int a = 0; a < D; ++a)
@@ -214,6 +218,8 @@ class LiquidPhenomenon final : public Phenomenon {
   json statistics() const override {
     const fluid::LiquidStatistics s = solver_.statistics();
     return {{"volume_m3", s.volume},
+            {"target_volume_m3", s.targetVolume},
+            {"volume_control_divergence_1_s", s.controlDivergence},
             {"max_speed_m_s", s.maxSpeed},
             {"kinetic_energy_J", s.kineticEnergy},
             {"pressure_iterations", s.pressureIterations},

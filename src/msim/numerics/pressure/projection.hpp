@@ -83,6 +83,11 @@ class PressureProjection {
   // multigrid hierarchy coarsens the Dirichlet terms too). Faces between two air cells keep their
   // velocity (the caller extrapolates it).
   void setFreeSurface(const Grid<float, D>& liquidPhi, float minTheta = 1e-3f);
+  // Divergence [1/s] the projected velocity keeps in every cell that has an unknown (default 0):
+  // the volume control of Kim, Liu, Llamas, Jiao & Rossignac (2007) makes a liquid that has lost
+  // volume expand by div u = c > 0. A region with no Dirichlet cell cannot change its volume; its
+  // mean target is removed with the rest of its right-hand side's mean (floatingRegions()).
+  void setTargetDivergence(double perSecond) { targetDivergence_ = static_cast<float>(perSecond); }
 
   // Makes `velocity` divergence free; the pressure [Pa] is kept (pressure()) and warm-starts
   // the next call.
@@ -121,6 +126,7 @@ class PressureProjection {
   MacGrid<D> coupling_;      // with a free surface: the weights between cells that have unknowns
   std::vector<float> dirichlet_;  // with a free surface: PoissonMatrix's Dirichlet terms
   bool freeSurface_ = false;
+  float targetDivergence_ = 0.0f;
   std::array<std::array<float, 2>, D> wallNormalVelocity_{};
   PoissonMatrix<D> matrix_;
   FloatingRegions<D> floating_;
