@@ -99,4 +99,19 @@ TEST(LiquidCli, BadInputNamesTheKey) {
   expectInputError("liquid_none", replaced(tinyScene("flip"), R"("initial_liquid": [{"shape": {"type": "box", "min": [0, 0, 0], "max": [0.25, 0.3, 0.4]}}])",
                                            R"("initial_liquid": [])"),
                    {"initial_liquid"});
+  expectInputError("liquid_emitter_in_solid",
+                   tinyScene("flip", R"(, "obstacles": [{"shape": {"type": "box", "min": [0.5, 0, 0], "max": [0.8, 0.2, 0.4]}}],
+                                      "sources": [{"shape": {"type": "sphere", "center": [0.65, 0.1, 0.2], "radius": 0.04},
+                                                   "velocity": [0, 1, 0]}])"),
+                   {"sources[0].shape", "obstacle"});
+  // 0.03 m^3 in a 0.128 m^3 tank, and a 10 x 10 cm hose at 2 m/s for 0.1 s adds 0.002: fits; for
+  // 10 s it would add 0.2.
+  const std::string hose = R"(, "sources": [{"shape": {"type": "box", "min": [0.5, 0.3, 0.15], "max": [0.6, 0.4, 0.25]},
+                                              "velocity": [0, -2, 0]}])";
+  const fs::path fits = scratch("liquid_hose_fits");
+  writeText(fits / "s.json", tinyScene("flip", hose));
+  const Result ok = runMsim("run " + (fits / "s.json").string() + " -q --out " + (fits / "out").string());
+  EXPECT_EQ(ok.exitCode, 0) << ok.output;
+  expectInputError("liquid_overfilled", replaced(tinyScene("flip", hose), R"("duration": 0.1)", R"("duration": 10)"),
+                   {"sources", "closed domain"});
 }

@@ -62,15 +62,69 @@ void FlipParticles<D>::assign(std::vector<Vecf<D>> positions, std::vector<Vecf<D
 }
 
 template <int D>
-void FlipParticles<D>::advect(const MacGrid<D>& velocity, double dt, const Grid<float, D>& solid) {
+void FlipParticles<D>::advect(const MacGrid<D>& velocity, double dt, const Grid<float, D>& solid,
+                              const std::array<std::array<bool, 2>, D>& openSides) {
+  flagged_.assign(positions_.size(), 0);
   parallelFor(0, positions_.size(), [&](std::size_t p) {
     const Vec<D> x = positions_[p].template cast<double>();
     const Vec<D> mid = insideDomain<D>(spec_, Vec<D>(x + 0.5 * dt * sampleLinear<D>(velocity, x)).template cast<float>())
                            .template cast<double>();
-    const Vecf<D> next = insideDomain<D>(spec_, Vec<D>(x + dt * sampleLinear<D>(velocity, mid)).template cast<float>());
+    const Vec<D> free = x + dt * sampleLinear<D>(velocity, mid);
+    for (int a = 0; a < D; ++a) {
+      const double lo = spec_.origin[a], hi = lo + spec_.res[a] * spec_.dx;
+      if ((openSides[a][0] && free[a] < lo) || (openSides[a][1] && free[a] > hi)) flagged_[p] = 1;
+    }
+    const Vecf<D> next = insideDomain<D>(spec_, free.template cast<float>());
     // A particle does not enter a solid cell: it stays where it was (the wall stops it).
     if (solid[spec_.clampedCellIndex(next)] <= 0.5f) positions_[p] = next;
   });
+  removeFlagged();
+}
+
+template <int D>
+std::size_t FlipParticles<D>::removeFlagged() {
+  std::size_t kept = 0;
+  for (std::size_t p = 0; p < positions_.size(); ++p) {
+    if (flagged_[p]) continue;
+    positions_[kept] = positions_[p];
+    velocities_[kept] = velocities_[p];
+    ++kept;
+  }
+  const std::size_t removed = positions_.size() - kept;
+  positions_.resize(kept);
+  velocities_.resize(kept);
+  return removed;
+}
+
+template <int D>
+std::size_t FlipParticles<D>::removeInside(const Grid<float, D>& region) {
+  flagged_.assign(positions_.size(), 0);
+  parallelFor(0, positions_.size(), [&](std::size_t p) { flagged_[p] = sampleLinear<D>(region, positions_[p].template cast<double>()) < 0.0f; });
+  return removeFlagged();
+}
+
+template <int D>
+std::size_t FlipParticles<D>::emit(const Grid<float, D>& region, const Grid<float, D>& solid, const Vecf<D>& velocity,
+                                   std::uint64_t round) {
+  parallelFor(0, positions_.size(), [&](std::size_t p) {
+    if (sampleLinear<D>(region, positions_[p].template cast<double>()) < 0.0f) velocities_[p] = velocity;
+  });
+  bucketByCell();
+  const std::size_t before = positions_.size();
+  for (std::size_t cell = 0; cell < region.count(); ++cell) {
+    if (!(region[cell] < 0.0f) || solid[cell] > 0.5f) continue;
+    const int have = static_cast<int>(cellStart_[cell + 1] - cellStart_[cell]);
+    if (2 * have >= perCell_) continue;  // refilled when half empty: fuller cells hold the flux at v A
+    const IVec<D> c = region.coord(cell);
+    Rng rng = Rng(seed_ ^ (round * 0x9E3779B97F4A7C15ull)).split(cell);
+    for (int k = have; k < perCell_; ++k) {
+      Vecf<D> x;
+      for (int a = 0; a < D; ++a) x[a] = static_cast<float>(spec_.origin[a] + (c[a] + rng.uniform()) * spec_.dx);
+      positions_.push_back(x);
+      velocities_.push_back(velocity);
+    }
+  }
+  return positions_.size() - before;
 }
 
 template <int D>

@@ -14,6 +14,7 @@
 //              r = R / 4: the kernel-weighted mean depth of a half ball is 0.246 R in 3D and
 //              0.259 R in 2D, so a flat, evenly filled layer gets its surface on its top.
 #include <cstddef>
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -31,12 +32,25 @@ class FlipParticles {
 
   // Fills the cells with phi < 0 (and no solid) with jittered particles at the grid's velocity.
   void seed(const Grid<float, D>& phi, const Grid<float, D>& solid, const MacGrid<D>& velocity);
-  void advect(const MacGrid<D>& velocity, double dt, const Grid<float, D>& solid);
+  // Particles that cross a side marked open in openSides[axis][0 = lower, 1 = upper] leave the
+  // liquid (are deleted); the other sides hold them in.
+  void advect(const MacGrid<D>& velocity, double dt, const Grid<float, D>& solid,
+              const std::array<std::array<bool, 2>, D>& openSides = {});
   void toGrid(MacGrid<D>& velocity);
   void fromGrid(const MacGrid<D>& updated, const MacGrid<D>& before, double flipRatio);
   // phi (cell-centred) from the particles; cells far from any particle get +band, cells deep in
   // the liquid -band (the reinitialisation that follows fills in the distances).
   void surface(Grid<float, D>& phi, double bandCells) const;
+
+  // An emitter covering the cells where region < 0: the particles in it take `velocity`, and its
+  // open cells holding fewer than perCell particles are topped up (at random positions in the
+  // cell, random stream `round`). Returns how many were added.
+  std::size_t emit(const Grid<float, D>& region, const Grid<float, D>& solid, const Vecf<D>& velocity,
+                   std::uint64_t round);
+  // A sink: deletes the particles where region < 0 (D-linearly sampled); returns how many.
+  std::size_t removeInside(const Grid<float, D>& region);
+  // Liquid volume one particle stands for [m^3]: a cell's volume over the particles seeded per cell.
+  double particleVolume() const { return spec_.cellVolume() / perCell_; }
 
   // Replaces the particles (a resumed run's saved ones); std::invalid_argument for mismatched
   // lengths.
@@ -49,6 +63,8 @@ class FlipParticles {
 
  private:
   void bucketByCell() const;
+  // Deletes the particles whose flag is set (order kept).
+  std::size_t removeFlagged();
 
   GridSpec<D> spec_;
   int perCell_;
@@ -59,6 +75,7 @@ class FlipParticles {
   Splatter<D> splatter_;
   mutable std::vector<std::uint32_t> cellStart_, order_;  // particles grouped by cell
   mutable std::vector<std::uint32_t> cellOf_, next_;      // the grouping's work storage
+  std::vector<std::uint8_t> flagged_;                     // removeFlagged()'s marks
 };
 
 }  // namespace msim::fluid

@@ -71,6 +71,45 @@ void LiquidSolver<D>::addLiquid(const Grid<float, D>& cellPhi, const Vec<D>& vel
 }
 
 template <int D>
+double LiquidSolver<D>::emit(const Grid<float, D>& region, const Vec<D>& velocity) {
+  if (!region.sameLayout(phi_)) throw std::invalid_argument("liquid solver: emit needs a cell-centred region");
+  if (!started_) start();
+  ScopedStage s(timers_, "liquid: sources");
+  const double before = numerics::enclosedVolume(phi_, &solid_);
+  parallelFor(0, phi_.count(), [&](std::size_t i) {
+    if (solid_[i] <= 0.5f) phi_[i] = std::min(phi_[i], region[i]);
+  });
+  for (int a = 0; a < D; ++a) {
+    auto& u = velocity_.component(a);
+    const auto& w = projection_.faceWeights().component(a);
+    parallelForCells(u, [&](const IVec<D>& f, std::size_t lin) {
+      if (w[lin] > 0.0f && faceTouches(a, f, [&](std::size_t cell) { return region[cell] < 0.0f; }))
+        u[lin] = static_cast<float>(velocity[a]);
+    });
+  }
+  if (params_.tracker == InterfaceTracker::Flip)  // the particles are the liquid (phi is rebuilt from them)
+    return flip_.particleVolume() * double(flip_.emit(region, solid_, velocity.template cast<float>(), ++emissions_));
+  particles_.removeInside(region);
+  const double added = numerics::enclosedVolume(phi_, &solid_) - before;
+  targetVolume_ += added;
+  return added;
+}
+
+template <int D>
+double LiquidSolver<D>::drain(const Grid<float, D>& region) {
+  if (!region.sameLayout(phi_)) throw std::invalid_argument("liquid solver: drain needs a cell-centred region");
+  if (!started_) start();
+  ScopedStage s(timers_, "liquid: sinks");
+  const double before = numerics::enclosedVolume(phi_, &solid_);
+  parallelFor(0, phi_.count(), [&](std::size_t i) { phi_[i] = std::max(phi_[i], -region[i]); });
+  if (params_.tracker == InterfaceTracker::Flip) return flip_.particleVolume() * double(flip_.removeInside(region));
+  particles_.removeInside(region);
+  const double removed = before - numerics::enclosedVolume(phi_, &solid_);
+  targetVolume_ = std::max(0.0, targetVolume_ - removed);
+  return removed;
+}
+
+template <int D>
 void LiquidSolver<D>::restore(const Grid<float, D>& phi, const MacGrid<D>& velocity, long steps) {
   if (!phi.sameLayout(phi_)) throw std::invalid_argument("liquid solver: restore needs a cell-centred phi");
   phi_ = phi;
@@ -83,7 +122,7 @@ void LiquidSolver<D>::restore(const Grid<float, D>& phi, const MacGrid<D>& veloc
   started_ = true;
   if (params_.tracker == InterfaceTracker::ParticleLevelSet && particles_.size() == 0) particles_.seed(phi_);
   targetVolume_ = numerics::enclosedVolume(phi_, &solid_);
-  volumeErrorIntegral_ = leakRate_ = 0.0;
+  volumeErrorIntegral_ = leakRate_ = flipVolumeScale_ = 0.0;
   controlStarted_ = false;
 }
 
@@ -100,6 +139,7 @@ void LiquidSolver<D>::start() {
   } else {
     particles_.seed(phi_);
   }
+  flipVolumeScale_ = 0.0;
   targetVolume_ = numerics::enclosedVolume(phi_, &solid_);
   volumeErrorIntegral_ = leakRate_ = 0.0;
   controlStarted_ = false;
@@ -127,8 +167,19 @@ double LiquidSolver<D>::openSideOutflow(double dt) const {
 
 template <int D>
 double LiquidSolver<D>::volumeControlDivergence(double dt) {
-  if (!params_.volumeControl || !(targetVolume_ > 0.0)) return 0.0;
-  const double x = numerics::enclosedVolume(phi_, &solid_) / targetVolume_ - 1.0;
+  if (!params_.volumeControl) return 0.0;
+  const double volume = numerics::enclosedVolume(phi_, &solid_);
+  if (params_.tracker == InterfaceTracker::Flip) {
+    // FLIP's liquid is its particles: the target is their count, scaled by the ratio of the
+    // rebuilt surface's volume to theirs when the control first saw them (the reconstruction's
+    // bias; holding the particles' own volume instead would move still water). Emitters, sinks
+    // and open sides change the count.
+    const double particleVolume = flip_.particleVolume() * double(flip_.size());
+    if (flipVolumeScale_ == 0.0 && particleVolume > 0.0) flipVolumeScale_ = volume / particleVolume;
+    targetVolume_ = particleVolume * flipVolumeScale_;
+  }
+  if (!(targetVolume_ > 0.0)) return 0.0;
+  const double x = volume / targetVolume_ - 1.0;
   volumeErrorIntegral_ += x * dt;
   // The rate at which the surface lost volume in this step beyond what the last control asked
   // for (a splash hitting a wall loses several percent in a few steps, faster than the PI gains
@@ -182,7 +233,10 @@ void LiquidSolver<D>::moveSurface(double dt) {
 template <int D>
 void LiquidSolver<D>::moveFlipSurface(double dt) {
   ScopedStage s(timers_, "liquid: surface");
-  flip_.advect(velocity_, dt, solid_);
+  std::array<std::array<bool, 2>, D> open{};
+  for (int a = 0; a < D; ++a)
+    for (int side = 0; side < 2; ++side) open[a][side] = params_.sides.side[a][side] == numerics::DomainSide::Open;
+  flip_.advect(velocity_, dt, solid_, open);
   flip_.surface(phi_, params_.bandCells);
   numerics::reinitializeFastMarching(phi_, params_.bandCells);
 }
@@ -217,7 +271,7 @@ void LiquidSolver<D>::step(double dt) {
   if (!(dt > 0.0) || !std::isfinite(dt)) throw std::invalid_argument(fmt::format("liquid solver: step of {} s", dt));
   if (!started_) start();
   const bool flip = params_.tracker == InterfaceTracker::Flip;
-  if (params_.volumeControl) targetVolume_ = std::max(0.0, targetVolume_ - openSideOutflow(dt));
+  if (params_.volumeControl && !flip) targetVolume_ = std::max(0.0, targetVolume_ - openSideOutflow(dt));
   if (flip) {
     moveFlipSurface(dt);
     {

@@ -23,8 +23,9 @@
 // dx/dt = -k_p x - k_i int x dt, a PI controller that drives the relative error back to 0. The
 // rate at which the surface lost volume in the last step beyond what the control asked for is fed
 // forward (a splash that hits a wall loses several percent within a few steps, faster than the PI
-// gains follow). The target is the starting volume plus what came in through open sides less what
-// went out. The correction is spread over the whole liquid, not put back where the volume was lost.
+// gains follow). The target is the starting volume plus what emitters added and came in through
+// open sides less what sinks and open sides took (FLIP: the particles' volume, scaled as the
+// surface first measured it). The correction is spread over the whole liquid, not put back where the volume was lost.
 // Obstacles are static solids given by a signed distance at the grid nodes, as for smoke. Storage
 // is float, reductions double; the work arrays live in the object.
 #include <cstddef>
@@ -113,6 +114,13 @@ class LiquidSolver {
   // the first step: the particles are seeded then.
   void addLiquid(const Grid<float, D>& cellPhi, const Vec<D>& velocity = Vec<D>::Zero());
 
+  // An emitter (call between steps): liquid fills the cells where region < 0 (outside solids) and
+  // the faces touching them move at `velocity`; with FLIP the particles there take the velocity
+  // and the cells are topped up with new ones. A sink: the liquid where region < 0 is removed.
+  // Volume control's target follows both. Each returns the volume it added or removed [m^3].
+  double emit(const Grid<float, D>& region, const Vec<D>& velocity);
+  double drain(const Grid<float, D>& region);
+
   // A saved state (--resume): phi, the face velocities and the number of steps taken. Assign the
   // saved particles first (levelSetParticles() / flipParticles()); a particle level set left
   // empty is seeded afresh from phi. Volume control holds the restored volume from then on.
@@ -174,9 +182,11 @@ class LiquidSolver {
   std::size_t lastEscaped_ = 0;
   double targetVolume_ = 0.0, volumeErrorIntegral_ = 0.0, controlDivergence_ = 0.0;
   double lastVolumeError_ = 0.0, leakRate_ = 0.0;
+  double flipVolumeScale_ = 0.0;  // FLIP: rebuilt surface volume per particle volume (0: not yet seen)
   bool controlStarted_ = false;
   bool started_ = false;
   long steps_ = 0;
+  std::uint64_t emissions_ = 0;  // emit() calls so far (new random streams each)
   StageTimers timers_;
 };
 

@@ -174,6 +174,23 @@ void ParticleLevelSet<D>::reseed(const Grid<float, D>& phi) {
     if (std::abs(phi[i]) < band && count[i] < perCell_) seedCell(phi, phi.coord(i), perCell_ - count[i], i);
 }
 
+template <int D>
+std::size_t ParticleLevelSet<D>::removeInside(const Grid<float, D>& region) {
+  std::size_t kept = 0;
+  for (std::size_t p = 0; p < positions_.size(); ++p) {
+    if (sampleLinear<D>(region, positions_[p]) < 0.0f) continue;
+    positions_[kept] = positions_[p];
+    radii_[kept] = radii_[p];
+    signs_[kept] = signs_[p];
+    ++kept;
+  }
+  const std::size_t removed = positions_.size() - kept;
+  positions_.resize(kept);
+  radii_.resize(kept);
+  signs_.resize(kept);
+  return removed;
+}
+
 template class ParticleLevelSet<2>;
 template class ParticleLevelSet<3>;
 

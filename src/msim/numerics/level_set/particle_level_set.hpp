@@ -65,6 +65,11 @@ class ParticleLevelSet {
   // band's cells up to particlesPerCell (new particles attracted and sized as in seed).
   void reseed(const Grid<float, D>& phi);
 
+  // Deletes the particles where region < 0 (D-linearly sampled): liquid added or taken away there
+  // by an emitter or a sink would make them escaped; the next reseeding fills the band again.
+  // Returns how many.
+  std::size_t removeInside(const Grid<float, D>& region);
+
   // Replaces the particles (a resumed run's saved ones); std::invalid_argument for mismatched
   // lengths.
   void assign(std::vector<Vec<D>> positions, std::vector<float> radii, std::vector<std::int8_t> signs);

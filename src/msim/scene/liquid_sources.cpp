@@ -1,0 +1,128 @@
+#include "msim/scene/liquid_sources.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "msim/core/error.hpp"
+#include "msim/core/parallel.hpp"
+#include "msim/scene/json_vectors.hpp"
+#include "msim/scene/phenomenon_support.hpp"
+#include "msim/scene/scene_file.hpp"
+#include "msim/scene/schema/shape_schema.hpp"
+
+namespace msim::scene {
+
+void declareLiquidSources(Schema& root) {
+  Schema source = Schema::object("an emitter: liquid fills its shape every step and leaves it at its velocity");
+  source.field("shape", shapeSchema());
+  source.vector("velocity", "m/s", {0.0, 0.0, 0.0}, "velocity of the emitted liquid").lengths({2, 3});
+  source.vector("motion", "m/s", {0.0, 0.0, 0.0},
+                "the emitter itself moves: its shape is translated by motion (t - start)")
+      .lengths({2, 3});
+  source.number("start", "s", 0.0, "emits from this time").min(0.0);
+  source.number("stop", "s", 0.0, "emits until this time; 0 = to the end").min(0.0);
+  root.array("sources", source, "emitters of liquid (taps, hoses, inflows)");
+
+  Schema sink = Schema::object("a sink or drain: the liquid inside its shape is removed every step");
+  sink.field("shape", shapeSchema());
+  sink.number("start", "s", 0.0, "drains from this time").min(0.0);
+  sink.number("stop", "s", 0.0, "drains until this time; 0 = to the end").min(0.0);
+  root.array("sinks", sink, "sinks and drains");
+}
+
+namespace {
+
+// Cross-section [m^(D-1)] of the covered cells normal to the unit direction n: their volume over
+// their extent along n (exact for boxes and cylinders aligned with n).
+template <int D>
+double crossSection(const std::vector<std::pair<std::size_t, float>>& cells, const GridSpec<D>& spec, const Vec<D>& n) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo, volume = 0.0;
+  const Grid<float, D> layout(spec, 0.0f);
+  for (const auto& [cell, cover] : cells) {
+    const double s = layout.position(layout.coord(cell)).dot(n);
+    lo = std::min(lo, s);
+    hi = std::max(hi, s);
+    volume += cover * spec.cellVolume();
+  }
+  return volume / (hi - lo + spec.dx);
+}
+
+}  // namespace
+
+template <int D>
+LiquidSources<D>::LiquidSources(const Scene& scene, const Grid<float, D>& solid, double initialVolume) {
+  const nlohmann::json& r = scene.resolved;
+  const GridSpec<D> spec = solid.spec();
+  const double duration = r.at("time").at("duration").get<double>();
+  double emitted = 0.0;
+  for (std::size_t i = 0; i < r.at("sources").size(); ++i) {
+    const nlohmann::json& s = r.at("sources")[i];
+    Region e;
+    const std::string key = fmt::format("sources[{}].shape", i);
+    e.shape = sceneShape<D>(scene, s.at("shape"), key);
+    const auto cells = coveredOpenCells<D>(scene, *e.shape, solid, key);  // InputError inside a solid
+    e.velocity = sceneVector<D>(s.at("velocity"));
+    e.motion = sceneVector<D>(s.at("motion"));
+    e.start = s.at("start").get<double>();
+    e.stop = s.at("stop").get<double>();
+    const double speed = e.velocity.norm();
+    const double on = std::max(0.0, (e.stop > 0.0 ? std::min(e.stop, duration) : duration) - e.start);
+    if (speed > 0.0) emitted += crossSection<D>(cells, spec, Vec<D>(e.velocity / speed)) * speed * on;
+    e.field = e.shape->distanceField(spec);
+    emitters_.push_back(std::move(e));
+  }
+  for (std::size_t i = 0; i < r.at("sinks").size(); ++i) {
+    const nlohmann::json& s = r.at("sinks")[i];
+    Region k;
+    const std::string key = fmt::format("sinks[{}].shape", i);
+    k.shape = sceneShape<D>(scene, s.at("shape"), key);
+    coveredOpenCells<D>(scene, *k.shape, solid, key);
+    k.start = s.at("start").get<double>();
+    k.stop = s.at("stop").get<double>();
+    k.field = k.shape->distanceField(spec);
+    sinks_.push_back(std::move(k));
+  }
+  // A closed domain with no sink keeps all it is given.
+  bool closed = sinks_.empty();
+  const nlohmann::json& sides = r.at("domain").at("boundaries");
+  for (int a = 0; a < D; ++a)
+    for (int side = 0; side < 2; ++side) closed = closed && sides.at(kDomainSideKeys[a][side]).get<std::string>() != "open";
+  if (closed && !emitters_.empty()) {
+    double capacity = 0.0;
+    for (std::size_t c = 0; c < solid.count(); ++c) capacity += solid[c] < 0.5f ? spec.cellVolume() : 0.0;
+    if (initialVolume + emitted > capacity)
+      throw InputError(fmt::format(
+          "{}: 'sources': the closed domain has {:.4g} m^{} of open space, but the initial liquid ({:.4g}) and what "
+          "the sources emit over the run ({:.4g}: velocity times cross-section times the time they are on) come to "
+          "{:.4g}: open a side of 'domain.boundaries', add a sink, or stop the sources sooner",
+          scene.file.string(), capacity, D, initialVolume, emitted, initialVolume + emitted, D));
+  }
+}
+
+template <int D>
+const Grid<float, D>& LiquidSources<D>::regionAt(Region& r, double t) const {
+  if (r.motion.squaredNorm() == 0.0) return r.field;
+  const Vec<D> offset = r.motion * (t - r.start);
+  parallelForCells(r.field, [&](const IVec<D>& c, std::size_t i) {
+    r.field[i] = static_cast<float>(r.shape->distance(r.field.position(c) - offset));
+  });
+  return r.field;
+}
+
+template <int D>
+double LiquidSources<D>::apply(fluid::LiquidSolver<D>& solver, double t) {
+  double change = 0.0;
+  for (Region& e : emitters_)
+    if (e.on(t)) change += solver.emit(regionAt(e, t), e.velocity);
+  for (Region& k : sinks_)
+    if (k.on(t)) change -= solver.drain(k.field);
+  return change;
+}
+
+template class LiquidSources<2>;
+template class LiquidSources<3>;
+
+}  // namespace msim::scene

@@ -1,0 +1,98 @@
+// Emitters, sinks and open sides (issue #24): a hose delivers about its velocity times its
+// cross-section per second (measured +20% with the particle level set, +16% with FLIP at 64^2:
+// within each step gravity speeds the liquid up as it leaves the hose, and FLIP refills a cell
+// when it is half empty), a drain empties a tank of exactly what it holds, and FLIP particles that leave
+// through an open side are gone (volume control follows all three, so the liquid neither swells
+// nor shrinks to make up for them).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "msim/fluid/liquid/liquid_solver.hpp"
+#include "msim/numerics/level_set/level_set_measures.hpp"
+
+using namespace msim;
+using namespace msim::fluid;
+
+namespace {
+
+GridSpec<2> unitSquare(int n) { return GridSpec<2>(Vec2::Zero(), 1.0 / n, IVec2(n, n)); }
+
+Grid<float, 2> box(const GridSpec<2>& spec, const Vec2& lo, const Vec2& hi) {
+  Grid<float, 2> phi(spec);
+  for (std::size_t i = 0; i < phi.count(); ++i) {
+    const Vec2 x = phi.position(phi.coord(i));
+    phi[i] = static_cast<float>(std::max({lo[0] - x[0], x[0] - hi[0], lo[1] - x[1], x[1] - hi[1]}));
+  }
+  return phi;
+}
+
+double volumeOf(const LiquidSolver<2>& solver) { return numerics::enclosedVolume(solver.phi(), &solver.solid()); }
+
+// A hose pointing down into an empty closed tank for 0.5 s: the liquid's volume then is the
+// hose's own plus v A t.
+double hoseVolumeRatio(InterfaceTracker tracker) {
+  const GridSpec<2> spec = unitSquare(64);
+  LiquidParams<2> params;
+  params.tracker = tracker;
+  LiquidSolver<2> solver(spec, params);
+  // Cells 28..35 across (8 cells = 0.125 m), 56..59 high.
+  const Grid<float, 2> hose = box(spec, Vec2(28.0 / 64, 56.0 / 64), Vec2(36.0 / 64, 60.0 / 64));
+  const Vec2 velocity(0.0, -1.0);
+  double t = 0.0;
+  while (0.5 - t > 1e-9) {
+    solver.emit(hose, velocity);
+    const double dt = std::min({0.5 - t, solver.cflTimestep(), 1.0 / 120.0});
+    solver.step(dt);
+    t += dt;
+  }
+  const double area = 8.0 / 64, hoseVolume = 8.0 * 4.0 / (64.0 * 64.0);
+  return volumeOf(solver) / (hoseVolume + 1.0 * area * 0.5);
+}
+
+}  // namespace
+
+TEST(LiquidSources, HoseDeliversVelocityTimesCrossSection) {
+  for (const InterfaceTracker tracker : {InterfaceTracker::ParticleLevelSet, InterfaceTracker::Flip}) {
+    const double ratio = hoseVolumeRatio(tracker);
+    RecordProperty(tracker == InterfaceTracker::Flip ? "flip_ratio" : "pls_ratio", std::to_string(ratio));
+    EXPECT_NEAR(ratio, 1.0, 0.25) << (tracker == InterfaceTracker::Flip ? "FLIP" : "particle level set");
+  }
+}
+
+TEST(LiquidSources, DrainEmptiesTheTank) {
+  for (const InterfaceTracker tracker : {InterfaceTracker::ParticleLevelSet, InterfaceTracker::Flip}) {
+    const GridSpec<2> spec = unitSquare(48);
+    LiquidParams<2> params;
+    params.tracker = tracker;
+    LiquidSolver<2> solver(spec, params);
+    solver.addLiquid(box(spec, Vec2(-1, -1), Vec2(2, 0.3)));
+    solver.step(1.0 / 120.0);
+    const double full = volumeOf(solver);
+    // A drain over the whole floor, two cells deep.
+    const Grid<float, 2> drain = box(spec, Vec2(-1, -1), Vec2(2, 2.0 / 48));
+    double removed = 0.0;
+    for (int s = 0; s < 400 && volumeOf(solver) > 0.0; ++s) {
+      removed += solver.drain(drain);
+      solver.step(1.0 / 120.0);
+    }
+    EXPECT_LT(volumeOf(solver), 0.02 * full);
+    EXPECT_NEAR(removed / full, 1.0, 0.1);
+  }
+}
+
+TEST(LiquidSources, FlipParticlesLeaveThroughAnOpenSide) {
+  const GridSpec<2> spec = unitSquare(48);
+  LiquidParams<2> params;
+  params.tracker = InterfaceTracker::Flip;
+  params.sides.side[0][1] = numerics::DomainSide::Open;  // x max
+  LiquidSolver<2> solver(spec, params);
+  solver.addLiquid(box(spec, Vec2(0.5, -1), Vec2(0.9, 0.4)), Vec2(2.0, 0.0));
+  solver.step(1.0 / 120.0);
+  const std::size_t before = solver.flipParticles().size();
+  for (int s = 0; s < 120; ++s) solver.step(1.0 / 120.0);
+  EXPECT_LT(solver.flipParticles().size(), before / 2);
+  // What is left is not inflated to make up for what left.
+  EXPECT_LT(volumeOf(solver), 0.6 * 0.4 * 0.4);
+}
