@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_harness.hpp"
+#include "msim/io/obj.hpp"
 #include "msim/io/ply.hpp"
 #include "msim/io/vdb.hpp"
 
@@ -67,6 +68,15 @@ TEST(LiquidCli, ParticleLevelSetSceneWritesSurfaceMeshParticlesAndPreview) {
 }
 
 TEST(LiquidCli, FlipSceneWritesSurfaceMeshParticlesAndPreview) { expectFramesWritten("flip", "flip_particles"); }
+
+TEST(LiquidCli, ObjMeshOnRequest) {
+  const fs::path dir = scratch("liquid_obj");
+  writeText(dir / "s.json", replaced(tinyScene("flip"), R"("tracker": "flip")", R"("tracker": "flip", "mesh_format": "obj")"));
+  const Result r = runMsim("run " + (dir / "s.json").string() + " -q --out " + (dir / "out").string());
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "out" / "mesh" / "tiny_0002.ply"));
+  EXPECT_GT(io::readObj(dir / "out" / "mesh" / "tiny_0002.obj").triangles.size(), 50u);
+}
 
 TEST(LiquidCli, ResumeContinuesFromTheSavedSurface) {
   for (const std::string tracker : {"particle_level_set", "flip"}) {

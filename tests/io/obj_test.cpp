@@ -71,5 +71,20 @@ TEST(Obj, ErrorsNameFileAndLine) {
   expectInputError([&] { readObj(dir / "missing.obj"); }, {"missing.obj"});
 }
 
+TEST(Obj, WrittenMeshReadsBackExactly) {
+  TriangleMesh mesh;
+  mesh.vertices = {Vec3(0.1, 0.2, 0.3), Vec3(1.0 / 3.0, -2.5e-4, 7.0), Vec3(-1, 0, 0.125), Vec3(2, 2, 2)};
+  mesh.triangles = {{0, 1, 2}, {2, 1, 3}};
+  const auto file = scratchDir() / "obj_write_round_trip.obj";
+  writeObj(file, mesh);
+  const TriangleMesh back = readObj(file);
+  ASSERT_EQ(back.vertices.size(), mesh.vertices.size());
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i)
+    EXPECT_LT((back.vertices[i] - mesh.vertices[i]).norm(), 1e-8 * (1.0 + mesh.vertices[i].norm()));
+  EXPECT_EQ(back.triangles, mesh.triangles);
+  mesh.triangles.push_back({0, 1, 4});
+  EXPECT_THROW(writeObj(file, mesh), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace msim::io

@@ -7,7 +7,10 @@
 #include <system_error>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "msim/core/error.hpp"
+#include "msim/io/atomic_file.hpp"
 
 namespace msim::io {
 
@@ -79,6 +82,27 @@ TriangleMesh readObj(const std::filesystem::path& path) {
   }
   if (in.bad()) throw InputError(path.string() + ": read error");
   return mesh;
+}
+
+void writeObj(const std::filesystem::path& path, const TriangleMesh& mesh) {
+  const std::size_t n = mesh.vertices.size();
+  std::string text = "# written by msim\n";
+  text.reserve(text.size() + 40 * n + 24 * mesh.triangles.size());
+  for (const auto& v : mesh.vertices) text += fmt::format("v {:.9g} {:.9g} {:.9g}\n", v[0], v[1], v[2]);
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const auto& tri = mesh.triangles[t];
+    for (int v : tri)
+      if (v < 0 || static_cast<std::size_t>(v) >= n)
+        throw std::invalid_argument(fmt::format("triangle {} has vertex index {} outside [0, {}) ({})", t, v, n,
+                                                path.string()));
+    text += fmt::format("f {} {} {}\n", tri[0] + 1, tri[1] + 1, tri[2] + 1);
+  }
+  writeFileAtomically(path, [&](const std::filesystem::path& tmp) {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    out.write(text.data(), static_cast<std::streamsize>(text.size()));
+    out.close();
+    if (!out) throw std::runtime_error("error writing " + tmp.string());
+  });
 }
 
 }  // namespace msim::io

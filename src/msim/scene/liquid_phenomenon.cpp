@@ -12,6 +12,7 @@
 #include "msim/core/parallel.hpp"
 #include "msim/fluid/liquid/liquid_solver.hpp"
 #include "msim/io/level_set_mesh.hpp"
+#include "msim/io/obj.hpp"
 #include "msim/io/ply.hpp"
 #include "msim/io/vdb.hpp"
 #include "msim/numerics/level_set/level_set_measures.hpp"
@@ -45,6 +46,8 @@ void declareLiquid(Schema& root) {
   liquid.boolean("volume_control", true,
                  "hold the liquid's volume: the pressure solve asks the liquid for the divergence that undoes the "
                  "measured volume error (Kim et al. 2007)");
+  liquid.string("mesh_format", "ply", "the surface mesh written per frame in 3D (mesh/<name>_NNNN.*): ply, obj, both or none")
+      .choices({"ply", "obj", "both", "none"});
   root.field("liquid", liquid);
 
   Schema body = Schema::object("liquid present at the start");
@@ -92,6 +95,7 @@ class LiquidPhenomenon final : public Phenomenon {
   LiquidPhenomenon(const Scene& scene, StageTimers& timers)
       : source_(scene.file.string()),
         name_(scene.resolved.at("name").get<std::string>()),
+        meshFormat_(scene.resolved.at("liquid").at("mesh_format").get<std::string>()),
         timers_(timers),
         obstacles_(scene, scene.gridSpec<D>()),
         solver_(scene.gridSpec<D>(), liquidParams<D>(scene)) {
@@ -172,12 +176,16 @@ class LiquidPhenomenon final : public Phenomenon {
     if (obstacleDistance_) writer.addLevelSet("obstacle_distance", *obstacleDistance_);
   }
 
-  // The surface as a triangle mesh (3D): mesh/<name>_NNNN.ply.
+  // The surface as a triangle mesh (3D): mesh/<name>_NNNN.ply and/or .obj (liquid.mesh_format).
   void writeFrameData(const std::filesystem::path& runDir, int frame) const override {
     if constexpr (D == 3) {
+      if (meshFormat_ == "none") return;
       const std::filesystem::path dir = runDir / "mesh";
       std::filesystem::create_directories(dir);
-      io::writePlyMesh(dir / fmt::format("{}_{:04d}.ply", name_, frame), io::levelSetMesh(solver_.phi()));
+      const TriangleMesh mesh = io::levelSetMesh(solver_.phi());
+      const std::string stem = fmt::format("{}_{:04d}", name_, frame);
+      if (meshFormat_ != "obj") io::writePlyMesh(dir / (stem + ".ply"), mesh);
+      if (meshFormat_ == "obj" || meshFormat_ == "both") io::writeObj(dir / (stem + ".obj"), mesh);
     }
   }
 
@@ -271,7 +279,7 @@ class LiquidPhenomenon final : public Phenomenon {
     return cloud;
   }
 
-  std::string source_, name_;
+  std::string source_, name_, meshFormat_;
   StageTimers& timers_;
   SceneObstacles<D> obstacles_;
   fluid::LiquidSolver<D> solver_;

@@ -62,8 +62,8 @@ void FlipParticles<D>::assign(std::vector<Vecf<D>> positions, std::vector<Vecf<D
 }
 
 template <int D>
-void FlipParticles<D>::advect(const MacGrid<D>& velocity, double dt, const Grid<float, D>& solid,
-                              const std::array<std::array<bool, 2>, D>& openSides) {
+void FlipParticles<D>::advect(const MacGrid<D>& velocity, double dt, const Grid<float, D>* solidDistance,
+                              const Grid<float, D>& solid, const std::array<std::array<bool, 2>, D>& openSides) {
   flagged_.assign(positions_.size(), 0);
   parallelFor(0, positions_.size(), [&](std::size_t p) {
     const Vec<D> x = positions_[p].template cast<double>();
@@ -74,9 +74,33 @@ void FlipParticles<D>::advect(const MacGrid<D>& velocity, double dt, const Grid<
       const double lo = spec_.origin[a], hi = lo + spec_.res[a] * spec_.dx;
       if ((openSides[a][0] && free[a] < lo) || (openSides[a][1] && free[a] > hi)) flagged_[p] = 1;
     }
-    const Vecf<D> next = insideDomain<D>(spec_, free.template cast<float>());
-    // A particle does not enter a solid cell: it stays where it was (the wall stops it).
-    if (solid[spec_.clampedCellIndex(next)] <= 0.5f) positions_[p] = next;
+    Vec<D> next = insideDomain<D>(spec_, free.template cast<float>()).template cast<double>();
+    auto inSolidCell = [&](const Vec<D>& y) { return solid[spec_.clampedCellIndex(y.template cast<float>())] > 0.5f; };
+    if (solidDistance) {
+      const double d = sampleLinear<D>(*solidDistance, next);
+      if (d < 0.0 || inSolidCell(next)) {
+        // Out along the distance's gradient: to just outside the surface, then on by quarter cells
+        // out of a cell whose centre is inside. Where that does not get out (a corner), the
+        // particle stays where it was.
+        Vec<D> g;
+        const double h = 0.5 * spec_.dx;
+        for (int a = 0; a < D; ++a) {
+          Vec<D> up = next, down = next;
+          up[a] += h;
+          down[a] -= h;
+          g[a] = (sampleLinear<D>(*solidDistance, up) - sampleLinear<D>(*solidDistance, down)) / (2.0 * h);
+        }
+        const double norm = g.norm();
+        if (norm > 0.0) {
+          const Vec<D> n = g / norm;
+          if (d < 0.0) next -= (d - 1e-3 * spec_.dx) * n;
+          for (int k = 0; k < 4 && inSolidCell(next); ++k) next += 0.25 * spec_.dx * n;
+          next = insideDomain<D>(spec_, next.template cast<float>()).template cast<double>();
+        }
+        if (norm == 0.0 || sampleLinear<D>(*solidDistance, next) < 0.0 || inSolidCell(next)) next = x;
+      }
+    }
+    positions_[p] = next.template cast<float>();
   });
   removeFlagged();
 }

@@ -6,8 +6,10 @@
 //   fromGrid   v_p <- r (v_p + u_new(x_p) - u_old(x_p)) + (1 - r) u_new(x_p), r the FLIP ratio:
 //              r = 1 is FLIP (only the change moves to the particles, no numerical dissipation),
 //              r = 0 is PIC (the grid velocity, smoothed at every transfer);
-//   advect     positions by the grid velocity (midpoint rule), kept inside the domain and out of
-//              solid cells;
+//   advect     positions by the grid velocity (midpoint rule), kept inside the domain; one that
+//              ends inside an obstacle, or in a cell the grid counts as solid (its centre is
+//              inside), is pushed back out along the distance's gradient, so that it slides
+//              along the wall and stays where the pressure and the surface see it;
 //   surface    phi at the cell centres from the particles (Zhu & Bridson's averaged spheres:
 //              phi(x) = |x - x_bar| - r, x_bar the mean position of the particles within R,
 //              weighted by k(s) = max(0, 1 - s^2)^3, s = |x - x_p| / R), with R = 2 dx and
@@ -33,8 +35,10 @@ class FlipParticles {
   // Fills the cells with phi < 0 (and no solid) with jittered particles at the grid's velocity.
   void seed(const Grid<float, D>& phi, const Grid<float, D>& solid, const MacGrid<D>& velocity);
   // Particles that cross a side marked open in openSides[axis][0 = lower, 1 = upper] leave the
-  // liquid (are deleted); the other sides hold them in.
-  void advect(const MacGrid<D>& velocity, double dt, const Grid<float, D>& solid,
+  // liquid (are deleted); the other sides hold them in. solidDistance: the obstacles' signed
+  // distance (any sample layout, negative inside), or null without obstacles; solid: the cells
+  // counted as solid (> 0.5).
+  void advect(const MacGrid<D>& velocity, double dt, const Grid<float, D>* solidDistance, const Grid<float, D>& solid,
               const std::array<std::array<bool, 2>, D>& openSides = {});
   void toGrid(MacGrid<D>& velocity);
   void fromGrid(const MacGrid<D>& updated, const MacGrid<D>& before, double flipRatio);

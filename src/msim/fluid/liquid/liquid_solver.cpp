@@ -44,6 +44,7 @@ template <int D>
 void LiquidSolver<D>::setObstacles(const Grid<float, D>& nodalSolidPhi) {
   projection_.setSolids(numerics::openFaceFractions<D>(spec_, nodalSolidPhi));
   numerics::solidCellsFromNodes(nodalSolidPhi, solid_);
+  solidDistance_ = nodalSolidPhi;
   advector_.setSolid(solid_);
 }
 
@@ -58,7 +59,21 @@ bool LiquidSolver<D>::faceTouches(int axis, const IVec<D>& f, IsLiquid&& isLiqui
 template <int D>
 void LiquidSolver<D>::addLiquid(const Grid<float, D>& cellPhi, const Vec<D>& velocity) {
   if (!cellPhi.sameLayout(phi_)) throw std::invalid_argument("liquid solver: addLiquid needs a cell-centred phi");
-  for (std::size_t i = 0; i < phi_.count(); ++i) phi_[i] = std::min(phi_[i], cellPhi[i]);
+  // The domain's sides are no surface of the liquid: a body that reaches a side (a pool filled to
+  // the tank's walls) has a distance that kinks in the cells next to it, where the side is nearer
+  // than the free surface. Those cells take the depth of their inner neighbour when it is deeper
+  // (a zero normal derivative at the wall), or the surface would start tilted there.
+  Grid<float, D> body = cellPhi;
+  for (int a = 0; a < D; ++a) {
+    if (spec_.res[a] < 2) continue;
+    parallelForCells(body, [&](const IVec<D>& c, std::size_t i) {
+      if (c[a] != 0 && c[a] != spec_.res[a] - 1) return;
+      IVec<D> inner = c;
+      inner[a] += c[a] == 0 ? 1 : -1;
+      if (body[i] < 0.0f) body[i] = std::min(body[i], cellPhi(inner));
+    });
+  }
+  for (std::size_t i = 0; i < phi_.count(); ++i) phi_[i] = std::min(phi_[i], body[i]);
   // Faces with new liquid on a side move with it.
   for (int a = 0; a < D; ++a) {
     auto& u = velocity_.component(a);
@@ -192,9 +207,10 @@ double LiquidSolver<D>::volumeControlDivergence(double dt) {
   // Kim et al. (2007) choose the gains so that an error decays, overdamped, within about 25 steps
   // (k_i = (k_p / 4.4)^2); a dam break's splashes need it faster (volumeControlSteps).
   const double kp = 2.3 / (params_.volumeControlSteps * dt), ki = (kp / 4.4) * (kp / 4.4);
-  // At most 2% of the volume per step: a measurement that jumps (a drop leaving the grid's reach)
-  // must not turn into a blast.
-  const double limit = 0.02 / dt;
+  // At most 2% of the volume per step and 3 per second: a measurement that jumps (a drop leaving
+  // the grid's reach) must not turn into a blast, and a bound that grew as the step shrinks would
+  // feed itself (faster flow, shorter steps, a larger divergence allowed).
+  const double limit = std::min(0.02 / dt, 3.0);
   return std::clamp(-(kp * x + ki * volumeErrorIntegral_ + leakRate_) / (x + 1.0), -limit, limit);
 }
 
@@ -236,7 +252,7 @@ void LiquidSolver<D>::moveFlipSurface(double dt) {
   std::array<std::array<bool, 2>, D> open{};
   for (int a = 0; a < D; ++a)
     for (int side = 0; side < 2; ++side) open[a][side] = params_.sides.side[a][side] == numerics::DomainSide::Open;
-  flip_.advect(velocity_, dt, solid_, open);
+  flip_.advect(velocity_, dt, solidDistance_ ? &*solidDistance_ : nullptr, solid_, open);
   flip_.surface(phi_, params_.bandCells);
   numerics::reinitializeFastMarching(phi_, params_.bandCells);
 }
@@ -296,8 +312,26 @@ void LiquidSolver<D>::step(double dt) {
   }
   {
     ScopedStage s(timers_, "liquid: pressure");
-    parallelFor(0, phi_.count(), [&](std::size_t i) {  // solids hold no liquid
-      pressurePhi_[i] = solid_[i] > 0.5f ? std::max(phi_[i], static_cast<float>(0.5 * spec_.dx)) : phi_[i];
+    // A cell whose centre is inside a solid may still have open faces (a curved wall cuts faces
+    // partly, Batty et al. 2007) and so a pressure unknown. It takes the liquid's side from its
+    // open neighbours: made air (p = 0), it would drain the liquid through the wall's partly open
+    // faces (FLIP water poured into a mesh glass vanished into its walls at the rate it came in).
+    const float dry = static_cast<float>(0.5 * spec_.dx);
+    parallelForCells(pressurePhi_, [&](const IVec<D>& c, std::size_t i) {
+      if (solid_[i] <= 0.5f) {
+        pressurePhi_[i] = phi_[i];
+        return;
+      }
+      float p = dry;
+      for (int a = 0; a < D; ++a)
+        for (int side = -1; side <= 1; side += 2) {
+          IVec<D> n = c;
+          n[a] += side;
+          if (n[a] < 0 || n[a] >= spec_.res[a]) continue;
+          const std::size_t j = phi_.index(n);
+          if (solid_[j] <= 0.5f) p = std::min(p, phi_[j]);
+        }
+      pressurePhi_[i] = p;
     });
     projection_.setFreeSurface(pressurePhi_);
     controlDivergence_ = volumeControlDivergence(dt);

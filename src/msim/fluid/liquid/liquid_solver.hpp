@@ -169,6 +169,7 @@ class LiquidSolver {
   LiquidParams<D> params_;
   Grid<float, D> phi_;
   Grid<float, D> solid_;
+  std::optional<Grid<float, D>> solidDistance_;  // the obstacles' nodal signed distance, if any
   MacGrid<D> velocity_;
   numerics::Advector<float, D> advector_;
   numerics::PressureProjection<D> projection_;
