@@ -54,7 +54,8 @@ void declareLiquid(Schema& root) {
   body.field("shape", shapeSchema());
   body.vector("velocity", "m/s", {0.0, 0.0, 0.0}, "initial velocity of this body").lengths({2, 3});
   root.array("initial_liquid", body, "bodies of liquid at t = 0 (their union)");
-  root.array("obstacles", sceneObstacleSchema("a static solid the liquid flows around"), "static solids");
+  root.array("obstacles", sceneObstacleSchema("a solid the liquid flows around; moving ones push it"),
+             "static and moving solids (free-slip walls)");
   declareLiquidSources(root);
 }
 
@@ -106,14 +107,7 @@ class LiquidPhenomenon final : public Phenomenon {
           logger().warn("{}: 'domain.boundaries.{}' is open: the pressure is 0 there and the liquid flows out through "
                         "it (set it to \"closed\" for a tank wall)",
                         source_, kDomainSideKeys[a][s]);
-    if (obstacles_.moving())
-      throw InputError(fmt::format("{}: 'obstacles': moving obstacles are not supported by the liquid phenomenon yet "
-                                   "(give them no velocity, oscillation or frequency)",
-                                   source_));
-    if (!obstacles_.empty()) {
-      solver_.setObstacles(obstacles_.nodalDistance(0.0));
-      obstacleDistance_ = obstacles_.cellDistance(0.0);
-    }
+    if (!obstacles_.empty()) placeObstacles(0.0);
     const json& bodies = scene.resolved.at("initial_liquid");
     if (bodies.empty() && scene.resolved.at("sources").empty())
       throw InputError(fmt::format("{}: 'initial_liquid' and 'sources' are empty: a liquid scene needs a body of "
@@ -130,13 +124,20 @@ class LiquidPhenomenon final : public Phenomenon {
     fraction_ = Grid<float, D>(spec);
   }
 
-  double stableTimestep() const override { return solver_.cflTimestep(); }
+  // The liquid's CFL step, and a moving obstacle crosses at most cfl cells per step.
+  double stableTimestep() const override {
+    const double obstacleSpeed = obstacles_.moving() ? obstacles_.maxSpeed(time_) : 0.0;
+    const double obstacleStep = obstacleSpeed > 0.0 ? solver_.params().cfl * solver_.spec().dx / obstacleSpeed
+                                                    : std::numeric_limits<double>::infinity();
+    return std::min(solver_.cflTimestep(), obstacleStep);
+  }
 
   void step(double dt) override {
     double exchanged = 0.0;  // by the emitters and sinks
     {
       ScopedStage stage(timers_, "liquid: step");
       exchanged = sources_->apply(solver_, time_);
+      if (obstacles_.moving()) placeObstacles(time_ + 0.5 * dt);
       solver_.step(dt);
     }
     time_ += dt;
@@ -173,7 +174,7 @@ class LiquidPhenomenon final : public Phenomenon {
       writer.addPoints(kFlipParticles, flipCloud(), solver_.spec().dx);
     else
       writer.addPoints(kLevelSetParticles, levelSetCloud(), solver_.spec().dx);
-    if (obstacleDistance_) writer.addLevelSet("obstacle_distance", *obstacleDistance_);
+    if (!obstacles_.empty()) writer.addLevelSet("obstacle_distance", obstacles_.cellDistance(time_));
   }
 
   // The surface as a triangle mesh (3D): mesh/<name>_NNNN.ply and/or .obj (liquid.mesh_format).
@@ -201,6 +202,7 @@ class LiquidPhenomenon final : public Phenomenon {
   // start is not saved, so it is close to but not bit-equal with an uninterrupted run.
   void restore(const std::filesystem::path& vdbFile, double time) override {
     time_ = time;
+    if (obstacles_.moving()) placeObstacles(time);
     const io::VdbFile saved(vdbFile, io::VdbProvenance::MsimRun);
     Grid<float, D> phi(solver_.spec());
     restoreGrid(saved, kPhi, phi, source_);
@@ -249,6 +251,12 @@ class LiquidPhenomenon final : public Phenomenon {
  private:
   double volume() const { return numerics::enclosedVolume(solver_.phi(), &solver_.solid()); }
 
+  // The obstacles where they are at time t, with their velocity when they move.
+  void placeObstacles(double t) {
+    solver_.setObstacles(obstacles_.nodalDistance(t));
+    if (obstacles_.moving()) solver_.setObstacleVelocity(obstacles_.faceVelocity(t));
+  }
+
   io::PointCloud levelSetCloud() const {
     const auto& lp = solver_.levelSetParticles();
     io::PointCloud cloud;
@@ -283,7 +291,6 @@ class LiquidPhenomenon final : public Phenomenon {
   StageTimers& timers_;
   SceneObstacles<D> obstacles_;
   fluid::LiquidSolver<D> solver_;
-  std::optional<Grid<float, D>> obstacleDistance_;
   render::PreviewSettings preview_;
   mutable Grid<float, D> fraction_;  // the preview's liquid fraction (smeared Heaviside of phi)
   std::optional<LiquidSources<D>> sources_;

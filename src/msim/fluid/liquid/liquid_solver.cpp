@@ -42,8 +42,19 @@ LiquidSolver<D>::LiquidSolver(const GridSpec<D>& spec, const LiquidParams<D>& pa
 
 template <int D>
 void LiquidSolver<D>::setObstacles(const Grid<float, D>& nodalSolidPhi) {
-  projection_.setSolids(numerics::openFaceFractions<D>(spec_, nodalSolidPhi));
   numerics::solidCellsFromNodes(nodalSolidPhi, solid_);
+  // The faces of cells counted as solid (centre inside) are closed: the surface, the particles and
+  // the volume all leave those cells out, so the pressure must not let the liquid flow into them
+  // (through a curved wall's partly open faces it did, and FLIP water poured into a glass packed
+  // into a film on its floor). Faces between open cells keep their fractions (Batty et al. 2007).
+  MacGrid<D> open = numerics::openFaceFractions<D>(spec_, nodalSolidPhi);
+  for (int a = 0; a < D; ++a) {
+    auto& w = open.component(a);
+    parallelForCells(w, [&](const IVec<D>& f, std::size_t lin) {
+      if (faceTouches(a, f, [&](std::size_t cell) { return solid_[cell] > 0.5f; })) w[lin] = 0.0f;
+    });
+  }
+  projection_.setSolids(open);
   solidDistance_ = nodalSolidPhi;
   advector_.setSolid(solid_);
 }
@@ -142,15 +153,61 @@ void LiquidSolver<D>::restore(const Grid<float, D>& phi, const MacGrid<D>& veloc
 }
 
 template <int D>
-void LiquidSolver<D>::start() {
+void LiquidSolver<D>::extendIntoSolids() {
+  if (!solidDistance_) return;
+  // Layer by layer, each solid cell next to cells already given takes their mean: the liquid's phi
+  // continues into the wall (a 90-degree contact, as the domain's clamped sides give). Left with
+  // the air's sign, a wall would be a surface of the liquid, which the level set then eroded along
+  // every obstacle (a pool in a box container lost half its water in a second).
+  auto& given = solidFill_;
+  given.resize(phi_.count());
+  parallelFor(0, phi_.count(), [&](std::size_t i) { given[i] = solid_[i] <= 0.5f; });
+  auto& next = solidFillValue_;
+  next.resize(phi_.count());
+  for (int layer = 0; layer < 3; ++layer) {
+    parallelForCells(phi_, [&](const IVec<D>& c, std::size_t i) {
+      next[i] = std::numeric_limits<float>::quiet_NaN();
+      if (given[i]) return;
+      double sum = 0.0;
+      int count = 0;
+      for (int a = 0; a < D; ++a)
+        for (int side = -1; side <= 1; side += 2) {
+          IVec<D> n = c;
+          n[a] += side;
+          if (n[a] < 0 || n[a] >= spec_.res[a]) continue;
+          const std::size_t j = phi_.index(n);
+          if (given[j] == 1) {
+            sum += phi_[j];
+            ++count;
+          }
+        }
+      if (count > 0) next[i] = static_cast<float>(sum / count);
+    });
+    parallelFor(0, phi_.count(), [&](std::size_t i) {
+      if (!std::isnan(next[i])) {
+        phi_[i] = next[i];
+        given[i] = 1;
+      }
+    });
+  }
+}
+
+template <int D>
+void LiquidSolver<D>::reinitialize() {
+  extendIntoSolids();
   numerics::reinitializeFastMarching(phi_, params_.bandCells);
+}
+
+template <int D>
+void LiquidSolver<D>::start() {
+  reinitialize();
   extendVelocity();
   if (params_.tracker == InterfaceTracker::Flip) {
     flip_.seed(phi_, solid_, velocity_);
     // Volume control holds the volume the particles' own surface has (it differs from the
     // given shape's by the reconstruction's bias; holding the other would move still water).
     flip_.surface(phi_, params_.bandCells);
-    numerics::reinitializeFastMarching(phi_, params_.bandCells);
+    reinitialize();
   } else {
     particles_.seed(phi_);
   }
@@ -240,7 +297,7 @@ void LiquidSolver<D>::moveSurface(double dt) {
   advector_.advect(phi_, velocity_, dt);
   particles_.advect(velocity_, dt);
   lastEscaped_ = particles_.correct(phi_);
-  numerics::reinitializeFastMarching(phi_, params_.bandCells);
+  reinitialize();
   particles_.correct(phi_);
   particles_.adjustRadii(phi_);
   if ((steps_ + 1) % params_.reseedInterval == 0) particles_.reseed(phi_);
@@ -254,7 +311,7 @@ void LiquidSolver<D>::moveFlipSurface(double dt) {
     for (int side = 0; side < 2; ++side) open[a][side] = params_.sides.side[a][side] == numerics::DomainSide::Open;
   flip_.advect(velocity_, dt, solidDistance_ ? &*solidDistance_ : nullptr, solid_, open);
   flip_.surface(phi_, params_.bandCells);
-  numerics::reinitializeFastMarching(phi_, params_.bandCells);
+  reinitialize();
 }
 
 template <int D>
@@ -312,26 +369,8 @@ void LiquidSolver<D>::step(double dt) {
   }
   {
     ScopedStage s(timers_, "liquid: pressure");
-    // A cell whose centre is inside a solid may still have open faces (a curved wall cuts faces
-    // partly, Batty et al. 2007) and so a pressure unknown. It takes the liquid's side from its
-    // open neighbours: made air (p = 0), it would drain the liquid through the wall's partly open
-    // faces (FLIP water poured into a mesh glass vanished into its walls at the rate it came in).
-    const float dry = static_cast<float>(0.5 * spec_.dx);
-    parallelForCells(pressurePhi_, [&](const IVec<D>& c, std::size_t i) {
-      if (solid_[i] <= 0.5f) {
-        pressurePhi_[i] = phi_[i];
-        return;
-      }
-      float p = dry;
-      for (int a = 0; a < D; ++a)
-        for (int side = -1; side <= 1; side += 2) {
-          IVec<D> n = c;
-          n[a] += side;
-          if (n[a] < 0 || n[a] >= spec_.res[a]) continue;
-          const std::size_t j = phi_.index(n);
-          if (solid_[j] <= 0.5f) p = std::min(p, phi_[j]);
-        }
-      pressurePhi_[i] = p;
+    parallelFor(0, phi_.count(), [&](std::size_t i) {  // solids hold no liquid (their faces are closed)
+      pressurePhi_[i] = solid_[i] > 0.5f ? std::max(phi_[i], static_cast<float>(0.5 * spec_.dx)) : phi_[i];
     });
     projection_.setFreeSurface(pressurePhi_);
     controlDivergence_ = volumeControlDivergence(dt);

@@ -26,7 +26,9 @@
 // gains follow). The target is the starting volume plus what emitters added and came in through
 // open sides less what sinks and open sides took (FLIP: the particles' volume, scaled as the
 // surface first measured it). The correction is spread over the whole liquid, not put back where the volume was lost.
-// Obstacles are static solids given by a signed distance at the grid nodes, as for smoke. Storage
+// Obstacles are solids given by a signed distance at the grid nodes, as for smoke; moving ones are
+// placed again before every step with the velocity of the solid on every face, which the pressure
+// uses as the boundary condition (the solid pushes the liquid through its faces' closed parts). Storage
 // is float, reductions double; the work arrays live in the object.
 #include <cstddef>
 #include <cstdint>
@@ -107,9 +109,11 @@ class LiquidSolver {
   LiquidSolver(const LiquidSolver&) = delete;
   LiquidSolver& operator=(const LiquidSolver&) = delete;
 
-  // Static obstacles from a signed distance at the grid nodes (numerics::sampleNodes), negative
-  // inside; cells whose centre is inside are solid.
+  // Obstacles from a signed distance at the grid nodes (numerics::sampleNodes), negative inside;
+  // cells whose centre is inside are solid. Moving obstacles: call it before every step, with
+  // setObstacleVelocity (the velocity of the solid on every face, 0 by default).
   void setObstacles(const Grid<float, D>& nodalSolidPhi);
+  void setObstacleVelocity(const MacGrid<D>& solidVelocity) { projection_.setSolidVelocity(solidVelocity); }
   // Adds liquid where cellPhi < 0 (the union with what is there), moving at `velocity`. Before
   // the first step: the particles are seeded then.
   void addLiquid(const Grid<float, D>& cellPhi, const Vec<D>& velocity = Vec<D>::Zero());
@@ -156,6 +160,9 @@ class LiquidSolver {
   void moveSurface(double dt);
   void moveFlipSurface(double dt);
   void extendVelocity();
+  // phi continued into the obstacles from the cells next to them (3 layers), then fast marching.
+  void extendIntoSolids();
+  void reinitialize();
   // Liquid volume [m^3] that leaves through open domain sides in dt at the current velocity.
   double openSideOutflow(double dt) const;
   // Kim et al.'s divergence for the volume just measured after the surface moved (0 when off).
@@ -170,6 +177,8 @@ class LiquidSolver {
   Grid<float, D> phi_;
   Grid<float, D> solid_;
   std::optional<Grid<float, D>> solidDistance_;  // the obstacles' nodal signed distance, if any
+  std::vector<std::uint8_t> solidFill_;             // extendIntoSolids(): cells given so far
+  std::vector<float> solidFillValue_;               // and the layer being added
   MacGrid<D> velocity_;
   numerics::Advector<float, D> advector_;
   numerics::PressureProjection<D> projection_;
