@@ -47,6 +47,8 @@ granular_impacts    | preview | --set domain.resolution=50
 granular_explosion  | preview | --frames 14 --set domain.resolution=40
 dam_break_2d        | preview | --frames 10
 dam_break_3d        | render  | --frames 10
+drop_into_pool      | render  | --frames 15
+wave_maker_2d       | preview | --frames 96
 "
 
 wanted=("$@")

@@ -64,10 +64,12 @@ double liquidBytesPerCell(int dimensions, const json& resolved) {
   // velocity, its copy, weights, solid velocity, 1/theta and the advector's scratch (about 6
   // face grids), known flags (bytes): ~ 18 + 12 D floats. Particles: the particle level set keeps
   // 16 (2D) or 32 (3D) of 29 bytes in each band cell, about a tenth of the cells; FLIP 2^D of 24
-  // bytes in each liquid cell, about half of them.
+  // bytes in each liquid cell, about half of them. While a frame is written the VDB writer holds
+  // copies of phi, the velocities and the particles (about 40 floats a cell more): a 256^3 FLIP
+  // dam break with a quarter of the box filled peaked at 480 bytes per cell.
   const bool flip = resolved.at("liquid").at("tracker").get<std::string>() == "flip";
   const double particles = flip ? 0.5 * (1 << dimensions) * 24.0 : 0.1 * (dimensions == 2 ? 16 : 32) * 29.0;
-  return 4.0 * (18 + 12 * dimensions) + particles;
+  return 4.0 * (58 + 12 * dimensions) + particles;
 }
 
 template <int D>
