@@ -1,7 +1,7 @@
 // Emitters, sinks and open sides (issue #24): a hose delivers about its velocity times its
-// cross-section per second (measured +20% with the particle level set, +16% with FLIP at 64^2:
-// within each step gravity speeds the liquid up as it leaves the hose, and FLIP refills a cell
-// when it is half empty), a drain empties a tank of exactly what it holds, and FLIP particles that leave
+// cross-section per second (measured +20% with the particle level set, +16% with FLIP at 64^2;
+// imposing the hose's velocity again after the pressure solve leaves the excess as it is, so it is
+// not the step's gravity), a drain empties a tank of what it holds, and FLIP particles that leave
 // through an open side are gone (volume control follows all three, so the liquid neither swells
 // nor shrinks to make up for them).
 #include <gtest/gtest.h>
