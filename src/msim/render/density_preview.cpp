@@ -13,7 +13,6 @@ namespace msim::render {
 namespace {
 
 using Rgb = std::array<float, 3>;
-constexpr Rgb kGasColour = {0.92f, 0.93f, 0.95f};
 constexpr Rgb kSolidColour = {0.42f, 0.33f, 0.27f};
 constexpr float kSolidDepth = 50.0f;  // optical depth of one solid cell: opaque
 
@@ -98,7 +97,7 @@ Radiance project(const Grid<float, 3>& rho, const float* solid, const PreviewSet
         break;
       }
       const float a = 1.0f - std::exp(-k * std::max(rho[i], 0.0f));
-      for (int ch = 0; ch < 3; ++ch) L[ch] += T * a * albedo * kGasColour[ch] * (lightT[i] + ambient);
+      for (int ch = 0; ch < 3; ++ch) L[ch] += T * a * albedo * s.colour[ch] * (lightT[i] + ambient);
       if (emit.active()) {
         const Rgb e = emit(i);
         for (int ch = 0; ch < 3; ++ch) L[ch] += T * e[ch];
@@ -143,7 +142,7 @@ Radiance project(const Grid<float, 2>& rho, const float* solid, const PreviewSet
       // Emission through half the slab's smoke, on average.
       const Rgb e = emit.active() ? emit(i) : Rgb{0, 0, 0};
       const float seen = std::exp(-0.5f * kView * rhoi);
-      for (int ch = 0; ch < 3; ++ch) r.colour[i][ch] = a * albedo * kGasColour[ch] * (lightT + ambient) + seen * e[ch];
+      for (int ch = 0; ch < 3; ++ch) r.colour[i][ch] = a * albedo * s.colour[ch] * (lightT + ambient) + seen * e[ch];
       r.alpha[i] = a;
     }
   }, 16);

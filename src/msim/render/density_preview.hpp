@@ -4,6 +4,8 @@
 // term and a dark background. Solid cells (obstacles), when given, are drawn as opaque matte
 // surfaces that also cast shadows into the gas. It is the per-frame preview every scene writes; the physically
 // based renderer (Stam ch. 5) is a separate module.
+#include <array>
+
 #include "msim/core/grid.hpp"
 #include "msim/io/png.hpp"
 
@@ -14,6 +16,7 @@ struct PreviewSettings {
   int upAxis = 1;             // image up; the light shines down this axis
   double extinction = 10.0;   // sigma_t per unit density [m^2/kg]
   double albedo = 0.9;        // scattered fraction of extinguished light
+  std::array<float, 3> colour = {0.92f, 0.93f, 0.95f};  // the medium's tint (linear RGB): smoke's near white
   double ambient = 0.25;      // sky light reaching every voxel, relative to the key light
   int minWidth = 480;         // images are upscaled by an integer factor to at least this width
   double depth2D = 0.0;       // optical depth thickness of a 2D grid [m]; 0 means 8 cells

@@ -123,6 +123,7 @@ class LiquidPhenomenon final : public Phenomenon {
     }
     sources_.emplace(scene, solver_.solid(), volume());
     preview_ = previewSettings(scene);
+    preview_.colour = {0.30f, 0.58f, 0.85f};  // water reads as water in the side views
     fraction_ = Grid<float, D>(spec);
   }
 
