@@ -15,8 +15,8 @@
 //              weighted by k(s) = max(0, 1 - s^2)^3, s = |x - x_p| / R), with R = 2 dx and
 //              r = R / 4: the kernel-weighted mean depth of a half ball is 0.246 R in 3D and
 //              0.259 R in 2D, so a flat, evenly filled layer gets its surface on its top.
-#include <cstddef>
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 

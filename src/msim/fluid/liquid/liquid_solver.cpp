@@ -37,6 +37,7 @@ LiquidSolver<D>::LiquidSolver(const GridSpec<D>& spec, const LiquidParams<D>& pa
     const auto& u = velocity_.component(a);
     facePhi_[a] = Grid<float, D>(spec, u.size(), u.offset());
     known_[a].assign(u.count(), 0);
+    for (int side = 0; side < 2; ++side) openSides_[a][side] = params.sides.side[a][side] == numerics::DomainSide::Open;
   }
 }
 
@@ -56,6 +57,11 @@ void LiquidSolver<D>::setObstacles(const Grid<float, D>& nodalSolidPhi) {
   }
   projection_.setSolids(open);
   solidDistance_ = nodalSolidPhi;
+  // phi continues three cells into the obstacles (a 90-degree contact, as the domain's clamped
+  // sides give). Left with the air's sign, a wall would be a surface of the liquid, which the
+  // level set then eroded along every obstacle (a pool in a box container lost half its water in a
+  // second).
+  intoSolids_ = numerics::SolidExtension<D>(solid_, 3);
   advector_.setSolid(solid_);
 }
 
@@ -101,10 +107,6 @@ double LiquidSolver<D>::emit(const Grid<float, D>& region, const Vec<D>& velocit
   if (!region.sameLayout(phi_)) throw std::invalid_argument("liquid solver: emit needs a cell-centred region");
   if (!started_) start();
   ScopedStage s(timers_, "liquid: sources");
-  const double before = numerics::enclosedVolume(phi_, &solid_);
-  parallelFor(0, phi_.count(), [&](std::size_t i) {
-    if (solid_[i] <= 0.5f) phi_[i] = std::min(phi_[i], region[i]);
-  });
   for (int a = 0; a < D; ++a) {
     auto& u = velocity_.component(a);
     const auto& w = projection_.faceWeights().component(a);
@@ -115,10 +117,9 @@ double LiquidSolver<D>::emit(const Grid<float, D>& region, const Vec<D>& velocit
   }
   if (params_.tracker == InterfaceTracker::Flip)  // the particles are the liquid (phi is rebuilt from them)
     return flip_.particleVolume() * double(flip_.emit(region, solid_, velocity.template cast<float>(), ++emissions_));
-  particles_.removeInside(region);
-  const double added = numerics::enclosedVolume(phi_, &solid_) - before;
-  targetVolume_ += added;
-  return added;
+  return editLevelSet(region, [&](std::size_t i) {
+    if (solid_[i] <= 0.5f) phi_[i] = std::min(phi_[i], region[i]);
+  });
 }
 
 template <int D>
@@ -126,13 +127,19 @@ double LiquidSolver<D>::drain(const Grid<float, D>& region) {
   if (!region.sameLayout(phi_)) throw std::invalid_argument("liquid solver: drain needs a cell-centred region");
   if (!started_) start();
   ScopedStage s(timers_, "liquid: sinks");
-  const double before = numerics::enclosedVolume(phi_, &solid_);
-  parallelFor(0, phi_.count(), [&](std::size_t i) { phi_[i] = std::max(phi_[i], -region[i]); });
   if (params_.tracker == InterfaceTracker::Flip) return flip_.particleVolume() * double(flip_.removeInside(region));
+  return -editLevelSet(region, [&](std::size_t i) { phi_[i] = std::max(phi_[i], -region[i]); });
+}
+
+template <int D>
+template <typename Edit>
+double LiquidSolver<D>::editLevelSet(const Grid<float, D>& region, Edit&& edit) {
+  const double before = numerics::enclosedVolume(phi_, &solid_);
+  parallelFor(0, phi_.count(), edit);
   particles_.removeInside(region);
-  const double removed = before - numerics::enclosedVolume(phi_, &solid_);
-  targetVolume_ = std::max(0.0, targetVolume_ - removed);
-  return removed;
+  const double change = numerics::enclosedVolume(phi_, &solid_) - before;
+  targetVolume_ = std::max(0.0, targetVolume_ + change);
+  return change;
 }
 
 template <int D>
@@ -147,54 +154,19 @@ void LiquidSolver<D>::restore(const Grid<float, D>& phi, const MacGrid<D>& veloc
   steps_ = steps;
   started_ = true;
   if (params_.tracker == InterfaceTracker::ParticleLevelSet && particles_.size() == 0) particles_.seed(phi_);
+  resetVolumeControl();
+}
+
+template <int D>
+void LiquidSolver<D>::resetVolumeControl() {
   targetVolume_ = numerics::enclosedVolume(phi_, &solid_);
   volumeErrorIntegral_ = leakRate_ = flipVolumeScale_ = 0.0;
   controlStarted_ = false;
 }
 
 template <int D>
-void LiquidSolver<D>::extendIntoSolids() {
-  if (!solidDistance_) return;
-  // Layer by layer, each solid cell next to cells already given takes their mean: the liquid's phi
-  // continues into the wall (a 90-degree contact, as the domain's clamped sides give). Left with
-  // the air's sign, a wall would be a surface of the liquid, which the level set then eroded along
-  // every obstacle (a pool in a box container lost half its water in a second).
-  auto& given = solidFill_;
-  given.resize(phi_.count());
-  parallelFor(0, phi_.count(), [&](std::size_t i) { given[i] = solid_[i] <= 0.5f; });
-  auto& next = solidFillValue_;
-  next.resize(phi_.count());
-  for (int layer = 0; layer < 3; ++layer) {
-    parallelForCells(phi_, [&](const IVec<D>& c, std::size_t i) {
-      next[i] = std::numeric_limits<float>::quiet_NaN();
-      if (given[i]) return;
-      double sum = 0.0;
-      int count = 0;
-      for (int a = 0; a < D; ++a)
-        for (int side = -1; side <= 1; side += 2) {
-          IVec<D> n = c;
-          n[a] += side;
-          if (n[a] < 0 || n[a] >= spec_.res[a]) continue;
-          const std::size_t j = phi_.index(n);
-          if (given[j] == 1) {
-            sum += phi_[j];
-            ++count;
-          }
-        }
-      if (count > 0) next[i] = static_cast<float>(sum / count);
-    });
-    parallelFor(0, phi_.count(), [&](std::size_t i) {
-      if (!std::isnan(next[i])) {
-        phi_[i] = next[i];
-        given[i] = 1;
-      }
-    });
-  }
-}
-
-template <int D>
 void LiquidSolver<D>::reinitialize() {
-  extendIntoSolids();
+  intoSolids_.extend(phi_);
   numerics::reinitializeFastMarching(phi_, params_.bandCells);
 }
 
@@ -211,10 +183,7 @@ void LiquidSolver<D>::start() {
   } else {
     particles_.seed(phi_);
   }
-  flipVolumeScale_ = 0.0;
-  targetVolume_ = numerics::enclosedVolume(phi_, &solid_);
-  volumeErrorIntegral_ = leakRate_ = 0.0;
-  controlStarted_ = false;
+  resetVolumeControl();
   started_ = true;
 }
 
@@ -222,18 +191,28 @@ template <int D>
 double LiquidSolver<D>::openSideOutflow(double dt) const {
   double outflow = 0.0;
   const double faceArea = spec_.cellVolume() / spec_.dx;
-  for (int a = 0; a < D; ++a)
+  for (int a = 0; a < D; ++a) {
+    // The faces of one side: the layer f[a] = 0 or res[a] of component a, visited as a grid of the
+    // other axes.
+    IVec<D> layerSize = spec_.res;
+    layerSize[a] = 1;
+    const auto& u = velocity_.component(a);
     for (int side = 0; side < 2; ++side) {
-      if (params_.sides.side[a][side] != numerics::DomainSide::Open) continue;
-      const auto& u = velocity_.component(a);
-      const int layer = side == 0 ? 0 : spec_.res[a];
+      if (!openSides_[a][side]) continue;
       const double outward = side == 0 ? -1.0 : 1.0;
-      outflow += parallelSum(u.count(), [&](std::size_t i) {
-        const IVec<D> f = u.coord(i);
-        if (f[a] != layer || !faceTouches(a, f, [&](std::size_t cell) { return liquidCell(cell); })) return 0.0;
-        return outward * u[i];
+      std::size_t faces = 1;
+      for (int b = 0; b < D; ++b) faces *= static_cast<std::size_t>(layerSize[b]);
+      outflow += parallelSum(faces, [&](std::size_t k) {
+        IVec<D> f;
+        for (int b = 0; b < D; ++b) {
+          f[b] = static_cast<int>(k % static_cast<std::size_t>(layerSize[b]));
+          k /= static_cast<std::size_t>(layerSize[b]);
+        }
+        f[a] = side == 0 ? 0 : spec_.res[a];
+        return faceTouches(a, f, [&](std::size_t cell) { return liquidCell(cell); }) ? outward * u(f) : 0.0;
       });
     }
+  }
   return outflow * faceArea * dt;
 }
 
@@ -306,10 +285,7 @@ void LiquidSolver<D>::moveSurface(double dt) {
 template <int D>
 void LiquidSolver<D>::moveFlipSurface(double dt) {
   ScopedStage s(timers_, "liquid: surface");
-  std::array<std::array<bool, 2>, D> open{};
-  for (int a = 0; a < D; ++a)
-    for (int side = 0; side < 2; ++side) open[a][side] = params_.sides.side[a][side] == numerics::DomainSide::Open;
-  flip_.advect(velocity_, dt, solidDistance_ ? &*solidDistance_ : nullptr, solid_, open);
+  flip_.advect(velocity_, dt, solidDistance_ ? &*solidDistance_ : nullptr, solid_, openSides_);
   flip_.surface(phi_, params_.bandCells);
   reinitialize();
 }

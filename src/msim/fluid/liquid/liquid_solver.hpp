@@ -25,11 +25,13 @@
 // forward (a splash that hits a wall loses several percent within a few steps, faster than the PI
 // gains follow). The target is the starting volume plus what emitters added and came in through
 // open sides less what sinks and open sides took (FLIP: the particles' volume, scaled as the
-// surface first measured it). The correction is spread over the whole liquid, not put back where the volume was lost.
+// surface first measured it). The correction is spread over the whole liquid, not put back where
+// the volume was lost.
 // Obstacles are solids given by a signed distance at the grid nodes, as for smoke; moving ones are
 // placed again before every step with the velocity of the solid on every face, which the pressure
 // uses as the boundary condition (the solid pushes the liquid through its faces' closed parts). Storage
 // is float, reductions double; the work arrays live in the object.
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -42,6 +44,7 @@
 #include "msim/numerics/advection/advector.hpp"
 #include "msim/numerics/level_set/particle_level_set.hpp"
 #include "msim/numerics/pressure/projection.hpp"
+#include "msim/numerics/solid_extension.hpp"
 
 namespace msim::fluid {
 
@@ -83,8 +86,9 @@ struct LiquidParams {
   double cfl = 1.0;                          // cells the fastest face may cross per substep
   bool volumeControl = true;                 // hold the volume (Kim et al. 2007; see above)
   // Steps in which a volume error decays. Kim et al. use 25 for slowly leaking bubbles; in the 3D
-  // dam break of tests/fluid_liquid/volume_test.cpp at 48 x 30 x 18 cells 25 left errors of up to
-  // 2.4% (particle level set) and 2.8% (FLIP), 10 1.6% and 2.9%, 5 1.05% and 2.2%.
+  // dam break of tests/fluid_liquid/volume_test.cpp at 48 x 30 x 18 cells the particle level set
+  // strays by up to 2.4% with 25, 1.6% with 10, 1.05% with 5 and 1.07% with 4 (FLIP: 2.6% with 5,
+  // 2.7% with 4).
   double volumeControlSteps = 5.0;
   int maxSubsteps = 64;                      // advance() refuses to take more (SimulationError)
 };
@@ -160,13 +164,18 @@ class LiquidSolver {
   void moveSurface(double dt);
   void moveFlipSurface(double dt);
   void extendVelocity();
-  // phi continued into the obstacles from the cells next to them (3 layers), then fast marching.
-  void extendIntoSolids();
+  // phi continued into the obstacles (intoSolids_), then fast marching.
   void reinitialize();
   // Liquid volume [m^3] that leaves through open domain sides in dt at the current velocity.
   double openSideOutflow(double dt) const;
   // Kim et al.'s divergence for the volume just measured after the surface moved (0 when off).
   double volumeControlDivergence(double dt);
+  // Volume control starts afresh from the volume phi holds now.
+  void resetVolumeControl();
+  // Applies edit(cell index) to the particle level set's phi, drops its particles in `region` and
+  // moves volume control's target by the volume change, which it returns [m^3].
+  template <typename Edit>
+  double editLevelSet(const Grid<float, D>& region, Edit&& edit);
   bool liquidCell(std::size_t cell) const { return phi_[cell] < 0.0f && solid_[cell] <= 0.5f; }
   // Whether face f of `axis` has a cell on either side for which isLiquid(cell index) holds.
   template <typename IsLiquid>
@@ -177,8 +186,7 @@ class LiquidSolver {
   Grid<float, D> phi_;
   Grid<float, D> solid_;
   std::optional<Grid<float, D>> solidDistance_;  // the obstacles' nodal signed distance, if any
-  std::vector<std::uint8_t> solidFill_;             // extendIntoSolids(): cells given so far
-  std::vector<float> solidFillValue_;               // and the layer being added
+  numerics::SolidExtension<D> intoSolids_;          // phi's continuation into the obstacles
   MacGrid<D> velocity_;
   numerics::Advector<float, D> advector_;
   numerics::PressureProjection<D> projection_;
@@ -194,6 +202,7 @@ class LiquidSolver {
   double lastVolumeError_ = 0.0, leakRate_ = 0.0;
   double flipVolumeScale_ = 0.0;  // FLIP: rebuilt surface volume per particle volume (0: not yet seen)
   bool controlStarted_ = false;
+  std::array<std::array<bool, 2>, D> openSides_{};  // params.sides: [axis][lower, upper] open
   bool started_ = false;
   long steps_ = 0;
   std::uint64_t emissions_ = 0;  // emit() calls so far (new random streams each)

@@ -48,24 +48,7 @@ void SmokeSolver<D>::setObstacles(const Grid<float, D>& nodalSolidPhi) {
   findCutFaces();
   if (conservative_) conservative_->transport.setSolid(sealed_);
   hasObstacles_ = true;
-  borderCells_.clear();
-  borderStart_.assign(1, 0);
-  borderNeighbours_.clear();
-  for (std::size_t i = 0; i < solid_.count(); ++i) {
-    if (solid_[i] <= 0.5f) continue;
-    const IVec<D> c = solid_.coord(i);
-    const std::size_t first = borderNeighbours_.size();
-    for (int a = 0; a < D; ++a)
-      for (int s : {-1, 1}) {
-        IVec<D> nb = c;
-        nb[a] += s;
-        if (solid_.inside(nb) && solid_(nb) <= 0.5f) borderNeighbours_.push_back(solid_.index(nb));
-      }
-    if (borderNeighbours_.size() > first) {
-      borderCells_.push_back(i);
-      borderStart_.push_back(borderNeighbours_.size());
-    }
-  }
+  border_ = numerics::SolidExtension<D>(solid_, 1);
 }
 
 template <int D>
@@ -222,11 +205,11 @@ template <int D>
 void SmokeSolver<D>::advectScalars(double dt) {
   if (!scalarsElsewhere_)
     for (Grid<float, D>* f : {&density_, &temperature_}) {
-      extendIntoSolid(*f);
+      border_.extend(*f);
       advector_.advect(*f, velocity_, dt);
     }
   for (auto& sc : scalars_) {
-    extendIntoSolid(sc.field);
+    border_.extend(sc.field);
     advector_.advect(sc.field, velocity_, dt);
   }
 }
@@ -342,15 +325,6 @@ template <int D>
 void SmokeSolver<D>::applyScalarSources(double dt) {
   for (const auto& src : sources_)
     applySourceScalars<D>(src, dt, density_, temperature_, [&](std::size_t i) -> Grid<float, D>& { return scalars_[i].field; });
-}
-
-template <int D>
-void SmokeSolver<D>::extendIntoSolid(Grid<float, D>& field) const {
-  parallelFor(0, borderCells_.size(), [&](std::size_t k) {
-    double sum = 0.0;
-    for (std::size_t j = borderStart_[k]; j < borderStart_[k + 1]; ++j) sum += field[borderNeighbours_[j]];
-    field[borderCells_[k]] = static_cast<float>(sum / static_cast<double>(borderStart_[k + 1] - borderStart_[k]));
-  }, 256);
 }
 
 template <int D>

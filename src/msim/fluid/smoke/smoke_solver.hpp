@@ -30,6 +30,7 @@
 #include "msim/numerics/advection/advector.hpp"
 #include "msim/numerics/flux_transport.hpp"
 #include "msim/numerics/pressure/projection.hpp"
+#include "msim/numerics/solid_extension.hpp"
 #include "msim/turbulence/turbulent_wind.hpp"
 
 namespace msim::fluid {
@@ -202,7 +203,6 @@ class SmokeSolver {
   };
   void resetInflowCells();
   void applyScalarSources(double dt);
-  void extendIntoSolid(Grid<float, D>& field) const;
   void advectScalars(double dt);
   void transportScalarsConservatively(double dt);
   void updateSealed();
@@ -224,9 +224,9 @@ class SmokeSolver {
   std::vector<Scalar> scalars_;
   std::vector<SmokeSource<D>> sources_;
   bool hasObstacles_ = false;
-  // Solid cells with a fluid face neighbour and those neighbours (CSR): the scalars are extended
-  // into them before advection so back-traces that end inside an obstacle read fluid values.
-  std::vector<std::size_t> borderCells_, borderStart_, borderNeighbours_;
+  // The solid cells next to the fluid: the scalars are extended into them before advection so
+  // back-traces that end inside an obstacle read fluid values.
+  numerics::SolidExtension<D> border_;
   // Per velocity component: faces open in the projection (weight > 0) that the advector keeps
   // fixed because they border a solid cell, with their advected same-component neighbours (CSR).
   struct CutFaces {
