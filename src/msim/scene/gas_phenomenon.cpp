@@ -89,12 +89,11 @@ fluid::MotionField motionField(const json& fields) {
 }
 
 template <int D>
-numerics::TransportBoundaries<D> boundaries(const json& sides) {
+numerics::TransportBoundaries<D> boundaries(const json& resolved) {
   numerics::TransportBoundaries<D> b;
+  const auto open = openDomainSides<D>(resolved);
   for (int a = 0; a < D; ++a)
-    for (int s = 0; s < 2; ++s)
-      b.side[a][s] = sides.at(kDomainSideKeys[a][s]).get<std::string>() == "open" ? numerics::BoundaryKind::Open
-                                                                        : numerics::BoundaryKind::Closed;
+    for (int s = 0; s < 2; ++s) b.side[a][s] = open[a][s] ? numerics::BoundaryKind::Open : numerics::BoundaryKind::Closed;
   return b;
 }
 
@@ -105,7 +104,7 @@ class GasPhenomenon final : public Phenomenon {
       : source_(scene.file.string()),
         timers_(timers),
         solver_(scene.gridSpec<D>(), params(scene.resolved), motionField(scene.resolved.at("motion_fields")),
-                boundaries<D>(scene.resolved.at("domain").at("boundaries"))) {
+                boundaries<D>(scene.resolved)) {
     const json& r = scene.resolved;
     const GridSpec<D> spec = scene.gridSpec<D>();
     Grid<float, D> solid(spec, 0.0f);

@@ -84,11 +84,9 @@ fluid::LiquidParams<D> liquidParams(const Scene& scene) {
   p.reseedInterval = l.at("reseed_interval").get<int>();
   p.volumeControl = l.at("volume_control").get<bool>();
   p.cfl = scene.resolved.at("time").at("cfl").get<double>();
-  const json& sides = scene.resolved.at("domain").at("boundaries");
+  const auto open = openDomainSides<D>(scene.resolved);
   for (int a = 0; a < D; ++a)
-    for (int s = 0; s < 2; ++s)
-      p.sides.side[a][s] = sides.at(kDomainSideKeys[a][s]).get<std::string>() == "open" ? numerics::DomainSide::Open
-                                                                                       : numerics::DomainSide::Wall;
+    for (int s = 0; s < 2; ++s) p.sides.side[a][s] = open[a][s] ? numerics::DomainSide::Open : numerics::DomainSide::Wall;
   return p;
 }
 
@@ -153,7 +151,7 @@ class LiquidPhenomenon final : public Phenomenon {
     }
     // Steps in which emitters or sinks changed the liquid are not checked: what they add is counted
     // in cells or particles, which the surface measures with a bias of its own (a small blob).
-    const double before = volume_, after = volume();
+    const double before = volume_, after = solver_.volume();
     if (exchanged == 0.0 && before > 0.0 && after < 0.9 * before)
       throw SimulationError(fmt::format("liquid: step {} lost {:.1f}% of the liquid's volume ({:.4g} -> {:.4g} m^{}): "
                                         "the flow is too violent for the grid",

@@ -35,14 +35,16 @@ void declareLiquidSources(Schema& root) {
 
 namespace {
 
-// Cross-section [m^(D-1)] of the covered cells normal to the unit direction n: their volume over
-// their extent along n (exact for boxes and cylinders aligned with n).
+// Cross-section [m^(D-1)] of the covered cells (indices into `grid`, cell-centred) normal to the
+// unit direction n: their volume over their extent along n (exact for boxes and cylinders aligned
+// with n).
 template <int D>
-double crossSection(const std::vector<std::pair<std::size_t, float>>& cells, const GridSpec<D>& spec, const Vec<D>& n) {
+double crossSection(const std::vector<std::pair<std::size_t, float>>& cells, const Grid<float, D>& grid,
+                    const Vec<D>& n) {
+  const GridSpec<D>& spec = grid.spec();
   double lo = std::numeric_limits<double>::infinity(), hi = -lo, volume = 0.0;
-  const Grid<float, D> layout(spec, 0.0f);
   for (const auto& [cell, cover] : cells) {
-    const double s = layout.position(layout.coord(cell)).dot(n);
+    const double s = grid.position(grid.coord(cell)).dot(n);
     lo = std::min(lo, s);
     hi = std::max(hi, s);
     volume += cover * spec.cellVolume();
@@ -70,7 +72,7 @@ LiquidSources<D>::LiquidSources(const Scene& scene, const Grid<float, D>& solid,
     e.stop = s.at("stop").get<double>();
     const double speed = e.velocity.norm();
     const double on = std::max(0.0, (e.stop > 0.0 ? std::min(e.stop, duration) : duration) - e.start);
-    if (speed > 0.0) emitted += crossSection<D>(cells, spec, Vec<D>(e.velocity / speed)) * speed * on;
+    if (speed > 0.0) emitted += crossSection<D>(cells, solid, Vec<D>(e.velocity / speed)) * speed * on;
     e.field = e.shape->distanceField(spec);
     emitters_.push_back(std::move(e));
   }
@@ -87,9 +89,7 @@ LiquidSources<D>::LiquidSources(const Scene& scene, const Grid<float, D>& solid,
   }
   // A closed domain with no sink keeps all it is given.
   bool closed = sinks_.empty();
-  const nlohmann::json& sides = r.at("domain").at("boundaries");
-  for (int a = 0; a < D; ++a)
-    for (int side = 0; side < 2; ++side) closed = closed && sides.at(kDomainSideKeys[a][side]).get<std::string>() != "open";
+  for (const auto& axis : openDomainSides<D>(r)) closed = closed && !axis[0] && !axis[1];
   if (closed && !emitters_.empty()) {
     double capacity = 0.0;
     for (std::size_t c = 0; c < solid.count(); ++c) capacity += solid[c] < 0.5f ? spec.cellVolume() : 0.0;
@@ -103,12 +103,13 @@ LiquidSources<D>::LiquidSources(const Scene& scene, const Grid<float, D>& solid,
 }
 
 template <int D>
-const Grid<float, D>& LiquidSources<D>::regionAt(Region& r, double t) const {
+const Grid<float, D>& LiquidSources<D>::regionAt(Region& r, double t) {
   if (r.motion.squaredNorm() == 0.0) return r.field;
-  const Vec<D> offset = r.motion * (t - r.start);
-  parallelForCells(r.field, [&](const IVec<D>& c, std::size_t i) {
-    r.field[i] = static_cast<float>(r.shape->distance(r.field.position(c) - offset));
-  });
+  // The shape moved by `offset` seen from a grid moved the other way, as SceneObstacles places its
+  // solids: meshes keep their fast whole-grid distance evaluation.
+  GridSpec<D> shifted = r.field.spec();
+  shifted.origin -= r.motion * (t - r.start);
+  r.field.data() = r.shape->distanceField(shifted).data();
   return r.field;
 }
 

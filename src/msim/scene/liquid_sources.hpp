@@ -42,7 +42,7 @@ class LiquidSources {
     bool on(double t) const { return t >= start && (stop <= 0.0 || t < stop); }
   };
   // The shape's distance, translated by motion (t - start) when it moves.
-  const Grid<float, D>& regionAt(Region& r, double t) const;
+  static const Grid<float, D>& regionAt(Region& r, double t);
 
   std::vector<Region> emitters_, sinks_;
 };

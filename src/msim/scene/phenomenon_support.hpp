@@ -2,6 +2,7 @@
 // Machinery every grid phenomenon needs between its solver and the scene: the finite-state check
 // that names step and field, resuming a grid from a saved frame, the preview settings from
 // outputs.preview, and shapes from scene keys with "outside the domain" errors.
+#include <array>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -46,6 +47,16 @@ const std::vector<float>& savedPointAttribute(const io::PointCloud& cloud, const
 
 // The keys of domain.boundaries, per axis and side (0 lower, 1 upper).
 inline constexpr const char* kDomainSideKeys[3][2] = {{"x_min", "x_max"}, {"y_min", "y_max"}, {"z_min", "z_max"}};
+
+// Which sides of a resolved scene's domain.boundaries are "open", per axis and side.
+template <int D>
+std::array<std::array<bool, 2>, D> openDomainSides(const nlohmann::json& resolved) {
+  std::array<std::array<bool, 2>, D> open{};
+  const nlohmann::json& sides = resolved.at("domain").at("boundaries");
+  for (int a = 0; a < D; ++a)
+    for (int s = 0; s < 2; ++s) open[a][s] = sides.at(kDomainSideKeys[a][s]).template get<std::string>() == "open";
+  return open;
+}
 
 // outputs.preview of a resolved scene.
 render::PreviewSettings previewSettings(const Scene& scene);

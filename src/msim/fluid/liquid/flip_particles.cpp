@@ -63,7 +63,7 @@ void FlipParticles<D>::assign(std::vector<Vecf<D>> positions, std::vector<Vecf<D
 
 template <int D>
 void FlipParticles<D>::advect(const MacGrid<D>& velocity, double dt, const Grid<float, D>* solidDistance,
-                              const Grid<float, D>& solid, const std::array<std::array<bool, 2>, D>& openSides) {
+                              const Grid<float, D>& solid, const numerics::DomainSides<D>& sides) {
   flagged_.assign(positions_.size(), 0);
   parallelFor(0, positions_.size(), [&](std::size_t p) {
     const Vec<D> x = positions_[p].template cast<double>();
@@ -72,7 +72,9 @@ void FlipParticles<D>::advect(const MacGrid<D>& velocity, double dt, const Grid<
     const Vec<D> free = x + dt * sampleLinear<D>(velocity, mid);
     for (int a = 0; a < D; ++a) {
       const double lo = spec_.origin[a], hi = lo + spec_.res[a] * spec_.dx;
-      if ((openSides[a][0] && free[a] < lo) || (openSides[a][1] && free[a] > hi)) flagged_[p] = 1;
+      if ((sides.side[a][0] == numerics::DomainSide::Open && free[a] < lo) ||
+          (sides.side[a][1] == numerics::DomainSide::Open && free[a] > hi))
+        flagged_[p] = 1;
     }
     Vec<D> next = insideDomain<D>(spec_, free.template cast<float>()).template cast<double>();
     auto inSolidCell = [&](const Vec<D>& y) { return solid[spec_.clampedCellIndex(y.template cast<float>())] > 0.5f; };

@@ -15,7 +15,6 @@
 //              weighted by k(s) = max(0, 1 - s^2)^3, s = |x - x_p| / R), with R = 2 dx and
 //              r = R / 4: the kernel-weighted mean depth of a half ball is 0.246 R in 3D and
 //              0.259 R in 2D, so a flat, evenly filled layer gets its surface on its top.
-#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -23,6 +22,7 @@
 #include "msim/core/grid.hpp"
 #include "msim/core/mac_grid.hpp"
 #include "msim/core/transfer.hpp"
+#include "msim/numerics/pressure/projection.hpp"
 
 namespace msim::fluid {
 
@@ -34,12 +34,11 @@ class FlipParticles {
 
   // Fills the cells with phi < 0 (and no solid) with jittered particles at the grid's velocity.
   void seed(const Grid<float, D>& phi, const Grid<float, D>& solid, const MacGrid<D>& velocity);
-  // Particles that cross a side marked open in openSides[axis][0 = lower, 1 = upper] leave the
-  // liquid (are deleted); the other sides hold them in. solidDistance: the obstacles' signed
-  // distance (any sample layout, negative inside), or null without obstacles; solid: the cells
-  // counted as solid (> 0.5).
+  // Particles that cross an open side of the domain leave the liquid (are deleted); walls hold
+  // them in. solidDistance: the obstacles' signed distance (any sample layout, negative inside),
+  // or null without obstacles; solid: the cells counted as solid (> 0.5).
   void advect(const MacGrid<D>& velocity, double dt, const Grid<float, D>* solidDistance, const Grid<float, D>& solid,
-              const std::array<std::array<bool, 2>, D>& openSides = {});
+              const numerics::DomainSides<D>& sides = {});
   void toGrid(MacGrid<D>& velocity);
   void fromGrid(const MacGrid<D>& updated, const MacGrid<D>& before, double flipRatio);
   // phi (cell-centred) from the particles; cells far from any particle get +band, cells deep in

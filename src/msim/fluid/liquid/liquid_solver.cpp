@@ -37,7 +37,6 @@ LiquidSolver<D>::LiquidSolver(const GridSpec<D>& spec, const LiquidParams<D>& pa
     const auto& u = velocity_.component(a);
     facePhi_[a] = Grid<float, D>(spec, u.size(), u.offset());
     known_[a].assign(u.count(), 0);
-    for (int side = 0; side < 2; ++side) openSides_[a][side] = params.sides.side[a][side] == numerics::DomainSide::Open;
   }
 }
 
@@ -198,7 +197,7 @@ double LiquidSolver<D>::openSideOutflow(double dt) const {
     layerSize[a] = 1;
     const auto& u = velocity_.component(a);
     for (int side = 0; side < 2; ++side) {
-      if (!openSides_[a][side]) continue;
+      if (params_.sides.side[a][side] != numerics::DomainSide::Open) continue;
       const double outward = side == 0 ? -1.0 : 1.0;
       std::size_t faces = 1;
       for (int b = 0; b < D; ++b) faces *= static_cast<std::size_t>(layerSize[b]);
@@ -219,7 +218,7 @@ double LiquidSolver<D>::openSideOutflow(double dt) const {
 template <int D>
 double LiquidSolver<D>::volumeControlDivergence(double dt) {
   if (!params_.volumeControl) return 0.0;
-  const double volume = numerics::enclosedVolume(phi_, &solid_);
+  const double volume = volume_;
   if (params_.tracker == InterfaceTracker::Flip) {
     // FLIP's liquid is its particles: the target is their count, scaled by the ratio of the
     // rebuilt surface's volume to theirs when the control first saw them (the reconstruction's
@@ -285,7 +284,7 @@ void LiquidSolver<D>::moveSurface(double dt) {
 template <int D>
 void LiquidSolver<D>::moveFlipSurface(double dt) {
   ScopedStage s(timers_, "liquid: surface");
-  flip_.advect(velocity_, dt, solidDistance_ ? &*solidDistance_ : nullptr, solid_, openSides_);
+  flip_.advect(velocity_, dt, solidDistance_ ? &*solidDistance_ : nullptr, solid_, params_.sides);
   flip_.surface(phi_, params_.bandCells);
   reinitialize();
 }
@@ -349,6 +348,7 @@ void LiquidSolver<D>::step(double dt) {
       pressurePhi_[i] = solid_[i] > 0.5f ? std::max(phi_[i], static_cast<float>(0.5 * spec_.dx)) : phi_[i];
     });
     projection_.setFreeSurface(pressurePhi_);
+    volume_ = numerics::enclosedVolume(phi_, &solid_);  // phi is final for this step from here on
     controlDivergence_ = volumeControlDivergence(dt);
     projection_.setTargetDivergence(controlDivergence_);
     lastSolve_ = projection_.project(velocity_, dt, params_.density);

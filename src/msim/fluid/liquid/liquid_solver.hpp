@@ -31,7 +31,6 @@
 // placed again before every step with the velocity of the solid on every face, which the pressure
 // uses as the boundary condition (the solid pushes the liquid through its faces' closed parts). Storage
 // is float, reductions double; the work arrays live in the object.
-#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -143,6 +142,9 @@ class LiquidSolver {
   int advance(double dt);
 
   LiquidStatistics statistics() const;
+  // The liquid's volume at the end of the last step [m^3] (measured once its surface had moved;
+  // the rest of a step leaves phi as it is).
+  double volume() const { return volume_; }
   const Grid<float, D>& phi() const { return phi_; }
   const MacGrid<D>& velocity() const { return velocity_; }
   MacGrid<D>& velocity() { return velocity_; }
@@ -198,11 +200,11 @@ class LiquidSolver {
   std::array<std::vector<std::uint8_t>, D> known_;     // per face: value given (extension)
   numerics::PcgStats lastSolve_;
   std::size_t lastEscaped_ = 0;
+  double volume_ = 0.0;
   double targetVolume_ = 0.0, volumeErrorIntegral_ = 0.0, controlDivergence_ = 0.0;
   double lastVolumeError_ = 0.0, leakRate_ = 0.0;
   double flipVolumeScale_ = 0.0;  // FLIP: rebuilt surface volume per particle volume (0: not yet seen)
   bool controlStarted_ = false;
-  std::array<std::array<bool, 2>, D> openSides_{};  // params.sides: [axis][lower, upper] open
   bool started_ = false;
   long steps_ = 0;
   std::uint64_t emissions_ = 0;  // emit() calls so far (new random streams each)

@@ -152,33 +152,11 @@ void ParticleLevelSet<D>::adjustRadii(const Grid<float, D>& phi) {
 }
 
 template <int D>
-void ParticleLevelSet<D>::reseed(const Grid<float, D>& phi) {
-  ++round_;
-  const float band = static_cast<float>(settings_.bandCells * spec_.dx);
-  std::size_t kept = 0;
-  std::vector<int> count(phi.count(), 0);
-  for (std::size_t p = 0; p < positions_.size(); ++p) {
-    const float value = sampleLinear<D>(phi, positions_[p]);
-    if (std::abs(value) > band) continue;
-    if (settings_.deleteEscapedOnReseed && signs_[p] * value < -radii_[p]) continue;
-    positions_[kept] = positions_[p];
-    radii_[kept] = radii_[p];
-    signs_[kept] = signs_[p];
-    ++count[spec_.clampedCellIndex(positions_[kept])];
-    ++kept;
-  }
-  positions_.resize(kept);
-  radii_.resize(kept);
-  signs_.resize(kept);
-  for (std::size_t i = 0; i < phi.count(); ++i)
-    if (std::abs(phi[i]) < band && count[i] < perCell_) seedCell(phi, phi.coord(i), perCell_ - count[i], i);
-}
-
-template <int D>
-std::size_t ParticleLevelSet<D>::removeInside(const Grid<float, D>& region) {
+template <typename Keep>
+std::size_t ParticleLevelSet<D>::keepIf(Keep&& keep) {
   std::size_t kept = 0;
   for (std::size_t p = 0; p < positions_.size(); ++p) {
-    if (sampleLinear<D>(region, positions_[p]) < 0.0f) continue;
+    if (!keep(p)) continue;
     positions_[kept] = positions_[p];
     radii_[kept] = radii_[p];
     signs_[kept] = signs_[p];
@@ -189,6 +167,26 @@ std::size_t ParticleLevelSet<D>::removeInside(const Grid<float, D>& region) {
   radii_.resize(kept);
   signs_.resize(kept);
   return removed;
+}
+
+template <int D>
+void ParticleLevelSet<D>::reseed(const Grid<float, D>& phi) {
+  ++round_;
+  const float band = static_cast<float>(settings_.bandCells * spec_.dx);
+  keepIf([&](std::size_t p) {
+    const float value = sampleLinear<D>(phi, positions_[p]);
+    return std::abs(value) <= band && !(settings_.deleteEscapedOnReseed && signs_[p] * value < -radii_[p]);
+  });
+  std::vector<int>& count = cellCount_;
+  count.assign(phi.count(), 0);
+  for (const Vec<D>& x : positions_) ++count[spec_.clampedCellIndex(x)];
+  for (std::size_t i = 0; i < phi.count(); ++i)
+    if (std::abs(phi[i]) < band && count[i] < perCell_) seedCell(phi, phi.coord(i), perCell_ - count[i], i);
+}
+
+template <int D>
+std::size_t ParticleLevelSet<D>::removeInside(const Grid<float, D>& region) {
+  return keepIf([&](std::size_t p) { return !(sampleLinear<D>(region, positions_[p]) < 0.0f); });
 }
 
 template class ParticleLevelSet<2>;

@@ -81,6 +81,9 @@ class ParticleLevelSet {
   int particlesPerCell() const { return perCell_; }
 
  private:
+  // Keeps the particles p with keep(p) (order kept); returns how many went.
+  template <typename Keep>
+  std::size_t keepIf(Keep&& keep);
   // Appends up to `count` particles in cell c (random stream `stream`), attracted to phi.
   void seedCell(const Grid<float, D>& phi, const IVec<D>& c, int count, std::uint64_t stream);
 
@@ -93,6 +96,7 @@ class ParticleLevelSet {
   std::vector<std::int8_t> signs_;
   // correct()'s work storage, kept so that steady stepping allocates nothing.
   mutable std::vector<std::size_t> escaped_;
+  std::vector<int> cellCount_;  // reseed()'s particles per cell
   mutable Grid<float, D> plus_, minus_;
 };
 
