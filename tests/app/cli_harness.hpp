@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 namespace fs = std::filesystem;
 
 // inline: each test file uses only some of these.
@@ -18,6 +20,12 @@ struct Result {
   int exitCode = -1;
   std::string output;  // stdout and stderr
 };
+
+// A JSON file a run wrote (run.json).
+inline nlohmann::json readJson(const fs::path& file) {
+  std::ifstream in(file);
+  return nlohmann::json::parse(in);
+}
 
 inline fs::path scratch(const std::string& name) {
   const fs::path dir = fs::path(MSIM_TEST_TMP) / "app" / name;

@@ -13,11 +13,6 @@ namespace {
 
 using nlohmann::json;
 
-json readJson(const fs::path& file) {
-  std::ifstream in(file);
-  return json::parse(in);
-}
-
 json runScene(const std::string& name, const std::string& sceneFile, const std::string& extra) {
   const fs::path dir = scratch(name);
   const Result r = runMsim("run " + sceneFile + " -q --out " + (dir / "out").string() + " " + extra);

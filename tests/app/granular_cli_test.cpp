@@ -14,11 +14,6 @@ namespace {
 
 using nlohmann::json;
 
-json readJson(const fs::path& file) {
-  std::ifstream in(file);
-  return json::parse(in);
-}
-
 // 12 x 10 x 12 cells of 5 cm: a slab of sand with a ball dropped on it. `extra` adds keys.
 std::string tinyScene(const std::string& extra = "") {
   return R"({

@@ -20,11 +20,6 @@ namespace {
 using nlohmann::json;
 using namespace msim;
 
-json readJson(const fs::path& file) {
-  std::ifstream in(file);
-  return json::parse(in);
-}
-
 // 16 x 8 x 8 cells of 5 cm in a closed tank, a block of water at one end.
 std::string tinyScene(const std::string& tracker, const std::string& extra = "") {
   return R"({

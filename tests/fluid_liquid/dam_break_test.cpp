@@ -27,6 +27,7 @@
 #include <cmath>
 #include <vector>
 
+#include "../cell_field.hpp"
 #include "msim/fluid/liquid/liquid_solver.hpp"
 
 using namespace msim;
@@ -55,12 +56,8 @@ std::vector<double> frontPositions(double heightRatio, const std::vector<Sample>
   LiquidParams<2> params;
   params.tracker = tracker;
   LiquidSolver<2> solver(spec, params);
-  Grid<float, 2> column(spec);
-  for (std::size_t i = 0; i < column.count(); ++i) {
-    const Vec2 x = column.position(column.coord(i));
-    column[i] = static_cast<float>(std::max(x[0] - a, x[1] - heightRatio * a));  // the box [0,a] x [0, n^2 a]
-  }
-  solver.addLiquid(column);
+  // The box [0, a] x [0, n^2 a].
+  solver.addLiquid(test::cellField<2>(spec, [&](const Vec2& x) { return std::max(x[0] - a, x[1] - heightRatio * a); }));
   const double timeScale = std::sqrt(2.0 * g / a);
   std::vector<double> fronts;
   double t = 0.0;

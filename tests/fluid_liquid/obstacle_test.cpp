@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "../cell_field.hpp"
 #include "msim/fluid/liquid/liquid_solver.hpp"
 #include "msim/numerics/level_set/level_set_measures.hpp"
 #include "msim/numerics/pressure/face_fractions.hpp"
@@ -40,9 +41,7 @@ Outcome pushThePlate(InterfaceTracker tracker, bool volumeControl) {
     solver.setObstacleVelocity(v);
   };
   place(0.0);
-  Grid<float, 2> pool(spec);
-  for (std::size_t i = 0; i < pool.count(); ++i) pool[i] = static_cast<float>(pool.position(pool.coord(i))[1] - 0.4);
-  solver.addLiquid(pool);
+  solver.addLiquid(test::cellField<2>(spec, [](const Vec2& x) { return x[1] - 0.4; }));
   auto area = [&] { return numerics::enclosedVolume(solver.phi(), &solver.solid()); };
   const double dt = 1.0 / 120.0;
   solver.step(dt);
@@ -112,12 +111,9 @@ double largestAreaChange(InterfaceTracker tracker, bool obstacleTank) {
     solver.setObstacles(numerics::sampleNodes<2>(spec, [&](const Vec2& x) {
       return std::min({x[1] - wall, x[0] - wall, 1.0 - wall - x[0]});
     }));
-  Grid<float, 2> column(spec);
-  for (std::size_t i = 0; i < column.count(); ++i) {
-    const Vec2 x = column.position(column.coord(i));
-    column[i] = static_cast<float>(std::max({wall - x[0], x[0] - 0.425, wall - x[1], x[1] - 0.625}));
-  }
-  solver.addLiquid(column);
+  solver.addLiquid(test::cellField<2>(spec, [&](const Vec2& x) {
+    return std::max({wall - x[0], x[0] - 0.425, wall - x[1], x[1] - 0.625});
+  }));
   auto area = [&] { return numerics::enclosedVolume(solver.phi(), &solver.solid()); };
   solver.step(1.0 / 120.0);
   const double start = area();

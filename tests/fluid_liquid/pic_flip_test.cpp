@@ -5,6 +5,7 @@
 
 #include <algorithm>
 
+#include "../cell_field.hpp"
 #include "msim/fluid/liquid/liquid_solver.hpp"
 
 using namespace msim;
@@ -23,12 +24,7 @@ Outcome damBreakAt048(double flipRatio) {
   params.tracker = InterfaceTracker::Flip;
   params.flipRatio = flipRatio;
   LiquidSolver<2> solver(spec, params);
-  Grid<float, 2> column(spec);
-  for (std::size_t i = 0; i < column.count(); ++i) {
-    const Vec2 x = column.position(column.coord(i));
-    column[i] = static_cast<float>(std::max(x[0] - 0.3, x[1] - 0.45));
-  }
-  solver.addLiquid(column);
+  solver.addLiquid(test::cellField<2>(spec, [](const Vec2& x) { return std::max(x[0] - 0.3, x[1] - 0.45); }));
   double t = 0.0;
   while (0.48 - t > 1e-9) {
     const double dt = std::min(0.48 - t, solver.cflTimestep());

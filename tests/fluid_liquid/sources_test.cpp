@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "../cell_field.hpp"
 #include "msim/fluid/liquid/liquid_solver.hpp"
 #include "msim/numerics/level_set/level_set_measures.hpp"
 
@@ -20,12 +21,9 @@ namespace {
 GridSpec<2> unitSquare(int n) { return GridSpec<2>(Vec2::Zero(), 1.0 / n, IVec2(n, n)); }
 
 Grid<float, 2> box(const GridSpec<2>& spec, const Vec2& lo, const Vec2& hi) {
-  Grid<float, 2> phi(spec);
-  for (std::size_t i = 0; i < phi.count(); ++i) {
-    const Vec2 x = phi.position(phi.coord(i));
-    phi[i] = static_cast<float>(std::max({lo[0] - x[0], x[0] - hi[0], lo[1] - x[1], x[1] - hi[1]}));
-  }
-  return phi;
+  return test::cellField<2>(spec, [&](const Vec2& x) {
+    return std::max({lo[0] - x[0], x[0] - hi[0], lo[1] - x[1], x[1] - hi[1]});
+  });
 }
 
 double volumeOf(const LiquidSolver<2>& solver) { return numerics::enclosedVolume(solver.phi(), &solver.solid()); }

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "../sanitizer_build.hpp"
+#include "../cell_field.hpp"
 #include "msim/fluid/liquid/liquid_solver.hpp"
 
 using namespace msim;
@@ -21,9 +22,7 @@ void stillTank(int n, int steps, InterfaceTracker tracker = InterfaceTracker::Pa
   LiquidParams<D> params;
   params.tracker = tracker;
   LiquidSolver<D> solver(spec, params);
-  Grid<float, D> water(spec);
-  for (std::size_t i = 0; i < water.count(); ++i) water[i] = static_cast<float>(water.position(water.coord(i))[1] - h);
-  solver.addLiquid(water);
+  solver.addLiquid(test::cellField<D>(spec, [&](const Vec<D>& x) { return x[1] - h; }));
   const double dt = 1.0 / 120.0;
   solver.step(dt);
   const double volume0 = solver.statistics().volume;
@@ -70,12 +69,7 @@ TEST(LiquidStillWater, PoolFilledToTheWallsStaysStill) {
   const GridSpec<2> spec(Vec2::Zero(), 1.0 / n, IVec2(n, n));
   const double h = 0.41, g = 9.81;
   LiquidSolver<2> solver(spec, LiquidParams<2>{});
-  Grid<float, 2> pool(spec);
-  for (std::size_t i = 0; i < pool.count(); ++i) {
-    const Vec2 x = pool.position(pool.coord(i));
-    pool[i] = static_cast<float>(std::max({-x[0], x[0] - 1.0, -x[1], x[1] - h}));
-  }
-  solver.addLiquid(pool);
+  solver.addLiquid(test::cellField<2>(spec, [&](const Vec2& x) { return std::max({-x[0], x[0] - 1.0, -x[1], x[1] - h}); }));
   for (int s = 0; s < 48; ++s) solver.step(1.0 / 24.0);
   EXPECT_LT(solver.statistics().maxSpeed, 1e-3 * std::sqrt(g * h));
 }

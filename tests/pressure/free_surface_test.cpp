@@ -7,6 +7,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "../cell_field.hpp"
 #include "msim/core/rng.hpp"
 #include "msim/numerics/pressure/projection.hpp"
 
@@ -18,13 +19,6 @@ namespace {
 template <int D>
 GridSpec<D> unitBox(int n) {
   return GridSpec<D>(Vec<D>::Zero(), 1.0 / n, IVec<D>::Constant(n));
-}
-
-template <int D>
-Grid<float, D> cellPhi(const GridSpec<D>& spec, auto&& f) {
-  Grid<float, D> phi(spec);
-  for (std::size_t i = 0; i < phi.count(); ++i) phi[i] = static_cast<float>(f(phi.position(phi.coord(i))));
-  return phi;
 }
 
 ProjectionSettings tightSettings() {
@@ -39,7 +33,7 @@ void hydrostaticTank(int n) {
   const GridSpec<D> spec = unitBox<D>(n);
   const double h = 0.3 + 0.37 * spec.dx, g = 9.81, rho = 1000.0, dt = 0.01;
   PressureProjection<D> projection(spec, DomainSides<D>::allWalls(), tightSettings());
-  const Grid<float, D> phi = cellPhi<D>(spec, [&](const Vec<D>& x) { return x[1] - h; });
+  const Grid<float, D> phi = test::cellField<D>(spec, [&](const Vec<D>& x) { return x[1] - h; });
   projection.setFreeSurface(phi);
   MacGrid<D> u(spec);
   u.component(1).fill(static_cast<float>(-g * dt));  // one step of gravity from rest
@@ -79,7 +73,7 @@ double discPressureError(int n) {
   const Vec2 centre(0.52, 0.49);
   const double radius = 0.31;
   PressureProjection<2> projection(spec, DomainSides<2>::allWalls(), tightSettings());
-  const Grid<float, 2> phi = cellPhi<2>(spec, [&](const Vec2& x) { return (x - centre).norm() - radius; });
+  const Grid<float, 2> phi = test::cellField<2>(spec, [&](const Vec2& x) { return (x - centre).norm() - radius; });
   projection.setFreeSurface(phi);
   MacGrid<2> u(spec);
   for (int a = 0; a < 2; ++a) {
@@ -117,7 +111,7 @@ TEST(FreeSurfaceProjection, MultigridWithDirichletCellsAgreesWithMic0InFewerIter
   // same pressure; the multigrid hierarchy, which carries the surface's Dirichlet terms down its
   // levels, needs fewer iterations.
   const GridSpec<2> spec = unitBox<2>(128);
-  const Grid<float, 2> phi = cellPhi<2>(spec, [](const Vec2& x) { return x[1] - 0.5 - 0.05 * std::sin(12.0 * x[0]); });
+  const Grid<float, 2> phi = test::cellField<2>(spec, [](const Vec2& x) { return x[1] - 0.5 - 0.05 * std::sin(12.0 * x[0]); });
   auto solve = [&](PressurePreconditioner preconditioner, int& iterations) {
     ProjectionSettings s = tightSettings();
     s.preconditioner = preconditioner;
@@ -172,7 +166,7 @@ TEST(FreeSurfaceProjection, LiquidCellsKeepTheTargetDivergence) {
   const GridSpec<2> spec = unitBox<2>(32);
   const double c = 0.05, h = 0.4 + 0.3 * spec.dx;
   PressureProjection<2> projection(spec, DomainSides<2>::allWalls(), tightSettings());
-  const Grid<float, 2> phi = cellPhi<2>(spec, [&](const Vec2& x) { return x[1] - h; });
+  const Grid<float, 2> phi = test::cellField<2>(spec, [&](const Vec2& x) { return x[1] - h; });
   projection.setFreeSurface(phi);
   projection.setTargetDivergence(c);
   MacGrid<2> u(spec);
