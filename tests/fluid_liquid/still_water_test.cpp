@@ -63,13 +63,22 @@ TEST(LiquidStillWater, FlipTankStaysStill2D) { stillTank<2>(40, 500, InterfaceTr
 // A pool given as a box that reaches exactly to the tank's walls (as scenes write it): the walls
 // are not a surface of the liquid. Its distance field kinks there (at the wall cells the wall is
 // nearer than the water's surface), which left alone tilts the surface by 0.06 dx at the walls and
-// sets a 2D 32^2 tank sloshing at 0.015 m/s.
-TEST(LiquidStillWater, PoolFilledToTheWallsStaysStill) {
-  const int n = 32;
-  const GridSpec<2> spec(Vec2::Zero(), 1.0 / n, IVec2(n, n));
+// sets a 32^2 tank sloshing at 0.015 m/s and a 32^3 one, with its edges and corners, at 0.033 m/s.
+template <int D>
+void poolFilledToTheWalls(int n) {
+  const GridSpec<D> spec(Vec<D>::Zero(), 1.0 / n, IVec<D>::Constant(n));
   const double h = 0.41, g = 9.81;
-  LiquidSolver<2> solver(spec, LiquidParams<2>{});
-  solver.addLiquid(test::cellField<2>(spec, [&](const Vec2& x) { return std::max({-x[0], x[0] - 1.0, -x[1], x[1] - h}); }));
+  LiquidSolver<D> solver(spec, LiquidParams<D>{});
+  solver.addLiquid(test::cellField<D>(spec, [&](const Vec<D>& x) {
+    double d = x[1] - h;  // the box [0,1]^D up to h, walls included
+    for (int a = 0; a < D; ++a) d = std::max({d, -x[a], a == 1 ? d : x[a] - 1.0});
+    return d;
+  }));
   for (int s = 0; s < 48; ++s) solver.step(1.0 / 24.0);
   EXPECT_LT(solver.statistics().maxSpeed, 1e-3 * std::sqrt(g * h));
+}
+
+TEST(LiquidStillWater, PoolFilledToTheWallsStaysStill) {
+  poolFilledToTheWalls<2>(32);
+  poolFilledToTheWalls<3>(test::fullOrSanitized(32, 16));
 }

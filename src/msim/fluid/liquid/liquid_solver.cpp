@@ -78,15 +78,16 @@ void LiquidSolver<D>::addLiquid(const Grid<float, D>& cellPhi, const Vec<D>& vel
   // The domain's sides are no surface of the liquid: a body that reaches a side (a pool filled to
   // the tank's walls) has a distance that kinks in the cells next to it, where the side is nearer
   // than the free surface. Those cells take the depth of their inner neighbour when it is deeper
-  // (a zero normal derivative at the wall), or the surface would start tilted there.
+  // (a zero normal derivative at the wall), or the surface would start tilted there; axis by axis,
+  // each pass reading the last one's values, so cells along an edge or in a corner get it too.
   Grid<float, D> body = cellPhi;
   for (int a = 0; a < D; ++a) {
-    if (spec_.res[a] < 2) continue;
+    if (spec_.res[a] < 3) continue;  // the inner neighbours must not be side cells themselves
     parallelForCells(body, [&](const IVec<D>& c, std::size_t i) {
       if (c[a] != 0 && c[a] != spec_.res[a] - 1) return;
       IVec<D> inner = c;
       inner[a] += c[a] == 0 ? 1 : -1;
-      if (body[i] < 0.0f) body[i] = std::min(body[i], cellPhi(inner));
+      if (body[i] < 0.0f) body[i] = std::min(body[i], body(inner));
     });
   }
   for (std::size_t i = 0; i < phi_.count(); ++i) phi_[i] = std::min(phi_[i], body[i]);
