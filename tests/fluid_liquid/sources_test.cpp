@@ -2,7 +2,8 @@
 // cross-section per second (measured +20% with the particle level set, +16% with FLIP at 64^2;
 // imposing the hose's velocity again after the pressure solve leaves the excess as it is, so it is
 // not the step's gravity), a drain empties a tank of what it holds, and FLIP particles that leave
-// through an open side are gone (volume control follows all three, so the liquid neither swells
+// through an open side are gone; an emitter under water against a wall lets liquid in through
+// the wall at its velocity (v h per second in 2D) (volume control follows all three, so the liquid neither swells
 // nor shrinks to make up for them).
 #include <gtest/gtest.h>
 
@@ -49,7 +50,41 @@ double hoseVolumeRatio(InterfaceTracker tracker) {
   return volumeOf(solver) / (hoseVolume + 1.0 * area * 0.5);
 }
 
+// An inflow under water against the left wall of a closed tank filled 0.4 deep: the emitter's
+// region is full of liquid from the start, so only its wall lets liquid in; after 0.5 s the tank
+// holds the start plus v h t.
+double submergedInflowRatio(InterfaceTracker tracker) {
+  const GridSpec<2> spec = unitSquare(64);
+  LiquidParams<2> params;
+  params.tracker = tracker;
+  LiquidSolver<2> solver(spec, params);
+  solver.addLiquid(box(spec, Vec2(-1, -1), Vec2(2, 0.4)));
+  solver.step(1.0 / 120.0);
+  const double start = volumeOf(solver);
+  const Grid<float, 2> inlet = box(spec, Vec2(-1, -1), Vec2(2.0 / 64, 0.25));  // 0.25 m of the wall
+  const Vec2 velocity(0.5, 0.0);
+  double t = 0.0;
+  while (0.5 - t > 1e-9) {
+    solver.emit(inlet, velocity);
+    const double dt = std::min({0.5 - t, solver.cflTimestep(), 1.0 / 120.0});
+    solver.step(dt);
+    t += dt;
+  }
+  return (volumeOf(solver) - start) / (0.5 * 0.25 * 0.5);
+}
+
 }  // namespace
+
+TEST(LiquidSources, SubmergedInflowAgainstAWallDeliversVelocityTimesHeight) {
+  for (const InterfaceTracker tracker : {InterfaceTracker::ParticleLevelSet, InterfaceTracker::Flip}) {
+    const double ratio = submergedInflowRatio(tracker);
+    RecordProperty(tracker == InterfaceTracker::Flip ? "flip_ratio" : "pls_ratio", std::to_string(ratio));
+    // Measured -1.7% (particle level set) and +17% (FLIP, whose refills at half-empty cells
+    // over-deliver as the hose's do).
+    EXPECT_NEAR(ratio, 1.0, tracker == InterfaceTracker::Flip ? 0.2 : 0.05)
+        << (tracker == InterfaceTracker::Flip ? "FLIP" : "particle level set");
+  }
+}
 
 TEST(LiquidSources, HoseDeliversVelocityTimesCrossSection) {
   for (const InterfaceTracker tracker : {InterfaceTracker::ParticleLevelSet, InterfaceTracker::Flip}) {

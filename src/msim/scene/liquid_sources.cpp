@@ -16,7 +16,9 @@
 namespace msim::scene {
 
 void declareLiquidSources(Schema& root) {
-  Schema source = Schema::object("an emitter: liquid fills its shape every step and leaves it at its velocity");
+  Schema source = Schema::object(
+      "an emitter: liquid fills its shape every step and leaves it at its velocity; against a closed side the side "
+      "lets it in there (an inflow)");
   source.field("shape", shapeSchema());
   source.vector("velocity", "m/s", {0.0, 0.0, 0.0}, "velocity of the emitted liquid").lengths({2, 3});
   source.vector("motion", "m/s", {0.0, 0.0, 0.0},

@@ -115,11 +115,38 @@ double LiquidSolver<D>::emit(const Grid<float, D>& region, const Vec<D>& velocit
         u[lin] = static_cast<float>(velocity[a]);
     });
   }
+  markWallInflow(region, velocity);
   if (params_.tracker == InterfaceTracker::Flip)  // the particles are the liquid (phi is rebuilt from them)
     return flip_.particleVolume() * double(flip_.emit(region, solid_, velocity.template cast<float>(), ++emissions_));
   return editLevelSet(region, [&](std::size_t i) {
     if (solid_[i] <= 0.5f) phi_[i] = std::min(phi_[i], region[i]);
   });
+}
+
+template <int D>
+void LiquidSolver<D>::markWallInflow(const Grid<float, D>& region, const Vec<D>& velocity) {
+  // Where the region lies against a wall and its velocity points into the domain, the wall's faces
+  // there let the liquid in: the pressure then pushes the liquid in front of the emitter on at its
+  // velocity (a region already full of liquid would otherwise add nothing: the projection would
+  // hold the liquid in it still against the closed wall). Cleared after the step.
+  for (int a = 0; a < D; ++a)
+    for (int side = 0; side < 2; ++side) {
+      if (params_.sides.side[a][side] != numerics::DomainSide::Wall) continue;
+      const double inward = side == 0 ? velocity[a] : -velocity[a];
+      if (!(inward > 0.0)) continue;
+      if (!wallInflow_) wallInflow_.emplace(spec_, 0.0f);
+      auto& u = wallInflow_->component(a);
+      parallelForCells(u, [&](const IVec<D>& f, std::size_t lin) {
+        if (f[a] != (side == 0 ? 0 : spec_.res[a])) return;
+        IVec<D> cell = f;
+        if (side == 1) cell[a] -= 1;
+        const std::size_t i = region.index(cell);
+        if (region[i] < 0.0f && solid_[i] <= 0.5f) {
+          u[lin] = static_cast<float>(velocity[a]);
+          inflowThisStep_ = true;
+        }
+      });
+    }
 }
 
 template <int D>
@@ -188,7 +215,7 @@ void LiquidSolver<D>::start() {
 }
 
 template <int D>
-double LiquidSolver<D>::openSideOutflow(double dt) const {
+double LiquidSolver<D>::boundaryOutflow(double dt) const {
   double outflow = 0.0;
   const double faceArea = spec_.cellVolume() / spec_.dx;
   for (int a = 0; a < D; ++a) {
@@ -198,7 +225,6 @@ double LiquidSolver<D>::openSideOutflow(double dt) const {
     layerSize[a] = 1;
     const auto& u = velocity_.component(a);
     for (int side = 0; side < 2; ++side) {
-      if (params_.sides.side[a][side] != numerics::DomainSide::Open) continue;
       const double outward = side == 0 ? -1.0 : 1.0;
       std::size_t faces = 1;
       for (int b = 0; b < D; ++b) faces *= static_cast<std::size_t>(layerSize[b]);
@@ -320,7 +346,7 @@ void LiquidSolver<D>::step(double dt) {
   if (!(dt > 0.0) || !std::isfinite(dt)) throw std::invalid_argument(fmt::format("liquid solver: step of {} s", dt));
   if (!started_) start();
   const bool flip = params_.tracker == InterfaceTracker::Flip;
-  if (params_.volumeControl && !flip) targetVolume_ = std::max(0.0, targetVolume_ - openSideOutflow(dt));
+  if (params_.volumeControl && !flip) targetVolume_ = std::max(0.0, targetVolume_ - boundaryOutflow(dt));
   if (flip) {
     moveFlipSurface(dt);
     {
@@ -352,12 +378,18 @@ void LiquidSolver<D>::step(double dt) {
     volume_ = numerics::enclosedVolume(phi_, &solid_);  // phi is final for this step from here on
     controlDivergence_ = volumeControlDivergence(dt);
     projection_.setTargetDivergence(controlDivergence_);
+    if (inflowThisStep_ || inflowApplied_) projection_.setWallFaceVelocity(inflowThisStep_ ? &*wallInflow_ : nullptr);
+    inflowApplied_ = inflowThisStep_;
     lastSolve_ = projection_.project(velocity_, dt, params_.density);
   }
   extendVelocity();
   if (flip) {
     ScopedStage s(timers_, "liquid: grid to particles");
     flip_.fromGrid(velocity_, gridVelocityBefore_, params_.flipRatio);
+  }
+  if (inflowThisStep_) {  // the emitters mark their wall faces again before the next step
+    for (int a = 0; a < D; ++a) wallInflow_->component(a).fill(0.0f);
+    inflowThisStep_ = false;
   }
   ++steps_;
 }

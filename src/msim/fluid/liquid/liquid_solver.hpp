@@ -123,7 +123,8 @@ class LiquidSolver {
 
   // An emitter (call between steps): liquid fills the cells where region < 0 (outside solids) and
   // the faces touching them move at `velocity`; with FLIP the particles there take the velocity
-  // and the cells are topped up with new ones. A sink: the liquid where region < 0 is removed.
+  // and the cells are topped up with new ones. Where the region lies against a closed side, the
+  // side's faces there let the liquid in at `velocity` for the next step (an inflow). A sink: the liquid where region < 0 is removed.
   // Volume control's target follows both. Each returns the volume it added or removed [m^3].
   double emit(const Grid<float, D>& region, const Vec<D>& velocity);
   double drain(const Grid<float, D>& region);
@@ -168,8 +169,11 @@ class LiquidSolver {
   void extendVelocity();
   // phi continued into the obstacles (intoSolids_), then fast marching.
   void reinitialize();
-  // Liquid volume [m^3] that leaves through open domain sides in dt at the current velocity.
-  double openSideOutflow(double dt) const;
+  // Liquid volume [m^3] that leaves through the domain's sides in dt at the current velocity: open
+  // sides, and walls (negative: their faces that emitters let liquid in through).
+  double boundaryOutflow(double dt) const;
+  // An emitter against a wall: the wall's faces under it get its velocity (see emit).
+  void markWallInflow(const Grid<float, D>& region, const Vec<D>& velocity);
   // Kim et al.'s divergence for the volume just measured after the surface moved (0 when off).
   double volumeControlDivergence(double dt);
   // Volume control starts afresh from the volume phi holds now.
@@ -208,6 +212,8 @@ class LiquidSolver {
   bool started_ = false;
   long steps_ = 0;
   std::uint64_t emissions_ = 0;  // emit() calls so far (new random streams each)
+  std::optional<MacGrid<D>> wallInflow_;  // emitters' wall faces (markWallInflow), this step
+  bool inflowThisStep_ = false, inflowApplied_ = false;  // set by emit(); in the projection
   StageTimers timers_;
 };
 

@@ -129,6 +129,15 @@ void PressureProjection<D>::setWallNormalVelocity(int axis, int side, double vel
 }
 
 template <int D>
+void PressureProjection<D>::setWallFaceVelocity(const MacGrid<D>* velocity) {
+  if (velocity)
+    wallFaceVelocity_ = *velocity;
+  else
+    wallFaceVelocity_.reset();
+  applyWallVelocities();
+}
+
+template <int D>
 void PressureProjection<D>::applyWallVelocities() {
   // A domain wall moves with its own normal velocity, whatever the obstacle velocity field says.
   for (int a = 0; a < D; ++a) {
@@ -136,7 +145,7 @@ void PressureProjection<D>::applyWallVelocities() {
     parallelForCells(us, [&](const IVec<D>& f, std::size_t lin) {
       for (int s = 0; s < 2; ++s)
         if (f[a] == (s == 0 ? 0 : spec_.res[a]) && sides_.side[a][s] == DomainSide::Wall)
-          us[lin] = wallNormalVelocity_[a][s];
+          us[lin] = wallNormalVelocity_[a][s] + (wallFaceVelocity_ ? wallFaceVelocity_->component(a)[lin] : 0.0f);
     });
   }
 }

@@ -14,6 +14,7 @@
 // divergence left over, so the tolerance bounds max |div u| relative to max |div u*|.
 #include <array>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "msim/core/grid.hpp"
@@ -70,6 +71,10 @@ class PressureProjection {
   // Neumann pressure condition (the wind tunnel of Selle ch. 2.9). Where every side is a wall the
   // caller must keep the net inflow zero, or no divergence-free field exists. Ignored on open sides.
   void setWallNormalVelocity(int axis, int side, double velocity);
+  // Normal velocity [m/s] through single faces of the walls, added to their wall's (an inflow
+  // over part of a side: a liquid's emitter against it); faces off the walls are ignored. Null:
+  // none.
+  void setWallFaceVelocity(const MacGrid<D>* velocity);
 
   // A free surface (liquids): cells with liquidPhi < 0 are liquid, the others air at pressure 0
   // with no unknown. Between a liquid cell i and an air neighbour j the surface lies at the
@@ -122,6 +127,7 @@ class PressureProjection {
 
   MacGrid<D> weights_;
   MacGrid<D> solidVelocity_;
+  std::optional<MacGrid<D>> wallFaceVelocity_;  // setWallFaceVelocity
   MacGrid<D> inverseTheta_;  // 1 / theta on liquid-air faces, 1 elsewhere; empty without a free surface
   MacGrid<D> coupling_;      // with a free surface: the weights between cells that have unknowns
   std::vector<float> dirichlet_;  // with a free surface: PoissonMatrix's Dirichlet terms
