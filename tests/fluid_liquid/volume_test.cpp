@@ -20,7 +20,8 @@ using namespace msim::fluid;
 
 namespace {
 
-// Largest |V(t) / V(0) - 1| over 4 s, sampled after every step.
+// Largest |V(t) / V(0) - 1| over 4 s, sampled after every step; V(0) is the exact volume (the
+// particle level set starts within 0.02% of it) or FLIP's first surface.
 double largestVolumeError(InterfaceTracker tracker, bool volumeControl) {
   const double dx = 1.0 / 30.0;
   const GridSpec<3> spec(Vec3::Zero(), dx, IVec3(48, 30, 18));
@@ -30,14 +31,19 @@ double largestVolumeError(InterfaceTracker tracker, bool volumeControl) {
   LiquidSolver<3> solver(spec, params);
   solver.addLiquid(test::cellField<3>(spec, [](const Vec3& x) { return std::max(x[0] - 0.4, x[1] - 0.5); }));
   const double exact = 0.4 * 0.5 * 0.6;
-  double worst = 0.0, t = 0.0;
+  double worst = 0.0, worstOfStart = 0.0, start = 0.0, t = 0.0;
   while (4.0 - t > 1e-9) {
     const double dt = std::min(4.0 - t, solver.cflTimestep());
     solver.step(dt);
     t += dt;
-    worst = std::max(worst, std::abs(numerics::enclosedVolume(solver.phi(), &solver.solid()) / exact - 1.0));
+    const double v = numerics::enclosedVolume(solver.phi(), &solver.solid());
+    if (start == 0.0) start = v;
+    worst = std::max(worst, std::abs(v / exact - 1.0));
+    worstOfStart = std::max(worstOfStart, std::abs(v / start - 1.0));
   }
-  return worst;
+  // FLIP's surface, rebuilt from its particles, starts 1.5% below the box (the reconstruction's
+  // bias, which volume control then holds): its volume is kept against its own start.
+  return tracker == InterfaceTracker::Flip ? worstOfStart : worst;
 }
 
 // Within `limit` with volume control, beyond it without (the control does the work).
@@ -51,8 +57,8 @@ void expectControlHolds(InterfaceTracker tracker, double limit) {
 
 }  // namespace
 
-TEST(LiquidVolume, ParticleLevelSetDamBreakKeepsItsVolumeWithinOneAndAHalfPercent) {
+TEST(LiquidVolume, ParticleLevelSetDamBreakKeepsItsVolume) {
   expectControlHolds(InterfaceTracker::ParticleLevelSet, 0.015);
 }
 
-TEST(LiquidVolume, FlipDamBreakKeepsItsVolumeWithinThreePercent) { expectControlHolds(InterfaceTracker::Flip, 0.03); }
+TEST(LiquidVolume, FlipDamBreakKeepsItsVolume) { expectControlHolds(InterfaceTracker::Flip, 0.022); }
