@@ -49,6 +49,8 @@ dam_break_2d        | preview | --frames 10
 dam_break_3d        | render  | --frames 10
 drop_into_pool      | render  | --frames 15
 wave_maker_2d       | preview | --frames 96
+pour_glass          | render  | --frames 30
+river_rapids        | render  | --frames 72
 "
 
 wanted=("$@")

@@ -1,7 +1,8 @@
 // The "liquid" phenomenon end to end: a tiny 3D dam break with either tracker writes its VDB
 // (liquid_phi as a level set, velocities, particles), surface mesh (PLY) and preview; --resume
 // continues it from the saved surface, velocity and particles; a moving obstacle runs; OBJ meshes on
-// request; bad input exits 2 naming the key.
+// request; sub-grid turbulence writes, resumes and renders its fine surface; bad input exits 2
+// naming the key.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -101,11 +102,47 @@ TEST(LiquidCli, ResumeContinuesFromTheSavedSurface) {
   }
 }
 
+TEST(LiquidCli, SubgridTurbulenceWritesTheFineSurfaceAndResumes) {
+  // liquid.turbulence: liquid_phi (meshed, previewed, rendered) is the fine surface, 4 x 4 x 4
+  // times the simulation's cells, liquid_sim_phi the simulation's; both hold the liquid's volume;
+  // --resume continues from them; the frame renders with the solids' distance resampled.
+  const fs::path dir = scratch("liquid_turbulence");
+  const std::string scene = replaced(
+      tinyScene("particle_level_set", R"(, "obstacles": [{"shape": {"type": "sphere", "center": [0.5, 0.0, 0.2], "radius": 0.08}}])"),
+      R"("tracker": "particle_level_set")", R"("tracker": "particle_level_set", "turbulence": {"enabled": true})");
+  writeText(dir / "s.json", replaced(scene, R"("duration": 0.1)", R"("duration": 0.15)"));
+  const std::string run = "run " + (dir / "s.json").string() + " -q --out " + (dir / "out").string();
+  const Result r = runMsim(run + " --frames 2");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  const fs::path out = dir / "out";
+  const io::VdbFile vdb(out / "vdb" / "tiny_0002.vdb", io::VdbProvenance::MsimRun);
+  const Grid<float, 3> fine = vdb.floatGrid("liquid_phi"), coarse = vdb.floatGrid("liquid_sim_phi");
+  EXPECT_EQ(fine.size(), IVec3(64, 32, 32));
+  EXPECT_EQ(coarse.size(), IVec3(16, 8, 8));
+  EXPECT_TRUE(vdb.hasGrid("turbulent_energy"));
+  const json last = readJson(out / "run.json").at("frames").back();
+  EXPECT_NEAR(last.at("fine_volume_m3").get<double>() / last.at("volume_m3").get<double>(), 1.0, 0.03);
+  for (const char* key : {"ripple_height_m", "turbulent_energy_integral", "noise_particles", "turbulence_band_fraction"})
+    EXPECT_TRUE(last.contains(key)) << key;
+  EXPECT_GT(io::readPlyMesh(out / "mesh" / "tiny_0002.ply").mesh.triangles.size(), 500u);  // the fine surface's
+  const Result resumed = runMsim(run + " --resume");
+  ASSERT_EQ(resumed.exitCode, 0) << resumed.output;
+  EXPECT_EQ(readJson(out / "run.json").at("frames").size(), 3u);
+  const Result rendered = runMsim("render " + out.string() + " --last -q --set render.camera.width=64 "
+                                  "--set render.camera.height=48 --out " + (dir / "render").string());
+  EXPECT_EQ(rendered.exitCode, 0) << rendered.output;
+  EXPECT_TRUE(fs::exists(dir / "render" / "tiny_0003.png"));
+}
+
 TEST(LiquidCli, BadInputNamesTheKey) {
   expectInputError("liquid_outside",
                    replaced(tinyScene("flip"), R"("min": [0, 0, 0], "max": [0.25, 0.3, 0.4])",
                             R"("min": [2, 2, 2], "max": [3, 3, 3])"),
                    {"initial_liquid[0].shape"});
+  expectInputError("liquid_turbulence_without_gravity",
+                   replaced(tinyScene("flip"), R"("tracker": "flip")",
+                            R"("tracker": "flip", "gravity": [0, 0, 0], "turbulence": {"enabled": true})"),
+                   {"liquid.turbulence", "gravity"});
   expectInputError("liquid_flip_ratio", replaced(tinyScene("flip"), R"("tracker": "flip")", R"("tracker": "flip", "flip_ratio": 1.5)"),
                    {"liquid.flip_ratio"});
   expectInputError("liquid_none", replaced(tinyScene("flip"), R"("initial_liquid": [{"shape": {"type": "box", "min": [0, 0, 0], "max": [0.25, 0.3, 0.4]}}])",

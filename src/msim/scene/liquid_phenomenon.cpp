@@ -11,6 +11,7 @@
 #include "msim/core/log.hpp"
 #include "msim/core/parallel.hpp"
 #include "msim/fluid/liquid/liquid_solver.hpp"
+#include "msim/fluid/liquid/liquid_turbulence.hpp"
 #include "msim/io/level_set_mesh.hpp"
 #include "msim/io/obj.hpp"
 #include "msim/io/ply.hpp"
@@ -22,6 +23,7 @@
 #include "msim/scene/scene_file.hpp"
 #include "msim/scene/scene_obstacles.hpp"
 #include "msim/scene/schema/shape_schema.hpp"
+#include "msim/scene/subgrid_turbulence_keys.hpp"
 
 namespace msim::scene {
 
@@ -29,7 +31,8 @@ namespace {
 
 using nlohmann::json;
 
-constexpr const char* kPhi = "liquid_phi";
+constexpr const char* kPhi = "liquid_phi";  // the surface: the fine one with sub-grid turbulence
+constexpr const char* kSimulationPhi = "liquid_sim_phi";  // with turbulence: the simulation grid's
 constexpr const char* kLevelSetParticles = "level_set_particles";
 constexpr const char* kFlipParticles = "flip_particles";
 
@@ -48,6 +51,11 @@ void declareLiquid(Schema& root) {
                  "measured volume error (Kim et al. 2007)");
   liquid.string("mesh_format", "ply", "the surface mesh written per frame in 3D (mesh/<name>_NNNN.*): ply, obj, both or none")
       .choices({"ply", "obj", "both", "none"});
+  Schema turbulence = Schema::object(
+      "sub-grid turbulence at the free surface (Narain ch. 3.5.3): the energy model and noise particles ripple a "
+      "surface on a finer grid, which is written, meshed, previewed and rendered");
+  declareSubgridTurbulenceKeys(turbulence, "ripple the surface with sub-grid turbulence", 1.0e-6);
+  liquid.field("turbulence", turbulence);
   root.field("liquid", liquid);
 
   Schema body = Schema::object("liquid present at the start");
@@ -67,9 +75,14 @@ double liquidBytesPerCell(int dimensions, const json& resolved) {
   // bytes in each liquid cell, about half of them. While a frame is written the VDB writer holds
   // copies of phi, the velocities and the particles (about 40 floats a cell more): a 256^3 FLIP
   // dam break with a quarter of the box filled peaked at 480 bytes per cell.
+  // Sub-grid turbulence: per fine cell phi, phi~, the fine solid, u' (D floats), the potential's
+  // node weight and value (4 floats), the advection window's phi, velocity and scratch (about
+  // 6 + 3 D floats where the band's box covers the grid): ~ 13 + 4 D floats.
   const bool flip = resolved.at("liquid").at("tracker").get<std::string>() == "flip";
   const double particles = flip ? 0.5 * (1 << dimensions) * 24.0 : 0.1 * (dimensions == 2 ? 16 : 32) * 29.0;
-  return 4.0 * (58 + 12 * dimensions) + particles;
+  const json& t = resolved.at("liquid").at("turbulence");
+  const double fine = t.at("enabled").get<bool>() ? std::pow(t.at("refinement").get<int>(), dimensions) * 4.0 * (13 + 4 * dimensions) : 0.0;
+  return 4.0 * (58 + 12 * dimensions) + particles + fine;
 }
 
 template <int D>
@@ -87,6 +100,20 @@ fluid::LiquidParams<D> liquidParams(const Scene& scene) {
   const auto open = openDomainSides<D>(scene.resolved);
   for (int a = 0; a < D; ++a)
     for (int s = 0; s < 2; ++s) p.sides.side[a][s] = open[a][s] ? numerics::DomainSide::Open : numerics::DomainSide::Wall;
+  return p;
+}
+
+template <int D>
+fluid::LiquidTurbulenceParams liquidTurbulenceParams(const Scene& scene) {
+  const json& l = scene.resolved.at("liquid");
+  fluid::LiquidTurbulenceParams p;
+  static_cast<turbulence::SubgridTurbulenceParams&>(p) = subgridTurbulenceParams(l.at("turbulence"));
+  p.energy.advection = liquidParams<D>(scene).advection;
+  p.gravity = sceneVector<D>(l.at("gravity")).norm();
+  if (!(p.gravity > 0.0))
+    throw InputError(fmt::format("{}: 'liquid.turbulence' needs gravity: 'liquid.gravity' is zero, and the ripples' time "
+                                 "scale is that of gravity waves (Narain eq. 3.13)",
+                                 scene.file.string()));
   return p;
 }
 
@@ -120,9 +147,12 @@ class LiquidPhenomenon final : public Phenomenon {
       solver_.addLiquid(shape->distanceField(spec), sceneVector<D>(bodies[i].at("velocity")));
     }
     sources_.emplace(scene, solver_.solid(), volume());
+    if (scene.resolved.at("liquid").at("turbulence").at("enabled").get<bool>())
+      turbulence_.emplace(solver_.spec(), liquidTurbulenceParams<D>(scene), solver_.params().advection, solver_.phi(),
+                          obstacles_.empty() ? nullptr : &solver_.solid());
     preview_ = previewSettings(scene);
     preview_.colour = {0.30f, 0.58f, 0.85f};  // water reads as water in the side views
-    fraction_ = Grid<float, D>(spec);
+    fraction_ = Grid<float, D>(surface().spec());
   }
 
   // The liquid's CFL step, and a moving obstacle crosses at most cfl cells per step.
@@ -140,6 +170,11 @@ class LiquidPhenomenon final : public Phenomenon {
       exchanged = sources_->apply(solver_, time_);
       if (obstacles_.moving()) placeObstacles(time_ + 0.5 * dt);
       solver_.step(dt);
+    }
+    if (turbulence_) {
+      ScopedStage stage(timers_, "liquid: turbulence");
+      if (obstacles_.moving()) turbulence_->setSolid(solver_.solid());
+      turbulence_->step(solver_.velocity(), solver_.phi(), dt);
     }
     time_ += dt;
     ScopedStage stage(timers_, "liquid: volume check");
@@ -163,12 +198,22 @@ class LiquidPhenomenon final : public Phenomenon {
     requireFinite(solver_.phi(), "liquid phi", stepIndex, time);
     static const char* axes[] = {"velocity x", "velocity y", "velocity z"};
     for (int a = 0; a < D; ++a) requireFinite(solver_.velocity().component(a), axes[a], stepIndex, time);
+    if (turbulence_) {
+      requireFinite(turbulence_->phi(), "fine liquid phi", stepIndex, time);
+      requireFinite(turbulence_->energy().energy(), "turbulent energy", stepIndex, time);
+    }
   }
 
-  // liquid_phi (a level set), "vel" at the cell centres in 3D for tools, the face velocities for
-  // --resume, the particles (their positions and radii or velocities), the obstacles' distance.
+  // liquid_phi (a level set; with sub-grid turbulence the fine surface, and the simulation's as
+  // liquid_sim_phi with the turbulent energy), "vel" at the cell centres in 3D for tools, the face
+  // velocities for --resume, the particles (their positions and radii or velocities), the
+  // obstacles' distance.
   void writeVolume(io::VdbWriter& writer) const override {
-    writer.addLevelSet(kPhi, solver_.phi(), 3);
+    writer.addLevelSet(kPhi, surface(), 3);
+    if (turbulence_) {
+      writer.addLevelSet(kSimulationPhi, solver_.phi(), 3);
+      writer.addFloatGrid("turbulent_energy", turbulence_->energy().energy());
+    }
     if constexpr (D == 3) writer.addVectorGrid("vel", solver_.velocity());
     writeFaceVelocities(writer, solver_.velocity());
     if (solver_.params().tracker == fluid::InterfaceTracker::Flip)
@@ -184,7 +229,7 @@ class LiquidPhenomenon final : public Phenomenon {
       if (meshFormat_ == "none") return;
       const std::filesystem::path dir = runDir / "mesh";
       std::filesystem::create_directories(dir);
-      const TriangleMesh mesh = io::levelSetMesh(solver_.phi());
+      const TriangleMesh mesh = io::levelSetMesh(surface());
       const std::string stem = fmt::format("{}_{:04d}", name_, frame);
       if (meshFormat_ != "obj") io::writePlyMesh(dir / (stem + ".ply"), mesh);
       if (meshFormat_ == "obj" || meshFormat_ == "both") io::writeObj(dir / (stem + ".obj"), mesh);
@@ -192,11 +237,13 @@ class LiquidPhenomenon final : public Phenomenon {
   }
 
   io::Image preview() const override {
-    const double eps = 1.5 * solver_.spec().dx;
+    const Grid<float, D>& phi = surface();
+    const double eps = 1.5 * phi.spec().dx;
     parallelFor(0, fraction_.count(), [&](std::size_t i) {
-      fraction_[i] = static_cast<float>(numerics::smearedInside(solver_.phi()[i], eps));
+      fraction_[i] = static_cast<float>(numerics::smearedInside(phi[i], eps));
     });
-    return render::renderDensityPreview(fraction_, preview_, obstacles_.empty() ? nullptr : &solver_.solid());
+    const Grid<float, D>* solid = turbulence_ ? &turbulence_->fineSolid() : &solver_.solid();
+    return render::renderDensityPreview(fraction_, preview_, obstacles_.empty() ? nullptr : solid);
   }
 
   // The resumed run continues from the saved surface, velocity and particles; the pressure's warm
@@ -206,7 +253,7 @@ class LiquidPhenomenon final : public Phenomenon {
     if (obstacles_.moving()) placeObstacles(time);
     const io::VdbFile saved(vdbFile, io::VdbProvenance::MsimRun);
     Grid<float, D> phi(solver_.spec());
-    restoreGrid(saved, kPhi, phi, source_);
+    restoreGrid(saved, turbulence_ ? kSimulationPhi : kPhi, phi, source_);
     MacGrid<D> velocity(solver_.spec());
     restoreFaceVelocities(saved, velocity, source_);
     if (solver_.params().tracker == fluid::InterfaceTracker::Flip) {
@@ -234,11 +281,20 @@ class LiquidPhenomenon final : public Phenomenon {
     }
     solver_.restore(phi, velocity, 0);
     volume_ = volume();
+    if (turbulence_) {
+      // The fine surface continues from the saved one; the noise particles start afresh.
+      Grid<float, D> fine(turbulence_->fineSpec());
+      restoreGrid(saved, kPhi, fine, source_);
+      turbulence_->restoreSurface(fine, phi);
+      restoreGrid(saved, "turbulent_energy", turbulence_->energy().energy(), source_);
+      if (obstacles_.moving()) turbulence_->setSolid(solver_.solid());
+      turbulence_->reseedParticles();
+    }
   }
 
   json statistics() const override {
     const fluid::LiquidStatistics s = solver_.statistics();
-    return {{"volume_m3", s.volume},
+    json j = {{"volume_m3", s.volume},
             {"target_volume_m3", s.targetVolume},
             {"volume_control_divergence_1_s", s.controlDivergence},
             {"max_speed_m_s", s.maxSpeed},
@@ -247,10 +303,20 @@ class LiquidPhenomenon final : public Phenomenon {
             {"pressure_unconverged_steps", unconverged_},
             {"particles", s.particles},
             {"escaped_particles", s.escaped}};
+    if (turbulence_) {
+      j["fine_volume_m3"] = numerics::enclosedVolume(turbulence_->phi(), &turbulence_->fineSolid());
+      j["ripple_height_m"] = turbulence_->meanRippleHeight();
+      j["turbulent_energy_integral"] = turbulence_->energy().integral();
+      j["noise_particles"] = turbulence_->particles().size();
+      j["turbulence_band_fraction"] = turbulence_->bandFraction();
+    }
+    return j;
   }
 
  private:
   double volume() const { return numerics::enclosedVolume(solver_.phi(), &solver_.solid()); }
+  // The surface users see: the fine one with sub-grid turbulence.
+  const Grid<float, D>& surface() const { return turbulence_ ? turbulence_->phi() : solver_.phi(); }
 
   // The obstacles where they are at time t, with their velocity when they move.
   void placeObstacles(double t) {
@@ -293,8 +359,9 @@ class LiquidPhenomenon final : public Phenomenon {
   SceneObstacles<D> obstacles_;
   fluid::LiquidSolver<D> solver_;
   render::PreviewSettings preview_;
-  mutable Grid<float, D> fraction_;  // the preview's liquid fraction (smeared Heaviside of phi)
+  mutable Grid<float, D> fraction_;  // the preview's liquid fraction (smeared Heaviside of the surface)
   std::optional<LiquidSources<D>> sources_;
+  std::optional<fluid::LiquidTurbulence<D>> turbulence_;
   long unconverged_ = 0;
   double volume_ = 0.0;  // after the last step (0 before the first)
   double time_ = 0.0;    // simulated [s]

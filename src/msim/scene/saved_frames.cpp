@@ -9,6 +9,7 @@
 
 #include "msim/core/error.hpp"
 #include "msim/core/log.hpp"
+#include "msim/core/resample.hpp"
 #include "msim/io/atomic_file.hpp"
 #include "msim/io/exr.hpp"
 #include "msim/io/vdb.hpp"
@@ -82,6 +83,13 @@ void renderSavedFrame(const io::VdbFile& frame, const RenderKeys& keys, const fs
   if (temperature && hasGrid(grids, keys.emitterGrid)) emitter = readForRender(frame, keys.emitterGrid, keys.slabCells);
   std::optional<Grid<float, 3>> obstacles;
   if (hasGrid(grids, keys.obstacleGrid)) obstacles = readForRender(frame, keys.obstacleGrid, keys.slabCells);
+  if (obstacles && !obstacles->sameLayout(density) && obstacles->offset() == density.offset()) {
+    // The solids' distance on the simulation grid, the surface on a finer one (a liquid with
+    // sub-grid turbulence): the distance resampled onto the surface's cells.
+    Grid<float, 3> fine(density.spec(), density.size(), density.offset());
+    resampleLinear<3>(*obstacles, fine);
+    obstacles = std::move(fine);
+  }
   render::FrameSurfaces surfaces;
   surfaces.distance = obstacles ? &*obstacles : nullptr;
   surfaces.liquid = liquid ? &*liquid : nullptr;

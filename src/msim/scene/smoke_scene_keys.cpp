@@ -10,6 +10,7 @@
 #include "msim/scene/scene_file.hpp"
 #include "msim/scene/scene_obstacles.hpp"
 #include "msim/scene/schema/shape_schema.hpp"
+#include "msim/scene/subgrid_turbulence_keys.hpp"
 #include "msim/scene/turbulent_wind_keys.hpp"
 
 namespace msim::scene {
@@ -63,23 +64,11 @@ Schema smokeKeys() {
   Schema turbulence = Schema::object(
       "procedural sub-grid turbulence (Narain ch. 3): an energy model on the grid, noise particles synthesising "
       "curl-noise eddies on a finer grid that carries the smoke");
-  turbulence.boolean("enabled", false, "simulate sub-grid turbulence; density and temperature then live on the fine grid");
-  turbulence.integer("refinement", 4, "fine cells per simulation cell and axis (the seed: 4)").min(1).max(8);
-  turbulence.number("largest_eddy", "m", 0.0, "l_0, size of the largest modelled eddies; 0 = four grid cells").min(0.0);
-  turbulence.number("viscosity", "m^2/s", 1.5e-5, "nu: sets the viscous cutoff that turns turbulence off in calm flow")
-      .min(0.0);
-  turbulence.number("eddy_viscosity_constant", "", 0.09,
-                    "C in the eddy viscosity nu_t = C l_0 sqrt(E_0) (eq. 3.6, 3.8): 0.09 = k-epsilon's C_mu; 1 = the seed")
-      .min(0.0, Bound::Exclusive);
-  turbulence.number("initial_energy", "m^2/s^2", 1e-4, "E_0 at the start (production needs E_0 > 0)").min(0.0);
-  turbulence.number("intensity", "", 1.0,
-                    "scales the eddies' speed (1: the seed's calibration, eddies of speed sqrt(E_i) per octave)")
-      .min(0.0);
-  turbulence.integer("octaves", 0, "noise octaves; 0 = down to two fine cells").min(0).max(8);
+  declareSubgridTurbulenceKeys(turbulence, "simulate sub-grid turbulence; density and temperature then live on the fine grid",
+                               1.5e-5);
   turbulence.boolean("coupling", true, "the simulated flow is advected by itself plus the turbulence (ch. 3.5.2)");
   turbulence.number("smoke_threshold", "kg/m^3", 1e-4, "cells with less smoke (and not near smoke) get no eddies")
       .min(0.0);
-  turbulence.integer("seed", 1, "random seed of the noise").min(0);
   turbulence.boolean("write_velocity", false,
                      "write the fine velocity U + u' as 'vel' in the VDB frames (large: 12 bytes per fine cell)");
   smoke.field("turbulence", turbulence);
@@ -228,14 +217,7 @@ template fluid::SmokeParams<3> smokeParams<3>(const Scene&);
 fluid::SmokeTurbulenceParams smokeTurbulenceParams(const json& resolved) {
   const json& t = resolved.at("smoke").at("turbulence");
   fluid::SmokeTurbulenceParams p;
-  p.refinement = t.at("refinement").get<int>();
-  p.energy.largestEddy = t.at("largest_eddy").get<double>();
-  p.energy.viscosity = t.at("viscosity").get<double>();
-  p.energy.initialEnergy = t.at("initial_energy").get<double>();
-  p.energy.eddyViscosityConstant = t.at("eddy_viscosity_constant").get<double>();
-  p.particles.octaves = t.at("octaves").get<int>();
-  p.particles.seed = t.at("seed").get<std::uint64_t>();
-  p.particles.intensity = t.at("intensity").get<double>();
+  static_cast<turbulence::SubgridTurbulenceParams&>(p) = subgridTurbulenceParams(t);
   p.coupling = t.at("coupling").get<bool>();
   p.smokeThreshold = t.at("smoke_threshold").get<double>();
   p.writeVelocity = t.at("write_velocity").get<bool>();

@@ -115,8 +115,16 @@ void NoiseParticles<D>::refill(std::uint64_t step) {
 }
 
 template <int D>
-void NoiseParticles<D>::advance(const MacGrid<D>& velocity, const TurbulentEnergy<D>& energy, double dt) {
-  const auto& e = energy.energy();
+double NoiseParticles<D>::energyAt(const TurbulentEnergy<D>& energy, const Grid<float, D>* energyFloor,
+                                   const Vec<D>& x) const {
+  double e0 = std::max(0.0f, sampleLinear<D>(energy.energy(), x));
+  if (energyFloor) e0 = std::max(e0, double(sampleLinear<D>(*energyFloor, x)));
+  return e0;
+}
+
+template <int D>
+void NoiseParticles<D>::advance(const MacGrid<D>& velocity, const TurbulentEnergy<D>& energy, double dt,
+                                const Grid<float, D>* energyFloor) {
   std::vector<std::uint8_t> keep(position_.size(), 1);
   parallelFor(0, position_.size(), [&](std::size_t j) {
     Vec<D>& p = position_[j];
@@ -126,7 +134,7 @@ void NoiseParticles<D>::advance(const MacGrid<D>& velocity, const TurbulentEnerg
       keep[j] = 0;
       return;
     }
-    const double e0 = std::max(0.0f, sampleLinear<D>(e, p));
+    const double e0 = energyAt(energy, energyFloor, p);
     for (int i = 0; i < octaves_; ++i) {
       const double ei = energy.octaveEnergy(e0, i);
       if (ei > 0.0) time_[j][i] += dt * std::sqrt(ei) / (l0_ / std::ldexp(1.0, i));  // dt / tau_i
@@ -148,14 +156,14 @@ void NoiseParticles<D>::advance(const MacGrid<D>& velocity, const TurbulentEnerg
 
 template <int D>
 void NoiseParticles<D>::synthesize(const TurbulentEnergy<D>& energy, MacGrid<D>& turbulent,
-                                   const std::vector<float>* nodeWeight) {
+                                   const std::vector<float>* nodeWeight, const Grid<float, D>* energyFloor) {
   const GridSpec<D>& fine = turbulent.component(0).spec();
   // Per particle and octave: amplitude A_i = s sqrt(E_i) l_i and the noise's time tap.
   const std::size_t n = position_.size();
   amplitude_.resize(n);
   timeTap_.resize(n);
   parallelFor(0, n, [&](std::size_t j) {
-    const double e0 = std::max(0.0f, sampleLinear<D>(energy.energy(), position_[j]));
+    const double e0 = energyAt(energy, energyFloor, position_[j]);
     for (int i = 0; i < octaves_; ++i) {
       const double l = l0_ / std::ldexp(1.0, i);
       amplitude_[j][i] = static_cast<float>(params_.intensity * std::sqrt(energy.octaveEnergy(e0, i)) * l);

@@ -50,14 +50,17 @@ class NoiseParticles {
                  const NoiseParticleParams& params, const Grid<float, D>* solid = nullptr);
 
   // Moves the particles with U (midpoint rule), advances their noise times by dt / tau_i, removes
-  // those that left the domain or entered a solid, and refills empty cells.
-  void advance(const MacGrid<D>& velocity, const TurbulentEnergy<D>& energy, double dt);
+  // those that left the domain or entered a solid, and refills empty cells. energyFloor (coarse
+  // cells, or null): E_0 is taken as at least this (a liquid's ripple energy, eq. 3.14), here and
+  // in synthesize().
+  void advance(const MacGrid<D>& velocity, const TurbulentEnergy<D>& energy, double dt,
+               const Grid<float, D>* energyFloor = nullptr);
 
   // u' on the faces of `turbulent` (a MAC grid over the fine spec). nodeWeight (res + 1 per axis, x
   // fastest) multiplies the potential at each node, and nodes of weight 0 are not evaluated; null:
   // every node, weight 1.
   void synthesize(const TurbulentEnergy<D>& energy, MacGrid<D>& turbulent,
-                  const std::vector<float>* nodeWeight = nullptr);
+                  const std::vector<float>* nodeWeight = nullptr, const Grid<float, D>* energyFloor = nullptr);
 
   // Moving obstacles: the new solid mask (> 0.5); particles inside it are dropped at the next
   // advance() and empty cells refilled around it.
@@ -69,6 +72,8 @@ class NoiseParticles {
 
  private:
   void refill(std::uint64_t step);
+  // E_0 at x, raised to the floor there when there is one.
+  double energyAt(const TurbulentEnergy<D>& energy, const Grid<float, D>* energyFloor, const Vec<D>& x) const;
   bool inFluid(const Vec<D>& x) const;
   IVec<D> coverageCoord(const Vec<D>& x) const;      // the coverage cell holding x (clamped)
   std::size_t coverageIndex(const IVec<D>& c) const;  // x fastest

@@ -21,23 +21,19 @@
 //      its scalars are carried here, neither advects nor dissipates them);
 //   6. the scalars averaged onto the coarse cells, u' onto the coarse faces (flux averages, so the
 //      coarse u' stays divergence-free) for the next step's coupling.
-#include <memory>
-#include <optional>
+#include <cstdint>
 #include <vector>
 
 #include "msim/core/grid.hpp"
 #include "msim/core/mac_grid.hpp"
 #include "msim/fluid/smoke/smoke_solver.hpp"
 #include "msim/numerics/advection/advector.hpp"
-#include "msim/turbulence/noise_particles.hpp"
-#include "msim/turbulence/turbulent_energy.hpp"
+#include "msim/turbulence/subgrid_turbulence.hpp"
 
 namespace msim::fluid {
 
-struct SmokeTurbulenceParams {
-  int refinement = 4;  // fine cells per coarse cell and axis (the seed: 4)
-  turbulence::TurbulentEnergyParams energy;      // l_0 <= 0: four coarse cells
-  turbulence::NoiseParticleParams particles;
+// refinement, energy and particles: the shared model (turbulence/subgrid_turbulence.hpp).
+struct SmokeTurbulenceParams : turbulence::SubgridTurbulenceParams {
   bool coupling = true;            // U advected by U + u' (ch. 3.5.2)
   double smokeThreshold = 1e-4;    // [kg/m^3] coarse cells with less smoke get no u'
   bool writeVelocity = false;      // the scene writes U + u' on the fine grid as its "vel" (outputs only)
@@ -66,68 +62,46 @@ class SmokeTurbulence {
   // coarseTemperature receive the averaged fine scalars.
   void step(const MacGrid<D>& velocity, double dt, Grid<float, D>& coarseDensity, Grid<float, D>& coarseTemperature);
 
-  const GridSpec<D>& fineSpec() const { return fine_; }
-  const Grid<float, D>& fineSolid() const { return fineSolid_; }
+  const GridSpec<D>& fineSpec() const { return model_.fineSpec(); }
+  const Grid<float, D>& fineSolid() const { return model_.fineSolid(); }
   Grid<float, D>& density() { return density_; }
   const Grid<float, D>& density() const { return density_; }
   Grid<float, D>& temperature() { return temperature_; }
   const Grid<float, D>& temperature() const { return temperature_; }
-  const MacGrid<D>& turbulentVelocity() const { return turbulent_; }       // u' on the fine faces
+  const MacGrid<D>& turbulentVelocity() const { return model_.turbulentVelocity(); }  // u' on the fine faces
   // U interpolated onto the fine faces plus the last step's u' (for outputs).
-  MacGrid<D> fineVelocity(const MacGrid<D>& velocity) const;
+  MacGrid<D> fineVelocity(const MacGrid<D>& velocity) const { return model_.fineVelocity(velocity); }
   const MacGrid<D>& coarseTurbulentVelocity() const { return coarseTurbulent_; }  // u' on the coarse faces
-  turbulence::TurbulentEnergy<D>& energy() { return energy_; }
-  const turbulence::TurbulentEnergy<D>& energy() const { return energy_; }
-  const turbulence::NoiseParticles<D>& particles() const { return *particles_; }
+  turbulence::TurbulentEnergy<D>& energy() { return model_.energy(); }
+  const turbulence::TurbulentEnergy<D>& energy() const { return model_.energy(); }
+  const turbulence::NoiseParticles<D>& particles() const { return model_.particles(); }
   const SmokeTurbulenceParams& params() const { return params_; }
   // Moving obstacles: the simulation grid's new solid mask; the fine grid, the energy model, the
   // fine advector and the noise particles follow it.
   void setSolid(const Grid<float, D>& coarseSolid);
   // Restarts the noise particles (a resumed run: they are not saved).
-  void reseedParticles();
+  void reseedParticles() { model_.reseedParticles(); }
   // Fills the coarse grids with the fine scalars averaged (after a restore).
   void downsample(Grid<float, D>& coarseDensity, Grid<float, D>& coarseTemperature) const;
   // 1/2 int |u'|^2 dV over the fine grid [m^5/s^2] (per unit depth in 2D), from the face values.
   double turbulentKineticEnergy() const;
   // Fraction of the fine nodes that got a potential in the last step.
-  double bandFraction() const { return bandFraction_; }
+  double bandFraction() const { return model_.band().fraction(); }
 
  private:
-  // The fine grids' box being advected (fine cells from lo, `size` of them) and its own copies of
-  // the scalars and U + u', kept while the box stays the same.
-  struct Window {
-    Window(const GridSpec<D>& fine, const IVec<D>& lo, const IVec<D>& size, const numerics::AdvectionSettings& advection);
-    IVec<D> lo, size;
-    Grid<float, D> density, temperature;
-    MacGrid<D> velocity;
-    numerics::Advector<float, D> advector;
-  };
-
-  void applySolid(const Grid<float, D>& coarseSolid);
-  void markBand(const MacGrid<D>& velocity, double dt, const Grid<float, D>& coarseDensity,
-                const Grid<float, D>& coarseTemperature);
-  void advectScalars(const MacGrid<D>& velocity, double dt);
-  // U resampled onto the faces of `out` (the fine grid or a window of it from fine cell lo) plus u'.
-  void advectingVelocity(const MacGrid<D>& velocity, const IVec<D>& lo, MacGrid<D>& out) const;
+  // Smoke does not live inside solids.
+  void clearSmokeInSolids();
+  // seeds_: the coarse cells with smoke (more than the threshold) or heat, where the band grows from.
+  void markSeeds(const Grid<float, D>& coarseDensity, const Grid<float, D>& coarseTemperature);
   void averageTurbulenceToCoarse();
 
-  GridSpec<D> coarse_, fine_;
   SmokeTurbulenceParams params_;
-  numerics::AdvectionSettings advection_;
   double ambientTemperature_;
-  Grid<float, D> coarseSolid_, fineSolid_;
-  bool hasSolid_ = false;
+  turbulence::SubgridTurbulence<D> model_;
   Grid<float, D> density_, temperature_;
-  MacGrid<D> turbulent_, coarseTurbulent_;
-  std::vector<std::uint8_t> coarseLevel_, levelScratch_;  // cells from the smoke and heat (markBand)
-  std::vector<float> coarseNodeWeight_, nodeWeight_;      // the potential's weight: coarse and fine nodes
-  IVec<D> bandLo_ = IVec<D>::Zero(), bandHi_ = IVec<D>::Zero();  // coarse cells, rounded out; empty when equal
-  turbulence::TurbulentEnergy<D> energy_;
-  std::unique_ptr<turbulence::NoiseParticles<D>> particles_;
-  std::optional<Window> window_;
-  bool windowSolidStale_ = false;
+  MacGrid<D> coarseTurbulent_;
+  std::vector<std::uint8_t> seeds_;  // coarse cells with smoke or heat (markBand)
   std::vector<SmokeSource<D>> sources_;
-  double bandFraction_ = 0.0;
 };
 
 extern template class SmokeTurbulence<2>;
