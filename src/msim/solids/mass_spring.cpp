@@ -1,0 +1,61 @@
+#include "msim/solids/mass_spring.hpp"
+
+#include <stdexcept>
+
+namespace msim::solids {
+
+int MassSpringSystem::addParticle(const Vec3& position, double particleMass, const Vec3& velocity) {
+  if (!(particleMass > 0.0)) throw std::invalid_argument("mass-spring system: a particle's mass must be > 0");
+  x.push_back(position);
+  v.push_back(velocity);
+  mass.push_back(particleMass);
+  pinned.push_back(0);
+  return static_cast<int>(x.size()) - 1;
+}
+
+void MassSpringSystem::addSpring(int a, int b, double stiffness, double damping) {
+  const int n = static_cast<int>(x.size());
+  if (a < 0 || b < 0 || a >= n || b >= n || a == b)
+    throw std::invalid_argument("mass-spring system: a spring needs two different particles");
+  if (!(stiffness >= 0.0) || !(damping >= 0.0))
+    throw std::invalid_argument("mass-spring system: stiffness and damping must be >= 0");
+  const double length = (x[b] - x[a]).norm();
+  if (!(length > 0.0)) throw std::invalid_argument("mass-spring system: a spring between coincident particles");
+  springs.push_back({a, b, length, stiffness, damping});
+}
+
+void MassSpringSystem::explicitForces(const std::vector<Vec3>& at, std::vector<Vec3>& force) const {
+  force.resize(at.size());
+  for (std::size_t p = 0; p < at.size(); ++p) force[p] = mass[p] * gravity;
+  for (const Spring& s : springs) {
+    const Vec3 d = at[s.b] - at[s.a];
+    const double length = d.norm();
+    if (!(length > 0.0)) continue;  // coincident: no direction to pull along
+    const Vec3 f = s.stiffness * (length / s.restLength - 1.0) * (d / length);
+    force[s.a] += f;
+    force[s.b] -= f;
+  }
+}
+
+double MassSpringSystem::kineticEnergy() const {
+  double e = 0.0;
+  for (std::size_t p = 0; p < x.size(); ++p) e += 0.5 * mass[p] * v[p].squaredNorm();
+  return e;
+}
+
+double MassSpringSystem::potentialEnergy() const {
+  double e = 0.0;
+  for (std::size_t s = 0; s < springs.size(); ++s) {
+    const double strainNow = strain(s);
+    e += 0.5 * springs[s].stiffness * springs[s].restLength * strainNow * strainNow;
+  }
+  for (std::size_t p = 0; p < x.size(); ++p) e -= mass[p] * gravity.dot(x[p]);
+  return e;
+}
+
+double MassSpringSystem::strain(std::size_t s) const {
+  const Spring& spring = springs[s];
+  return (x[spring.b] - x[spring.a]).norm() / spring.restLength - 1.0;
+}
+
+}  // namespace msim::solids

@@ -1,0 +1,50 @@
+#pragma once
+// A mass-spring solid (Selle ch. 5): particles with mass joined by springs. A spring between
+// particles 1 and 2 of rest length l0 pulls with the elastic force of eq. 5.1,
+//   F = k (|x2 - x1| / l0 - 1) d,  d = (x2 - x1) / |x2 - x1|,
+// so k is the force of a spring stretched to twice its length (a strain of 1), and damps only along
+// itself (ch. 5.2: isotropic "ether" damping makes objects float),
+//   F_d = b ((v2 - v1) . d) d.
+// Edge springs of triangles, tetrahedra and segments, and the bending springs that join the
+// unshared vertices of two triangles sharing an edge (ch. 5.3.3), are all of this kind. Pinned
+// particles do not move (their velocity is kept; scripted ones get it set by the caller).
+#include <cstddef>
+#include <vector>
+
+#include "msim/core/vec.hpp"
+
+namespace msim::solids {
+
+struct Spring {
+  int a = 0, b = 0;          // particle indices
+  double restLength = 0.0;   // l0 [m]
+  double stiffness = 0.0;    // k [N]: the force at a strain of 1 (eq. 5.1)
+  double damping = 0.0;      // b [N s/m] along the spring
+};
+
+struct MassSpringSystem {
+  std::vector<Vec3> x, v;       // positions [m] and velocities [m/s]
+  std::vector<double> mass;     // [kg], > 0
+  std::vector<char> pinned;     // 1: the particle does not move under forces
+  std::vector<Spring> springs;
+  Vec3 gravity = Vec3(0.0, -9.8, 0.0);  // [m/s^2] (the seed's g = 9.8)
+
+  std::size_t size() const { return x.size(); }
+  // Adds a particle; returns its index.
+  int addParticle(const Vec3& position, double particleMass, const Vec3& velocity = Vec3::Zero());
+  // Adds a spring between a and b at rest at their current distance. std::invalid_argument for
+  // an index out of range, a = b, coincident particles, or stiffness or damping < 0.
+  void addSpring(int a, int b, double stiffness, double damping);
+
+  // Elastic (eq. 5.1) plus gravity forces at positions `at` [N], into `force`.
+  void explicitForces(const std::vector<Vec3>& at, std::vector<Vec3>& force) const;
+  // 1/2 m |v|^2 summed [J].
+  double kineticEnergy() const;
+  // Elastic energy: for eq. 5.1, k l0 (s^2 / 2) per spring with strain s = |x2 - x1| / l0 - 1, plus
+  // the gravitational energy -m g . x [J].
+  double potentialEnergy() const;
+  // Strain |x2 - x1| / l0 - 1 of spring s.
+  double strain(std::size_t s) const;
+};
+
+}  // namespace msim::solids

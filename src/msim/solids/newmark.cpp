@@ -1,0 +1,92 @@
+#include "msim/solids/newmark.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/Sparse>
+
+namespace msim::solids {
+
+NewmarkStats NewmarkStepper::solveHalfStep(const MassSpringSystem& system, const std::vector<Vec3>& at,
+                                           const std::vector<Vec3>& from, double h, std::vector<Vec3>& out) {
+  const std::size_t n = system.size();
+  system.explicitForces(at, forces_);
+  // A = M + h sum_s c_s (d d^T) on the spring's two particles (minus across them), c_s = b_s and,
+  // with implicit springs, + h k_s / l0_s; rhs = M v + h F_e. Pinned particles keep `from`: their
+  // rows are M v = M v_from and their columns move to the right-hand side.
+  Eigen::VectorXd rhs(3 * static_cast<Eigen::Index>(n));
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(3 * n + 36 * system.springs.size());
+  for (std::size_t p = 0; p < n; ++p) {
+    for (int k = 0; k < 3; ++k) {
+      const auto row = static_cast<Eigen::Index>(3 * p + k);
+      entries.emplace_back(row, row, system.mass[p]);
+      rhs[row] = system.mass[p] * from[p][k] + (system.pinned[p] ? 0.0 : h * forces_[p][k]);
+    }
+  }
+  for (const Spring& s : system.springs) {
+    const Vec3 delta = at[s.b] - at[s.a];
+    const double length = delta.norm();
+    if (!(length > 0.0)) continue;
+    const Vec3 d = delta / length;
+    const double c = h * (s.damping + (settings_.implicitSprings ? h * s.stiffness / s.restLength : 0.0));
+    if (c == 0.0) continue;
+    const bool pinnedA = system.pinned[static_cast<std::size_t>(s.a)], pinnedB = system.pinned[static_cast<std::size_t>(s.b)];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        const double value = c * d[i] * d[j];
+        const auto ai = static_cast<Eigen::Index>(3 * s.a + i), aj = static_cast<Eigen::Index>(3 * s.a + j);
+        const auto bi = static_cast<Eigen::Index>(3 * s.b + i), bj = static_cast<Eigen::Index>(3 * s.b + j);
+        if (!pinnedA) entries.emplace_back(ai, aj, value);
+        if (!pinnedB) entries.emplace_back(bi, bj, value);
+        if (!pinnedA && !pinnedB) {
+          entries.emplace_back(ai, bj, -value);
+          entries.emplace_back(bi, aj, -value);
+        } else if (!pinnedA) {
+          rhs[ai] += value * from[static_cast<std::size_t>(s.b)][j];  // -(-value) v_b
+        } else if (!pinnedB) {
+          rhs[bi] += value * from[static_cast<std::size_t>(s.a)][j];
+        }
+      }
+  }
+  Eigen::SparseMatrix<double> a(rhs.size(), rhs.size());
+  a.setFromTriplets(entries.begin(), entries.end());
+  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> cg;
+  cg.setTolerance(settings_.cgTolerance);
+  cg.setMaxIterations(settings_.cgMaxIterations);
+  cg.compute(a);
+  Eigen::VectorXd guess(rhs.size());
+  for (std::size_t p = 0; p < n; ++p)
+    for (int k = 0; k < 3; ++k) guess[static_cast<Eigen::Index>(3 * p + k)] = from[p][k];
+  const Eigen::VectorXd solution = cg.solveWithGuess(rhs, guess);
+  out.resize(n);
+  for (std::size_t p = 0; p < n; ++p)
+    out[p] = system.pinned[p] ? from[p] : Vec3(solution[static_cast<Eigen::Index>(3 * p)],
+                                               solution[static_cast<Eigen::Index>(3 * p + 1)],
+                                               solution[static_cast<Eigen::Index>(3 * p + 2)]);
+  NewmarkStats stats;
+  stats.iterations = static_cast<int>(cg.iterations());
+  stats.converged = cg.info() == Eigen::Success;
+  return stats;
+}
+
+NewmarkStats NewmarkStepper::step(MassSpringSystem& system, double dt) {
+  if (!(dt > 0.0) || !std::isfinite(dt)) throw std::invalid_argument("Newmark step: dt must be > 0");
+  const double h = 0.5 * dt;
+  start_ = system.v;
+  NewmarkStats first = solveHalfStep(system, system.x, start_, h, half_);
+  mid_.resize(system.size());
+  for (std::size_t p = 0; p < system.size(); ++p) {
+    const Vec3 next = system.x[p] + dt * half_[p];
+    mid_[p] = 0.5 * (system.x[p] + next);
+    system.x[p] = next;
+  }
+  const NewmarkStats second = solveHalfStep(system, mid_, start_, h, half_);
+  for (std::size_t p = 0; p < system.size(); ++p) system.v[p] = 2.0 * half_[p] - start_[p];
+  first.iterations += second.iterations;
+  first.converged = first.converged && second.converged;
+  return first;
+}
+
+}  // namespace msim::solids
