@@ -71,19 +71,28 @@ NewmarkStats NewmarkStepper::solveHalfStep(const MassSpringSystem& system, const
   return stats;
 }
 
-NewmarkStats NewmarkStepper::step(MassSpringSystem& system, double dt) {
+NewmarkStats NewmarkStepper::step(MassSpringSystem& system, double dt, const BodyContact* bodies) {
   if (!(dt > 0.0) || !std::isfinite(dt)) throw std::invalid_argument("Newmark step: dt must be > 0");
   const double h = 0.5 * dt;
+  const std::size_t n = system.size();
   start_ = system.v;
   NewmarkStats first = solveHalfStep(system, system.x, start_, h, half_);
-  mid_.resize(system.size());
-  for (std::size_t p = 0; p < system.size(); ++p) {
-    const Vec3 next = system.x[p] + dt * half_[p];
+  mid_.resize(n);
+  touched_.assign(n, -1);
+  for (std::size_t p = 0; p < n; ++p) {
+    Vec3 next = system.x[p] + dt * half_[p];
+    if (bodies && !system.pinned[p]) {
+      next = bodies->move(system.x[p], half_[p], dt, touched_[p]);
+      if (touched_[p] >= 0) start_[p] = bodies->gamma(static_cast<std::size_t>(touched_[p]), next, start_[p]);
+    }
     mid_[p] = 0.5 * (system.x[p] + next);
     system.x[p] = next;
   }
   const NewmarkStats second = solveHalfStep(system, mid_, start_, h, half_);
-  for (std::size_t p = 0; p < system.size(); ++p) system.v[p] = 2.0 * half_[p] - start_[p];
+  for (std::size_t p = 0; p < n; ++p) {
+    system.v[p] = 2.0 * half_[p] - start_[p];
+    if (touched_[p] >= 0) system.v[p] = bodies->gamma(static_cast<std::size_t>(touched_[p]), system.x[p], system.v[p]);
+  }
   first.iterations += second.iterations;
   first.converged = first.converged && second.converged;
   return first;

@@ -13,9 +13,14 @@
 // damping h k / l0 along d (the seed's dt k / l0 for a whole step; here the half step's own h):
 // unconditionally stable at one step per frame, and damped only along the springs.
 // Pinned particles keep their velocity (scripted vertices set it) and move with it.
+// With bodies (ch. 6.2 B, 6.5) the step becomes the seed's inner step without self-collisions:
+// step 2 moves each particle with BodyContact::move (cut where it meets a body, the rest of the
+// step with Gamma of its velocity); particles that met a body restart step 3 from Gamma(v(n)) and
+// end with Gamma of their new velocity (object friction, step B.7).
 #include <vector>
 
 #include "msim/core/vec.hpp"
+#include "msim/solids/body_contact.hpp"
 #include "msim/solids/mass_spring.hpp"
 
 namespace msim::solids {
@@ -34,8 +39,8 @@ struct NewmarkStats {
 class NewmarkStepper {
  public:
   explicit NewmarkStepper(const NewmarkSettings& settings = {}) : settings_(settings) {}
-  // Advances the system by dt; std::invalid_argument for dt <= 0.
-  NewmarkStats step(MassSpringSystem& system, double dt);
+  // Advances the system by dt, against `bodies` when given; std::invalid_argument for dt <= 0.
+  NewmarkStats step(MassSpringSystem& system, double dt, const BodyContact* bodies = nullptr);
   const NewmarkSettings& settings() const { return settings_; }
 
  private:
@@ -45,6 +50,7 @@ class NewmarkStepper {
 
   NewmarkSettings settings_;
   std::vector<Vec3> forces_, start_, half_, mid_;
+  std::vector<int> touched_;  // the body each particle met in the step, or -1
 };
 
 }  // namespace msim::solids
