@@ -8,6 +8,7 @@
 // Edge springs of triangles, tetrahedra and segments, and the bending springs that join the
 // unshared vertices of two triangles sharing an edge (ch. 5.3.3), are all of this kind. Pinned
 // particles do not move (their velocity is kept; scripted ones get it set by the caller).
+#include <array>
 #include <cstddef>
 #include <vector>
 
@@ -22,11 +23,21 @@ struct Spring {
   double damping = 0.0;      // b [N s/m] along the spring
 };
 
+// A tetrahedron's altitude spring (ch. 5.3.4, altitude_spring.hpp): its vertices and the rest
+// length of each of its seven altitudes.
+struct TetrahedronSpring {
+  std::array<int, 4> v{};
+  std::array<double, 7> restAltitude{};
+  double stiffness = 0.0;  // [N] at an altitude strain of 1
+  double damping = 0.0;    // [N s/m] along the altitude
+};
+
 struct MassSpringSystem {
   std::vector<Vec3> x, v;       // positions [m] and velocities [m/s]
   std::vector<double> mass;     // [kg], > 0
   std::vector<char> pinned;     // 1: the particle does not move under forces
   std::vector<Spring> springs;
+  std::vector<TetrahedronSpring> tetrahedra;
   Vec3 gravity = Vec3(0.0, -9.8, 0.0);  // [m/s^2] (the seed's g = 9.8)
 
   std::size_t size() const { return x.size(); }
@@ -36,7 +47,12 @@ struct MassSpringSystem {
   // an index out of range, a = b, coincident particles, or stiffness or damping < 0.
   void addSpring(int a, int b, double stiffness, double damping);
 
-  // Elastic (eq. 5.1) plus gravity forces at positions `at` [N], into `force`.
+  // An altitude spring on the tetrahedron (a, b, c, d) at rest in its current shape.
+  // std::invalid_argument for an index out of range, repeated vertices, a rest shape that is
+  // inverted (negative volume) or flat, or stiffness or damping < 0.
+  void addTetrahedron(const std::array<int, 4>& v, double stiffness, double damping);
+
+  // Elastic (eq. 5.1, and the altitude springs) plus gravity forces at positions `at` [N], into `force`.
   void explicitForces(const std::vector<Vec3>& at, std::vector<Vec3>& force) const;
   // 1/2 m |v|^2 summed [J].
   double kineticEnergy() const;

@@ -6,6 +6,8 @@
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/Sparse>
 
+#include "msim/solids/altitude_spring.hpp"
+
 namespace msim::solids {
 
 NewmarkStats NewmarkStepper::solveHalfStep(const MassSpringSystem& system, const std::vector<Vec3>& at,
@@ -13,8 +15,9 @@ NewmarkStats NewmarkStepper::solveHalfStep(const MassSpringSystem& system, const
   const std::size_t n = system.size();
   system.explicitForces(at, forces_);
   // A = M + h sum_s c_s (d d^T) on the spring's two particles (minus across them), c_s = b_s and,
-  // with implicit springs, + h k_s / l0_s; rhs = M v + h F_e. Pinned particles keep `from`: their
-  // rows are M v = M v_from and their columns move to the right-hand side.
+  // with implicit springs, + h k_s / l0_s (the same along each tetrahedron's altitude, spread by
+  // its weights); rhs = M v + h F_e. Pinned particles keep `from`: their rows are M v = M v_from
+  // and their columns move to the right-hand side.
   Eigen::VectorXd rhs(3 * static_cast<Eigen::Index>(n));
   std::vector<Eigen::Triplet<double>> entries;
   entries.reserve(3 * n + 36 * system.springs.size());
@@ -25,30 +28,43 @@ NewmarkStats NewmarkStepper::solveHalfStep(const MassSpringSystem& system, const
       rhs[row] = system.mass[p] * from[p][k] + (system.pinned[p] ? 0.0 : h * forces_[p][k]);
     }
   }
+  // c (sum_i w_i v_i) . n along n on the nodes, node i getting w_i of it: the block c w_i w_j n n^T.
+  auto addAlong = [&](const int* nodes, const double* weights, int count, const Vec3& n, double c) {
+    if (c == 0.0) return;
+    for (int i = 0; i < count; ++i) {
+      const auto pi = static_cast<std::size_t>(nodes[i]);
+      if (system.pinned[pi]) continue;
+      for (int j = 0; j < count; ++j) {
+        const auto pj = static_cast<std::size_t>(nodes[j]);
+        const double w = c * weights[i] * weights[j];
+        for (int r = 0; r < 3; ++r)
+          for (int k = 0; k < 3; ++k) {
+            const double value = w * n[r] * n[k];
+            const auto row = static_cast<Eigen::Index>(3 * pi + r);
+            if (system.pinned[pj])
+              rhs[row] -= value * from[pj][k];
+            else
+              entries.emplace_back(row, static_cast<Eigen::Index>(3 * pj + k), value);
+          }
+      }
+    }
+  };
+  // Damping along each spring, and with implicit springs the stiffness k / l0 along it (ch. 5.5).
   for (const Spring& s : system.springs) {
     const Vec3 delta = at[s.b] - at[s.a];
     const double length = delta.norm();
     if (!(length > 0.0)) continue;
-    const Vec3 d = delta / length;
-    const double c = h * (s.damping + (settings_.implicitSprings ? h * s.stiffness / s.restLength : 0.0));
-    if (c == 0.0) continue;
-    const bool pinnedA = system.pinned[static_cast<std::size_t>(s.a)], pinnedB = system.pinned[static_cast<std::size_t>(s.b)];
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) {
-        const double value = c * d[i] * d[j];
-        const auto ai = static_cast<Eigen::Index>(3 * s.a + i), aj = static_cast<Eigen::Index>(3 * s.a + j);
-        const auto bi = static_cast<Eigen::Index>(3 * s.b + i), bj = static_cast<Eigen::Index>(3 * s.b + j);
-        if (!pinnedA) entries.emplace_back(ai, aj, value);
-        if (!pinnedB) entries.emplace_back(bi, bj, value);
-        if (!pinnedA && !pinnedB) {
-          entries.emplace_back(ai, bj, -value);
-          entries.emplace_back(bi, aj, -value);
-        } else if (!pinnedA) {
-          rhs[ai] += value * from[static_cast<std::size_t>(s.b)][j];  // -(-value) v_b
-        } else if (!pinnedB) {
-          rhs[bi] += value * from[static_cast<std::size_t>(s.a)][j];
-        }
-      }
+    const int nodes[2] = {s.a, s.b};
+    const double weights[2] = {-1.0, 1.0};
+    addAlong(nodes, weights, 2, delta / length,
+             h * (s.damping + (settings_.implicitSprings ? h * s.stiffness / s.restLength : 0.0)));
+  }
+  for (const TetrahedronSpring& t : system.tetrahedra) {
+    const AltitudeChoice choice = chooseAltitude({at[t.v[0]], at[t.v[1]], at[t.v[2]], at[t.v[3]]});
+    if (choice.candidate < 0) continue;
+    const double l0 = t.restAltitude[static_cast<std::size_t>(choice.candidate)];
+    addAlong(t.v.data(), choice.weights.data(), 4, choice.normal,
+             h * (t.damping + (settings_.implicitSprings ? h * t.stiffness / l0 : 0.0)));
   }
   Eigen::SparseMatrix<double> a(rhs.size(), rhs.size());
   a.setFromTriplets(entries.begin(), entries.end());
