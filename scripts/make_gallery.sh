@@ -51,6 +51,7 @@ drop_into_pool      | render  | --frames 15
 wave_maker_2d       | preview | --frames 96
 pour_glass          | render  | --frames 30
 river_rapids        | render  | --frames 72
+cloth_drape         | preview | --frames 24
 "
 
 wanted=("$@")

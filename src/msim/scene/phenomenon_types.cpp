@@ -1,3 +1,4 @@
+#include "msim/scene/cloth_phenomenon.hpp"
 #include "msim/scene/crowd_phenomenon.hpp"
 #include "msim/scene/gas_phenomenon.hpp"
 #include "msim/scene/granular_phenomenon.hpp"
@@ -9,7 +10,7 @@ namespace msim::scene {
 
 const std::vector<PhenomenonType>& phenomenonTypes() {
   static const std::vector<PhenomenonType> types = {gasPhenomenonType(), smokePhenomenonType(), crowdPhenomenonType(),
-                                                    granularPhenomenonType(), liquidPhenomenonType()};
+                                                    granularPhenomenonType(), liquidPhenomenonType(), clothPhenomenonType()};
   return types;
 }
 

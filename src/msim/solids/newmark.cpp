@@ -1,5 +1,6 @@
 #include "msim/solids/newmark.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -111,6 +112,7 @@ NewmarkStats NewmarkStepper::step(MassSpringSystem& system, double dt, const Bod
   }
   first.iterations += second.iterations;
   first.converged = first.converged && second.converged;
+  first.contacts = static_cast<int>(std::count_if(touched_.begin(), touched_.end(), [](int b) { return b >= 0; }));
   return first;
 }
 

@@ -34,6 +34,7 @@ struct NewmarkSettings {
 struct NewmarkStats {
   int iterations = 0;        // CG iterations of the step's two solves
   bool converged = true;     // both reached the tolerance
+  int contacts = 0;          // particles that met a body
 };
 
 class NewmarkStepper {

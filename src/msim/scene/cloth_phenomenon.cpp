@@ -1,0 +1,313 @@
+#include "msim/scene/cloth_phenomenon.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include <Eigen/Geometry>
+#include <fmt/format.h>
+
+#include "msim/core/error.hpp"
+#include "msim/core/log.hpp"
+#include "msim/io/obj.hpp"
+#include "msim/io/ply.hpp"
+#include "msim/io/vdb.hpp"
+#include "msim/render/density_preview.hpp"
+#include "msim/scene/json_vectors.hpp"
+#include "msim/scene/phenomenon_support.hpp"
+#include "msim/scene/scene_file.hpp"
+#include "msim/scene/schema/shape_schema.hpp"
+#include "msim/solids/cloth_mesh.hpp"
+#include "msim/solids/newmark.hpp"
+
+namespace msim::scene {
+
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+constexpr const char* kVertices = "cloth_vertices";
+constexpr double kExplodedStrain = 10.0;  // a spring stretched to 11 times its length: the run failed
+
+void declareCloth(Schema& root) {
+  Schema cloth = Schema::object("the cloth: its mesh, material and time step (docs/cloth.md)");
+  Schema patch = Schema::object("a rectangular patch: origin + s edge_u + t edge_v, s and t in [0, 1]");
+  patch.vector("origin", "m", {0.0, 1.0, 0.0}, "a corner of the patch").lengths({3});
+  patch.vector("edge_u", "m", {1.0, 0.0, 0.0}, "the first edge from the origin").lengths({3});
+  patch.vector("edge_v", "m", {0.0, 0.0, 1.0}, "the second edge from the origin").lengths({3});
+  patch.vector("quads", "", {32.0, 32.0}, "quads along edge_u and edge_v (two triangles each)").lengths({2}).min(1.0);
+  cloth.field("patch", patch);
+  Schema mesh = Schema::object("a triangle mesh file instead of the patch");
+  mesh.string("file", "", "OBJ or PLY, relative to the scene file; '' = use the patch");
+  mesh.number("scale", "", 1.0, "uniform scale of the vertices").min(0.0, Bound::Exclusive);
+  mesh.vector("translate", "m", {0.0, 0.0, 0.0}, "translation after scaling").lengths({3});
+  cloth.field("mesh", mesh);
+  cloth.number("density", "kg/m^2", 0.1, "mass per area").min(0.0, Bound::Exclusive);
+  cloth.number("edge_stiffness", "N", 20.0, "k of eq. 5.1 for the edge springs: the pull at a strain of 1")
+      .min(0.0, Bound::Exclusive);
+  cloth.number("edge_damping", "N s/m", 0.01, "damping along the edge springs").min(0.0);
+  cloth.number("bend_stiffness", "N", 2.0, "k of the bending springs across each interior edge").min(0.0);
+  cloth.number("bend_damping", "N s/m", 0.001, "damping along the bending springs").min(0.0);
+  cloth.vector("gravity", "m/s^2", {0.0, -9.8, 0.0}, "acceleration of gravity").lengths({3});
+  cloth.boolean("implicit_springs", true, "springs implicit along themselves (Selle ch. 5.5)");
+  cloth.number("cg_tolerance", "", 1e-3, "relative residual of the step's solves (Table 6.1)").min(0.0, Bound::Exclusive).max(1.0);
+  cloth.string("mesh_format", "ply", "the cloth mesh written per frame (mesh/<name>_NNNN.*): ply, obj, both or none")
+      .choices({"ply", "obj", "both", "none"});
+  Schema pin = Schema::object("vertices inside this shape do not move");
+  pin.field("shape", shapeSchema());
+  cloth.array("pins", pin, "pinned vertices");
+  root.field("cloth", cloth);
+  Schema body = Schema::object("a solid the cloth lands on and slides over");
+  body.field("shape", shapeSchema());
+  body.number("friction", "", 0.3, "mu of Coulomb friction (Selle ch. 6.5)").min(0.0);
+  root.array("bodies", body, "solids in contact with the cloth");
+}
+
+double clothBytesPerCell(int, const json&) { return 8.0; }  // the preview's grids
+
+
+class ClothPhenomenon final : public Phenomenon {
+ public:
+  ClothPhenomenon(const Scene& scene, StageTimers& timers)
+      : source_(scene.file.string()),
+        name_(scene.resolved.at("name").get<std::string>()),
+        timers_(timers),
+        spec_(scene.gridSpec<3>()),
+        cfl_(scene.resolved.at("time").at("cfl").get<double>()) {
+    if (scene.dimensions != 3)
+      throw InputError(fmt::format("{}: 'domain': a cloth scene is 3D (give domain.min and domain.max 3 numbers)", source_));
+    const json& c = scene.resolved.at("cloth");
+    meshFormat_ = c.at("mesh_format").get<std::string>();
+    mesh_ = clothMesh(scene, c);
+    solids::ClothMaterial material;
+    material.arealDensity = c.at("density").get<double>();
+    material.edgeStiffness = c.at("edge_stiffness").get<double>();
+    material.edgeDamping = c.at("edge_damping").get<double>();
+    material.bendStiffness = c.at("bend_stiffness").get<double>();
+    material.bendDamping = c.at("bend_damping").get<double>();
+    try {
+      cloth_ = solids::clothSystem(mesh_, material);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(fmt::format("{}: 'cloth': {}", meshSource_, e.what()));
+    }
+    cloth_.gravity = sceneVector<3>(c.at("gravity"));
+    const json& pins = c.at("pins");
+    for (std::size_t i = 0; i < pins.size(); ++i) {
+      const std::string key = fmt::format("cloth.pins[{}].shape", i);
+      const auto shape = sceneShape<3>(scene, pins[i].at("shape"), key);
+      int pinned = 0;
+      for (std::size_t v = 0; v < cloth_.size(); ++v)
+        if (shape->distance(cloth_.x[v]) <= 0.0) {
+          cloth_.pinned[v] = 1;
+          ++pinned;
+        }
+      if (pinned == 0) throw InputError(fmt::format("{}: '{}' holds no vertex of the cloth: nothing to pin", source_, key));
+    }
+    const json& bodies = scene.resolved.at("bodies");
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      std::shared_ptr<const geometry::Shape3> shape = sceneShape<3>(scene, bodies[i].at("shape"), fmt::format("bodies[{}].shape", i));
+      for (std::size_t v = 0; v < cloth_.size(); ++v)
+        if (shape->distance(cloth_.x[v]) < 0.0)
+          throw InputError(fmt::format("{}: 'bodies[{}].shape' holds cloth vertex {} at the start: the cloth must begin "
+                                       "outside the bodies",
+                                       source_, i, v));
+      contact_.addBody({shape, Vec3::Zero(), bodies[i].at("friction").get<double>()});
+      bodyShapes_.push_back(std::move(shape));
+    }
+    solids::NewmarkSettings settings;
+    settings.implicitSprings = c.at("implicit_springs").get<bool>();
+    settings.cgTolerance = c.at("cg_tolerance").get<double>();
+    stepper_ = solids::NewmarkStepper(settings);
+    implicitSprings_ = settings.implicitSprings;
+    springMass_.resize(cloth_.springs.size());
+    for (std::size_t i = 0; i < cloth_.springs.size(); ++i) {
+      const solids::Spring& s = cloth_.springs[i];
+      const double ma = cloth_.pinned[static_cast<std::size_t>(s.a)] ? 0.0 : cloth_.mass[static_cast<std::size_t>(s.a)];
+      const double mb = cloth_.pinned[static_cast<std::size_t>(s.b)] ? 0.0 : cloth_.mass[static_cast<std::size_t>(s.b)];
+      springMass_[i] = ma > 0.0 && mb > 0.0 ? ma * mb / (ma + mb) : std::max(ma, mb);
+    }
+    preview_ = previewSettings(scene);
+    preview_.colour = {0.85f, 0.45f, 0.30f};
+    coverage_ = Grid<float, 3>(spec_, 0.0f);
+    solid_ = Grid<float, 3>(spec_, 0.0f);
+    for (const auto& shape : bodyShapes_) {
+      const Grid<float, 3> d = shape->distanceField(spec_);
+      for (std::size_t i = 0; i < solid_.count(); ++i)
+        if (d[i] < 0.0f) solid_[i] = 1.0f;
+    }
+  }
+
+  // The explicit part's limit 2 / omega over the springs. Explicit springs: omega^2 = k / (l0 mu)
+  // along each. Implicit springs (ch. 5.5) are stable along themselves; what stays explicit is
+  // the sideways stiffness of their tension T = k |strain|, omega^2 = T / (L mu), taken at a
+  // strain of at least 1% (a slack cloth tightens within a step).
+  double stableTimestep() const override {
+    double step = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < cloth_.springs.size(); ++i) {
+      const solids::Spring& s = cloth_.springs[i];
+      if (!(springMass_[i] > 0.0) || !(s.stiffness > 0.0)) continue;
+      const double stiffness = implicitSprings_ ? s.stiffness * std::max(std::abs(cloth_.strain(i)), 0.01) /
+                                                      (s.restLength * (1.0 + cloth_.strain(i)))
+                                                : s.stiffness / s.restLength;
+      step = std::min(step, 2.0 * std::sqrt(springMass_[i] / stiffness));
+    }
+    return cfl_ * step;
+  }
+
+  void step(double dt) override {
+    ScopedStage stage(timers_, "cloth: step");
+    const solids::NewmarkStats s = stepper_.step(cloth_, dt, contact_.empty() ? nullptr : &contact_);
+    ++steps_;
+    iterations_ += s.iterations;
+    contacts_ = s.contacts;
+    if (!s.converged) {
+      ++unconverged_;
+      logger().warn("cloth: a solve of step {} did not converge ({} iterations)", steps_, s.iterations);
+    }
+  }
+
+  void checkFinite(long stepIndex, double time) const override {
+    for (std::size_t v = 0; v < cloth_.size(); ++v)
+      if (!cloth_.x[v].allFinite() || !cloth_.v[v].allFinite())
+        throw SimulationError(fmt::format("cloth: vertex {} is not finite at step {} (t = {:.4g} s)", v, stepIndex, time));
+    const double strain = maxStrain();
+    if (strain > kExplodedStrain)
+      throw SimulationError(fmt::format("cloth: a spring is stretched to {:.3g} times its length at step {} (t = {:.4g} s): "
+                                        "the cloth exploded; lower time.cfl or the stiffness",
+                                        strain + 1.0, stepIndex, time));
+  }
+
+  // The vertices (positions, velocities) for --resume and tools.
+  void writeVolume(io::VdbWriter& writer) const override {
+    io::PointCloud cloud;
+    std::vector<io::PointAttribute> v = {{"vx", {}}, {"vy", {}}, {"vz", {}}};
+    for (std::size_t p = 0; p < cloth_.size(); ++p) {
+      cloud.positions.push_back(cloth_.x[p].cast<float>());
+      for (int a = 0; a < 3; ++a) v[a].values.push_back(static_cast<float>(cloth_.v[p][a]));
+    }
+    cloud.attributes = std::move(v);
+    writer.addPoints(kVertices, cloud, spec_.dx);
+  }
+
+  // mesh/<name>_NNNN.ply (and .obj): the cloth's triangles, vertices in the same order every frame.
+  void writeFrameData(const fs::path& runDir, int frame) const override {
+    if (meshFormat_ == "none") return;
+    const fs::path dir = runDir / "mesh";
+    fs::create_directories(dir);
+    TriangleMesh now = mesh_;
+    now.vertices = cloth_.x;
+    const std::string stem = fmt::format("{}_{:04d}", name_, frame);
+    if (meshFormat_ != "obj") io::writePlyMesh(dir / (stem + ".ply"), now);
+    if (meshFormat_ == "obj" || meshFormat_ == "both") io::writeObj(dir / (stem + ".obj"), now);
+  }
+
+  io::Image preview() const override {
+    // The cloth's triangles marked in the cells they pass through, seen as a dense medium.
+    coverage_.fill(0.0f);
+    for (const auto& t : mesh_.triangles) {
+      const Vec3 a = cloth_.x[t[0]], b = cloth_.x[t[1]], c = cloth_.x[t[2]];
+      const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+      const int n = std::max(1, static_cast<int>(std::ceil(2.0 * longest / spec_.dx)));
+      for (int i = 0; i <= n; ++i)
+        for (int j = 0; i + j <= n; ++j) {
+          const Vec3 x = a + (double(i) / n) * (b - a) + (double(j) / n) * (c - a);
+          const Vec3 s = (x - spec_.origin) / spec_.dx;
+          const IVec3 cell = s.array().floor().cast<int>();
+          if ((cell.array() < 0).any() || (cell.array() >= spec_.res.array()).any()) continue;
+          coverage_(cell) = 1.0f;
+        }
+    }
+    return render::renderDensityPreview(coverage_, preview_, bodyShapes_.empty() ? nullptr : &solid_);
+  }
+
+  void restore(const fs::path& vdbFile, double) override {
+    const io::VdbFile saved(vdbFile, io::VdbProvenance::MsimRun);
+    const io::PointCloud cloud = saved.points(kVertices);
+    if (cloud.positions.size() != cloth_.size())
+      throw InputError(fmt::format("{}: '{}' holds {} vertices, the cloth has {}", vdbFile.string(), kVertices,
+                                   cloud.positions.size(), cloth_.size()));
+    const char* names[3] = {"vx", "vy", "vz"};
+    for (int a = 0; a < 3; ++a) {
+      const auto& v = savedPointAttribute(cloud, names[a], vdbFile, source_);
+      for (std::size_t p = 0; p < cloth_.size(); ++p) cloth_.v[p][a] = v[p];
+    }
+    for (std::size_t p = 0; p < cloth_.size(); ++p) cloth_.x[p] = cloud.positions[p].cast<double>();
+  }
+
+  json statistics() const override {
+    double sum = 0.0;
+    for (std::size_t s = 0; s < cloth_.springs.size(); ++s) sum += std::abs(cloth_.strain(s));
+    return {{"kinetic_energy_J", cloth_.kineticEnergy()},
+            {"potential_energy_J", cloth_.potentialEnergy()},
+            {"max_strain", maxStrain()},
+            {"mean_strain", cloth_.springs.empty() ? 0.0 : sum / static_cast<double>(cloth_.springs.size())},
+            {"contacts", contacts_},
+            {"cg_iterations_per_step", steps_ > 0 ? double(iterations_) / double(steps_) : 0.0},
+            {"unconverged_solves", unconverged_},
+            {"vertices", cloth_.size()},
+            {"triangles", mesh_.triangles.size()}};
+  }
+
+ private:
+  double maxStrain() const {
+    double largest = 0.0;
+    for (std::size_t s = 0; s < cloth_.springs.size(); ++s) largest = std::max(largest, std::abs(cloth_.strain(s)));
+    return largest;
+  }
+
+  TriangleMesh clothMesh(const Scene& scene, const json& c) {
+    const json& m = c.at("mesh");
+    const std::string file = m.at("file").get<std::string>();
+    if (file.empty()) {
+      const json& p = c.at("patch");
+      const Vec3 quads = Vec3(p.at("quads")[0].get<double>(), p.at("quads")[1].get<double>(), 0.0);
+      meshSource_ = source_;
+      try {
+        return solids::clothPatch(sceneVector<3>(p.at("origin")), sceneVector<3>(p.at("edge_u")),
+                                  sceneVector<3>(p.at("edge_v")), static_cast<int>(quads[0]), static_cast<int>(quads[1]));
+      } catch (const std::invalid_argument& e) {
+        throw InputError(fmt::format("{}: 'cloth.patch': {}", source_, e.what()));
+      }
+    }
+    const fs::path path = scene.directory() / file;
+    meshSource_ = path.string();
+    if (!fs::exists(path)) throw InputError(fmt::format("{}: 'cloth.mesh.file': {} does not exist", source_, path.string()));
+    TriangleMesh mesh = path.extension() == ".ply" ? io::readPlyMesh(path).mesh : io::readObj(path);
+    const double scale = m.at("scale").get<double>();
+    const Vec3 translate = sceneVector<3>(m.at("translate"));
+    for (Vec3& x : mesh.vertices) x = scale * x + translate;
+    return mesh;
+  }
+
+  std::string source_, meshSource_, name_, meshFormat_;
+  StageTimers& timers_;
+  GridSpec<3> spec_;
+  double cfl_;
+  TriangleMesh mesh_;
+  solids::MassSpringSystem cloth_;
+  solids::BodyContact contact_;
+  std::vector<std::shared_ptr<const geometry::Shape3>> bodyShapes_;
+  solids::NewmarkStepper stepper_;
+  bool implicitSprings_ = true;
+  std::vector<double> springMass_;  // each spring's reduced mass (the free end's with one end pinned)
+  render::PreviewSettings preview_;
+  mutable Grid<float, 3> coverage_;
+  Grid<float, 3> solid_;
+  long steps_ = 0, iterations_ = 0, unconverged_ = 0;
+  int contacts_ = 0;
+};
+
+std::unique_ptr<Phenomenon> createCloth(const Scene& scene, StageTimers& timers) {
+  return std::make_unique<ClothPhenomenon>(scene, timers);
+}
+
+}  // namespace
+
+PhenomenonType clothPhenomenonType() {
+  return {"cloth", "a mass-spring cloth on bodies with friction (Selle ch. 5-6)", &declareCloth, &clothBytesPerCell,
+          &createCloth};
+}
+
+}  // namespace msim::scene

@@ -1,0 +1,71 @@
+// The "cloth" phenomenon end to end: a small patch falls onto a ball and the floor; every frame
+// writes the mesh (same vertices in the same order), the vertices for --resume and a preview;
+// --resume continues; bad input exits 2 naming the key or file.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_harness.hpp"
+#include "msim/io/ply.hpp"
+#include "msim/io/vdb.hpp"
+
+namespace {
+
+using nlohmann::json;
+using namespace msim;
+
+std::string tinyCloth(const std::string& extra = "") {
+  return R"({
+  "name": "tiny", "phenomenon": "cloth",
+  "domain": {"min": [-0.5, 0, -0.5], "max": [0.5, 1, 0.5], "resolution": 24},
+  "time": {"duration": 0.2, "fps": 10},
+  "outputs": {"mp4": false},
+  "cloth": {"patch": {"origin": [-0.3, 0.6, -0.3], "edge_u": [0.6, 0, 0], "edge_v": [0, 0, 0.6], "quads": [8, 8]})" +
+         extra + R"(},
+  "bodies": [{"shape": {"type": "sphere", "center": [0, 0.3, 0], "radius": 0.2}, "friction": 0.5},
+             {"shape": {"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0]}}]
+})";
+}
+
+}  // namespace
+
+TEST(ClothCli, PatchFallsOntoTheBallAndWritesMeshesAndResumes) {
+  const fs::path dir = scratch("cloth_tiny");
+  writeText(dir / "s.json", replaced(tinyCloth(), R"("duration": 0.2)", R"("duration": 0.4)"));
+  const std::string run = "run " + (dir / "s.json").string() + " -q --out " + (dir / "out").string();
+  const Result r = runMsim(run + " --frames 2");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  const fs::path out = dir / "out";
+  const auto first = io::readPlyMesh(out / "mesh" / "tiny_0001.ply").mesh, second = io::readPlyMesh(out / "mesh" / "tiny_0002.ply").mesh;
+  ASSERT_EQ(first.vertices.size(), 81u);
+  ASSERT_EQ(second.vertices.size(), 81u);
+  EXPECT_EQ(first.triangles, second.triangles);
+  EXPECT_LT(second.vertices[40].y(), first.vertices[40].y()) << "the middle of the cloth falls";
+  const json last = readJson(out / "run.json").at("frames").back();
+  for (const char* key : {"kinetic_energy_J", "potential_energy_J", "max_strain", "mean_strain", "contacts",
+                          "cg_iterations_per_step", "unconverged_solves", "vertices", "triangles"})
+    EXPECT_TRUE(last.contains(key)) << key;
+  EXPECT_TRUE(fs::exists(out / "png" / "tiny_0002.png"));
+  EXPECT_TRUE(io::VdbFile(out / "vdb" / "tiny_0002.vdb", io::VdbProvenance::MsimRun).points("cloth_vertices").positions.size() == 81u);
+  const Result resumed = runMsim(run + " --resume");
+  ASSERT_EQ(resumed.exitCode, 0) << resumed.output;
+  const json frames = readJson(out / "run.json").at("frames");
+  ASSERT_EQ(frames.size(), 4u);
+  EXPECT_GT(frames.back().at("contacts").get<int>(), 0) << "by 0.4 s the cloth lies on the ball";
+}
+
+TEST(ClothCli, BadInputNamesTheKeyOrFile) {
+  expectInputError("cloth_pin_nothing", tinyCloth(R"(, "pins": [{"shape": {"type": "sphere", "center": [5, 5, 5], "radius": 0.1}}])"),
+                   {"cloth.pins[0].shape", "no vertex"});
+  expectInputError("cloth_inside_body",
+                   replaced(tinyCloth(), R"("center": [0, 0.3, 0], "radius": 0.2)", R"("center": [0, 0.6, 0], "radius": 0.2)"),
+                   {"bodies[0].shape"});
+  expectInputError("cloth_stiffness", tinyCloth(R"(, "edge_stiffness": 0)"), {"cloth.edge_stiffness"});
+  // A mesh with an edge shared by three triangles.
+  const fs::path dir = scratch("cloth_fan_mesh");
+  writeText(dir / "fan.obj", "v 0 0.5 0\nv 0.1 0.5 0\nv 0 0.6 0\nv 0 0.5 0.1\nv 0 0.4 0\nf 1 2 3\nf 1 2 4\nf 1 2 5\n");
+  expectInputError("cloth_non_manifold", tinyCloth(R"(, "mesh": {"file": ")" + (dir / "fan.obj").string() + R"("})"),
+                   {"fan.obj", "not a manifold"});
+}
