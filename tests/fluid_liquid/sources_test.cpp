@@ -29,6 +29,17 @@ Grid<float, 2> box(const GridSpec<2>& spec, const Vec2& lo, const Vec2& hi) {
 
 double volumeOf(const LiquidSolver<2>& solver) { return numerics::enclosedVolume(solver.phi(), &solver.solid()); }
 
+// The emitter on before every step for `seconds`, steps of at most 1/120 s.
+void emitFor(LiquidSolver<2>& solver, const Grid<float, 2>& region, const Vec2& velocity, double seconds) {
+  double t = 0.0;
+  while (seconds - t > 1e-9) {
+    solver.emit(region, velocity);
+    const double dt = std::min({seconds - t, solver.cflTimestep(), 1.0 / 120.0});
+    solver.step(dt);
+    t += dt;
+  }
+}
+
 // A hose pointing down into an empty closed tank for 0.5 s: the liquid's volume then is the
 // hose's own plus v A t.
 double hoseVolumeRatio(InterfaceTracker tracker) {
@@ -39,13 +50,7 @@ double hoseVolumeRatio(InterfaceTracker tracker) {
   // Cells 28..35 across (8 cells = 0.125 m), 56..59 high.
   const Grid<float, 2> hose = box(spec, Vec2(28.0 / 64, 56.0 / 64), Vec2(36.0 / 64, 60.0 / 64));
   const Vec2 velocity(0.0, -1.0);
-  double t = 0.0;
-  while (0.5 - t > 1e-9) {
-    solver.emit(hose, velocity);
-    const double dt = std::min({0.5 - t, solver.cflTimestep(), 1.0 / 120.0});
-    solver.step(dt);
-    t += dt;
-  }
+  emitFor(solver, hose, velocity, 0.5);
   const double area = 8.0 / 64, hoseVolume = 8.0 * 4.0 / (64.0 * 64.0);
   return volumeOf(solver) / (hoseVolume + 1.0 * area * 0.5);
 }
@@ -63,13 +68,7 @@ double submergedInflowRatio(InterfaceTracker tracker) {
   const double start = volumeOf(solver);
   const Grid<float, 2> inlet = box(spec, Vec2(-1, -1), Vec2(2.0 / 64, 0.25));  // 0.25 m of the wall
   const Vec2 velocity(0.5, 0.0);
-  double t = 0.0;
-  while (0.5 - t > 1e-9) {
-    solver.emit(inlet, velocity);
-    const double dt = std::min({0.5 - t, solver.cflTimestep(), 1.0 / 120.0});
-    solver.step(dt);
-    t += dt;
-  }
+  emitFor(solver, inlet, velocity, 0.5);
   return (volumeOf(solver) - start) / (0.5 * 0.25 * 0.5);
 }
 
