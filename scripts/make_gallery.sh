@@ -52,6 +52,7 @@ wave_maker_2d       | preview | --frames 96
 pour_glass          | render  | --frames 30
 river_rapids        | render  | --frames 72
 cloth_drape         | preview | --frames 24
+cloth_flag          | preview | --frames 40
 "
 
 wanted=("$@")

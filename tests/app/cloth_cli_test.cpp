@@ -1,6 +1,6 @@
 // The "cloth" phenomenon end to end: a small patch falls onto a ball and the floor; every frame
 // writes the mesh (same vertices in the same order), the vertices for --resume and a preview;
-// --resume continues; bad input exits 2 naming the key or file.
+// --resume continues; wind pushes it; bad input exits 2 naming the key or file.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -54,6 +54,27 @@ TEST(ClothCli, PatchFallsOntoTheBallAndWritesMeshesAndResumes) {
   const json frames = readJson(out / "run.json").at("frames");
   ASSERT_EQ(frames.size(), 4u);
   EXPECT_GT(frames.back().at("contacts").get<int>(), 0) << "by 0.4 s the cloth lies on the ball";
+}
+
+TEST(ClothCli, WindPushesTheClothAlongItsNormal) {
+  // A vertical patch pinned along its top edge in a 5 m/s wind blowing through it along z: the
+  // drag along the normal moves the free cloth downwind; without wind it only hangs.
+  const std::string patch = R"("patch": {"origin": [-0.3, 0.55, 0], "edge_u": [0.6, 0, 0], "edge_v": [0, 0.4, 0], "quads": [8, 8]})";
+  const std::string scene = replaced(tinyCloth(R"(, "pins": [{"shape": {"type": "box", "min": [-1, 0.94, -1], "max": [1, 0.96, 1]}}])"),
+                               R"("patch": {"origin": [-0.3, 0.6, -0.3], "edge_u": [0.6, 0, 0], "edge_v": [0, 0, 0.6], "quads": [8, 8]})", patch);
+  auto meanZ = [&](const std::string& name, const std::string& text) {
+    const fs::path dir = scratch(name);
+    writeText(dir / "s.json", text);
+    const Result r = runMsim("run " + (dir / "s.json").string() + " -q --out " + (dir / "out").string());
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    const auto mesh = io::readPlyMesh(dir / "out" / "mesh" / "tiny_0002.ply").mesh;
+    double z = 0.0;
+    for (const Vec3& x : mesh.vertices) z += x.z() / static_cast<double>(mesh.vertices.size());
+    return z;
+  };
+  EXPECT_NEAR(meanZ("cloth_no_wind", scene), 0.0, 1e-9) << "without wind the cloth hangs in its plane";
+  const std::string windy = replaced(scene, R"("bodies": [)", R"("winds": [{"speed_rms": 0.1, "mean_velocity": [0, 0, 5]}], "bodies": [)");
+  EXPECT_GT(meanZ("cloth_wind", windy), 0.01) << "the wind should blow the cloth along +z";
 }
 
 TEST(ClothCli, BadInputNamesTheKeyOrFile) {

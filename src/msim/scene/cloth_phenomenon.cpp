@@ -18,6 +18,7 @@
 #include "msim/scene/phenomenon_support.hpp"
 #include "msim/scene/scene_file.hpp"
 #include "msim/scene/schema/shape_schema.hpp"
+#include "msim/scene/turbulent_wind_keys.hpp"
 #include "msim/solids/cloth_mesh.hpp"
 #include "msim/solids/newmark.hpp"
 
@@ -51,6 +52,9 @@ void declareCloth(Schema& root) {
   cloth.number("bend_stiffness", "N", 2.0, "k of the bending springs across each interior edge").min(0.0);
   cloth.number("bend_damping", "N s/m", 0.001, "damping along the bending springs").min(0.0);
   cloth.vector("gravity", "m/s^2", {0.0, -9.8, 0.0}, "acceleration of gravity").lengths({3});
+  cloth.number("wind_drag", "kg/(m^2 s)", 1.0,
+               "c of the wind's drag c A ((u - v) . n) n on each triangle, along its normal (linear, as Selle ch. 6's leaves), from winds[]")
+      .min(0.0);
   cloth.boolean("implicit_springs", true, "springs implicit along themselves (Selle ch. 5.5)");
   cloth.number("cg_tolerance", "", 1e-3, "relative residual of the step's solves (Table 6.1)").min(0.0, Bound::Exclusive).max(1.0);
   cloth.string("mesh_format", "ply", "the cloth mesh written per frame (mesh/<name>_NNNN.*): ply, obj, both or none")
@@ -63,6 +67,7 @@ void declareCloth(Schema& root) {
   body.field("shape", shapeSchema());
   body.number("friction", "", 0.3, "mu of Coulomb friction (Selle ch. 6.5)").min(0.0);
   root.array("bodies", body, "solids in contact with the cloth");
+  declareTurbulentWinds(root);
 }
 
 double clothBytesPerCell(int, const json&) { return 8.0; }  // the preview's grids
@@ -93,6 +98,8 @@ class ClothPhenomenon final : public Phenomenon {
       throw InputError(fmt::format("{}: 'cloth': {}", meshSource_, e.what()));
     }
     cloth_.gravity = sceneVector<3>(c.at("gravity"));
+    windDrag_ = c.at("wind_drag").get<double>();
+    winds_ = turbulentWinds<3>(scene);
     const json& pins = c.at("pins");
     for (std::size_t i = 0; i < pins.size(); ++i) {
       const std::string key = fmt::format("cloth.pins[{}].shape", i);
@@ -157,9 +164,14 @@ class ClothPhenomenon final : public Phenomenon {
   }
 
   void step(double dt) override {
+    if (!winds_.empty() && windDrag_ > 0.0) {
+      ScopedStage stage(timers_, "cloth: wind");
+      windForces();
+    }
     ScopedStage stage(timers_, "cloth: step");
     const solids::NewmarkStats s = stepper_.step(cloth_, dt, contact_.empty() ? nullptr : &contact_);
     ++steps_;
+    time_ += dt;
     iterations_ += s.iterations;
     contacts_ = s.contacts;
     if (!s.converged) {
@@ -222,7 +234,8 @@ class ClothPhenomenon final : public Phenomenon {
     return render::renderDensityPreview(coverage_, preview_, bodyShapes_.empty() ? nullptr : &solid_);
   }
 
-  void restore(const fs::path& vdbFile, double) override {
+  void restore(const fs::path& vdbFile, double time) override {
+    time_ = time;
     const io::VdbFile saved(vdbFile, io::VdbProvenance::MsimRun);
     const io::PointCloud cloud = saved.points(kVertices);
     if (cloud.positions.size() != cloth_.size())
@@ -251,6 +264,25 @@ class ClothPhenomenon final : public Phenomenon {
   }
 
  private:
+  // Each triangle's drag c A ((u - v) . n) n at the step's start, u the winds at its centroid and
+  // v its mean velocity, a third on each vertex (linear drag along the normal, as in Selle ch. 6's
+  // leaves and wardrobe).
+  void windForces() {
+    cloth_.external.assign(cloth_.size(), Vec3::Zero());
+    for (const auto& t : mesh_.triangles) {
+      const Vec3 a = cloth_.x[t[0]], b = cloth_.x[t[1]], c = cloth_.x[t[2]];
+      const Vec3 cross = (b - a).cross(c - a);
+      const double twiceArea = cross.norm();
+      if (!(twiceArea > 0.0)) continue;
+      const Vec3 n = cross / twiceArea, centroid = (a + b + c) / 3.0;
+      Vec3 wind = Vec3::Zero();
+      for (const auto& w : winds_) wind += w.velocity(centroid, time_);
+      const Vec3 v = (cloth_.v[t[0]] + cloth_.v[t[1]] + cloth_.v[t[2]]) / 3.0;
+      const Vec3 f = windDrag_ * 0.5 * twiceArea * (wind - v).dot(n) * n;
+      for (const int k : t) cloth_.external[static_cast<std::size_t>(k)] += f / 3.0;
+    }
+  }
+
   double maxStrain() const {
     double largest = 0.0;
     for (std::size_t s = 0; s < cloth_.springs.size(); ++s) largest = std::max(largest, std::abs(cloth_.strain(s)));
@@ -295,6 +327,9 @@ class ClothPhenomenon final : public Phenomenon {
   render::PreviewSettings preview_;
   mutable Grid<float, 3> coverage_;
   Grid<float, 3> solid_;
+  std::vector<turbulence::TurbulentWind<3>> winds_;
+  double windDrag_ = 0.0;
+  double time_ = 0.0;  // simulated [s]
   long steps_ = 0, iterations_ = 0, unconverged_ = 0;
   int contacts_ = 0;
 };

@@ -47,7 +47,7 @@ void MassSpringSystem::addTetrahedron(const std::array<int, 4>& v, double stiffn
 
 void MassSpringSystem::explicitForces(const std::vector<Vec3>& at, std::vector<Vec3>& force) const {
   force.resize(at.size());
-  for (std::size_t p = 0; p < at.size(); ++p) force[p] = mass[p] * gravity;
+  for (std::size_t p = 0; p < at.size(); ++p) force[p] = mass[p] * gravity + (external.empty() ? Vec3(Vec3::Zero()) : external[p]);
   for (const Spring& s : springs) {
     const Vec3 d = at[s.b] - at[s.a];
     const double length = d.norm();

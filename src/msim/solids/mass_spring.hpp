@@ -39,6 +39,7 @@ struct MassSpringSystem {
   std::vector<Spring> springs;
   std::vector<TetrahedronSpring> tetrahedra;
   Vec3 gravity = Vec3(0.0, -9.8, 0.0);  // [m/s^2] (the seed's g = 9.8)
+  std::vector<Vec3> external;           // per particle [N] (wind drag), held through a step; empty: none
 
   std::size_t size() const { return x.size(); }
   // Adds a particle; returns its index.
@@ -52,7 +53,8 @@ struct MassSpringSystem {
   // inverted (negative volume) or flat, or stiffness or damping < 0.
   void addTetrahedron(const std::array<int, 4>& v, double stiffness, double damping);
 
-  // Elastic (eq. 5.1, and the altitude springs) plus gravity forces at positions `at` [N], into `force`.
+  // Elastic (eq. 5.1, and the altitude springs), gravity and external forces at positions `at`
+  // [N], into `force`.
   void explicitForces(const std::vector<Vec3>& at, std::vector<Vec3>& force) const;
   // 1/2 m |v|^2 summed [J].
   double kineticEnergy() const;
