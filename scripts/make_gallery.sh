@@ -53,6 +53,7 @@ pour_glass          | render  | --frames 30
 river_rapids        | render  | --frames 72
 cloth_drape         | preview | --frames 24
 cloth_flag          | preview | --frames 40
+solid_torus         | preview |
 "
 
 wanted=("$@")

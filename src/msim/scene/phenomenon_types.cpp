@@ -1,8 +1,8 @@
-#include "msim/scene/cloth_phenomenon.hpp"
 #include "msim/scene/crowd_phenomenon.hpp"
 #include "msim/scene/gas_phenomenon.hpp"
 #include "msim/scene/granular_phenomenon.hpp"
 #include "msim/scene/liquid_phenomenon.hpp"
+#include "msim/scene/mass_spring_phenomenon.hpp"
 #include "msim/scene/phenomenon.hpp"
 #include "msim/scene/smoke_phenomenon.hpp"
 
@@ -10,7 +10,8 @@ namespace msim::scene {
 
 const std::vector<PhenomenonType>& phenomenonTypes() {
   static const std::vector<PhenomenonType> types = {gasPhenomenonType(), smokePhenomenonType(), crowdPhenomenonType(),
-                                                    granularPhenomenonType(), liquidPhenomenonType(), clothPhenomenonType()};
+                                                    granularPhenomenonType(), liquidPhenomenonType(), clothPhenomenonType(),
+                                                    solidPhenomenonType()};
   return types;
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -15,6 +16,25 @@ namespace msim::solids {
 double tetrahedronVolume6(const MassSpringSystem& system, const std::array<int, 4>& t) {
   const auto& x = system.x;
   return (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]).dot(x[t[3]] - x[t[0]]);
+}
+
+std::vector<std::array<int, 3>> boundaryTriangles(const TetMesh& mesh) {
+  // A positively oriented tetrahedron (a, b, c, d) has the outward faces (a, c, b), (a, b, d),
+  // (a, d, c) and (b, c, d); a face shared by two tetrahedra is interior.
+  std::map<std::array<int, 3>, std::pair<std::array<int, 3>, int>> faces;
+  for (const auto& t : mesh.tetrahedra)
+    for (const std::array<int, 3>& f : {std::array<int, 3>{t[0], t[2], t[1]}, std::array<int, 3>{t[0], t[1], t[3]},
+                                        std::array<int, 3>{t[0], t[3], t[2]}, std::array<int, 3>{t[1], t[2], t[3]}}) {
+      std::array<int, 3> key = f;
+      std::sort(key.begin(), key.end());
+      auto& entry = faces[key];
+      entry.first = f;
+      ++entry.second;
+    }
+  std::vector<std::array<int, 3>> out;
+  for (const auto& [key, entry] : faces)
+    if (entry.second == 1) out.push_back(entry.first);
+  return out;
 }
 
 TetMesh bccTetMesh(const geometry::Shape3& shape, double spacing) {

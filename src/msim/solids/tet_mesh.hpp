@@ -36,6 +36,10 @@ struct SolidMaterial {
 // value out of range or a tetrahedron that is inverted or flat (naming it).
 MassSpringSystem solidSystem(const TetMesh& mesh, const SolidMaterial& material);
 
+// The triangles on the mesh's boundary (faces of one tetrahedron only), facing outwards, over the
+// mesh's vertex indices (the surface a solid shows).
+std::vector<std::array<int, 3>> boundaryTriangles(const TetMesh& mesh);
+
 // Six times the signed volume of tetrahedron t of the system (positive as meshed).
 double tetrahedronVolume6(const MassSpringSystem& system, const std::array<int, 4>& t);
 

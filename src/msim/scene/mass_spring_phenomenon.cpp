@@ -1,0 +1,433 @@
+#include "msim/scene/mass_spring_phenomenon.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <utility>
+
+#include <Eigen/Geometry>
+#include <fmt/format.h>
+
+#include "msim/core/error.hpp"
+#include "msim/core/log.hpp"
+#include "msim/io/obj.hpp"
+#include "msim/io/ply.hpp"
+#include "msim/io/vdb.hpp"
+#include "msim/render/density_preview.hpp"
+#include "msim/scene/json_vectors.hpp"
+#include "msim/scene/phenomenon_support.hpp"
+#include "msim/scene/scene_file.hpp"
+#include "msim/scene/schema/shape_schema.hpp"
+#include "msim/scene/turbulent_wind_keys.hpp"
+#include "msim/solids/cloth_mesh.hpp"
+#include "msim/solids/newmark.hpp"
+#include "msim/solids/tet_mesh.hpp"
+
+namespace msim::scene {
+
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+constexpr double kExplodedStrain = 10.0;  // a spring stretched to 11 times its length: the run failed
+
+// The keys cloth and solid share, in their object: gravity, the solver, outputs, pins.
+void declareMassSpringKeys(Schema& object, const char* what) {
+  object.vector("gravity", "m/s^2", {0.0, -9.8, 0.0}, "acceleration of gravity").lengths({3});
+  object.number("wind_drag", "kg/(m^2 s)", 1.0,
+                "c of the wind's drag c A ((u - v) . n) n on each surface triangle, along its normal (linear, as Selle "
+                "ch. 6's leaves), from winds[]")
+      .min(0.0);
+  object.boolean("implicit_springs", true, "springs implicit along themselves (Selle ch. 5.5)");
+  object.number("cg_tolerance", "", 1e-3, "relative residual of the step's solves (Table 6.1)").min(0.0, Bound::Exclusive).max(1.0);
+  object.string("mesh_format", "ply", fmt::format("the {} surface mesh written per frame (mesh/<name>_NNNN.*): ply, obj, both or none", what))
+      .choices({"ply", "obj", "both", "none"});
+  Schema pin = Schema::object("vertices inside this shape do not move");
+  pin.field("shape", shapeSchema());
+  object.array("pins", pin, "pinned vertices");
+}
+
+void declareBodiesAndWinds(Schema& root) {
+  Schema body = Schema::object("a solid the cloth or solid lands on and slides over");
+  body.field("shape", shapeSchema());
+  body.number("friction", "", 0.3, "mu of Coulomb friction (Selle ch. 6.5)").min(0.0);
+  root.array("bodies", body, "solids in contact");
+  declareTurbulentWinds(root);
+}
+
+void declareCloth(Schema& root) {
+  Schema cloth = Schema::object("the cloth: its mesh, material and time step (docs/cloth.md)");
+  Schema patch = Schema::object("a rectangular patch: origin + s edge_u + t edge_v, s and t in [0, 1]");
+  patch.vector("origin", "m", {0.0, 1.0, 0.0}, "a corner of the patch").lengths({3});
+  patch.vector("edge_u", "m", {1.0, 0.0, 0.0}, "the first edge from the origin").lengths({3});
+  patch.vector("edge_v", "m", {0.0, 0.0, 1.0}, "the second edge from the origin").lengths({3});
+  patch.vector("quads", "", {32.0, 32.0}, "quads along edge_u and edge_v (two triangles each)").lengths({2}).min(1.0);
+  cloth.field("patch", patch);
+  Schema mesh = Schema::object("a triangle mesh file instead of the patch");
+  mesh.string("file", "", "OBJ or PLY, relative to the scene file; '' = use the patch");
+  mesh.number("scale", "", 1.0, "uniform scale of the vertices").min(0.0, Bound::Exclusive);
+  mesh.vector("translate", "m", {0.0, 0.0, 0.0}, "translation after scaling").lengths({3});
+  cloth.field("mesh", mesh);
+  cloth.number("density", "kg/m^2", 0.1, "mass per area").min(0.0, Bound::Exclusive);
+  cloth.number("edge_stiffness", "N", 20.0, "k of eq. 5.1 for the edge springs: the pull at a strain of 1")
+      .min(0.0, Bound::Exclusive);
+  cloth.number("edge_damping", "N s/m", 0.01, "damping along the edge springs").min(0.0);
+  cloth.number("bend_stiffness", "N", 2.0, "k of the bending springs across each interior edge").min(0.0);
+  cloth.number("bend_damping", "N s/m", 0.001, "damping along the bending springs").min(0.0);
+  declareMassSpringKeys(cloth, "cloth");
+  root.field("cloth", cloth);
+  declareBodiesAndWinds(root);
+}
+
+void declareSolid(Schema& root) {
+  Schema solid = Schema::object("the solid: its shape, tetrahedra, material and time step (docs/solids.md)");
+  solid.field("shape", shapeSchema());
+  solid.number("spacing", "m", 0.05, "the BCC lattice's cube side: tetrahedra of spacing^3 / 12").min(0.0, Bound::Exclusive);
+  solid.number("density", "kg/m^3", 1000.0, "mass per volume").min(0.0, Bound::Exclusive);
+  solid.number("edge_stiffness", "N", 100.0, "k of eq. 5.1 for the edge springs").min(0.0, Bound::Exclusive);
+  solid.number("edge_damping", "N s/m", 0.1, "damping along the edge springs").min(0.0);
+  solid.number("altitude_stiffness", "N", 100.0, "k of each tetrahedron's altitude spring (ch. 5.3.4); 0 = edge springs only")
+      .min(0.0);
+  solid.number("altitude_damping", "N s/m", 0.1, "damping along the altitude springs").min(0.0);
+  solid.vector("initial_scale", "", {1.0, 1.0, 1.0},
+               "the solid starts scaled by these factors about its centre (crushed: [1, 0.05, 1]) and springs back")
+      .lengths({3})
+      .min(0.0);
+  declareMassSpringKeys(solid, "solid's");
+  root.field("solid", solid);
+  declareBodiesAndWinds(root);
+}
+
+double massSpringBytesPerCell(int, const json&) { return 8.0; }  // the preview's grids
+
+
+class MassSpringPhenomenon final : public Phenomenon {
+ public:
+  // kind: "cloth" or "solid", the phenomenon and its key.
+  MassSpringPhenomenon(const Scene& scene, StageTimers& timers, std::string kind)
+      : kind_(std::move(kind)),
+        vertices_(kind_ + "_vertices"),
+        source_(scene.file.string()),
+        name_(scene.resolved.at("name").get<std::string>()),
+        timers_(timers),
+        spec_(scene.gridSpec<3>()),
+        cfl_(scene.resolved.at("time").at("cfl").get<double>()) {
+    if (scene.dimensions != 3)
+      throw InputError(fmt::format("{}: 'domain': a {} scene is 3D (give domain.min and domain.max 3 numbers)", source_, kind_));
+    const json& c = scene.resolved.at(kind_);
+    meshFormat_ = c.at("mesh_format").get<std::string>();
+    if (kind_ == "cloth")
+      buildCloth(scene, c);
+    else
+      buildSolid(scene, c);
+    system_.gravity = sceneVector<3>(c.at("gravity"));
+    windDrag_ = c.at("wind_drag").get<double>();
+    winds_ = turbulentWinds<3>(scene);
+    const json& pins = c.at("pins");
+    for (std::size_t i = 0; i < pins.size(); ++i) {
+      const std::string key = fmt::format("{}.pins[{}].shape", kind_, i);
+      const auto shape = sceneShape<3>(scene, pins[i].at("shape"), key);
+      int pinned = 0;
+      for (std::size_t v = 0; v < system_.size(); ++v)
+        if (shape->distance(system_.x[v]) <= 0.0) {
+          system_.pinned[v] = 1;
+          ++pinned;
+        }
+      if (pinned == 0) throw InputError(fmt::format("{}: '{}' holds no vertex of the {}: nothing to pin", source_, key, kind_));
+    }
+    const json& bodies = scene.resolved.at("bodies");
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      std::shared_ptr<const geometry::Shape3> shape = sceneShape<3>(scene, bodies[i].at("shape"), fmt::format("bodies[{}].shape", i));
+      for (std::size_t v = 0; v < system_.size(); ++v)
+        if (shape->distance(system_.x[v]) < 0.0)
+          throw InputError(fmt::format("{}: 'bodies[{}].shape' holds {} vertex {} at the start: the {} must begin "
+                                       "outside the bodies",
+                                       source_, i, kind_, v, kind_));
+      contact_.addBody({shape, Vec3::Zero(), bodies[i].at("friction").get<double>()});
+      bodyShapes_.push_back(std::move(shape));
+    }
+    solids::NewmarkSettings settings;
+    settings.implicitSprings = c.at("implicit_springs").get<bool>();
+    settings.cgTolerance = c.at("cg_tolerance").get<double>();
+    stepper_ = solids::NewmarkStepper(settings);
+    implicitSprings_ = settings.implicitSprings;
+    springMass_.resize(system_.springs.size());
+    for (std::size_t i = 0; i < system_.springs.size(); ++i) {
+      const solids::Spring& s = system_.springs[i];
+      const double ma = system_.pinned[static_cast<std::size_t>(s.a)] ? 0.0 : system_.mass[static_cast<std::size_t>(s.a)];
+      const double mb = system_.pinned[static_cast<std::size_t>(s.b)] ? 0.0 : system_.mass[static_cast<std::size_t>(s.b)];
+      springMass_[i] = ma > 0.0 && mb > 0.0 ? ma * mb / (ma + mb) : std::max(ma, mb);
+    }
+    preview_ = previewSettings(scene);
+    preview_.colour = {0.85f, 0.45f, 0.30f};
+    coverage_ = Grid<float, 3>(spec_, 0.0f);
+    solid_ = Grid<float, 3>(spec_, 0.0f);
+    for (const auto& shape : bodyShapes_) {
+      const Grid<float, 3> d = shape->distanceField(spec_);
+      for (std::size_t i = 0; i < solid_.count(); ++i)
+        if (d[i] < 0.0f) solid_[i] = 1.0f;
+    }
+  }
+
+  // The explicit part's limit 2 / omega over the springs. Explicit springs: omega^2 = k / (l0 mu)
+  // along each. Implicit springs (ch. 5.5) are stable along themselves; what stays explicit is
+  // the sideways stiffness of their tension T = k |strain|, omega^2 = T / (L mu), taken at a
+  // strain of at least 1% (a slack cloth tightens within a step).
+  double stableTimestep() const override {
+    double step = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < system_.springs.size(); ++i) {
+      const solids::Spring& s = system_.springs[i];
+      if (!(springMass_[i] > 0.0) || !(s.stiffness > 0.0)) continue;
+      const double stiffness = implicitSprings_ ? s.stiffness * std::max(std::abs(system_.strain(i)), 0.01) /
+                                                      (s.restLength * (1.0 + system_.strain(i)))
+                                                : s.stiffness / s.restLength;
+      step = std::min(step, 2.0 * std::sqrt(springMass_[i] / stiffness));
+    }
+    return cfl_ * step;
+  }
+
+  void step(double dt) override {
+    if (!winds_.empty() && windDrag_ > 0.0) {
+      ScopedStage stage(timers_, kind_ == "cloth" ? "cloth: wind" : "solid: wind");
+      windForces();
+    }
+    ScopedStage stage(timers_, kind_ == "cloth" ? "cloth: step" : "solid: step");
+    const solids::NewmarkStats s = stepper_.step(system_, dt, contact_.empty() ? nullptr : &contact_);
+    ++steps_;
+    time_ += dt;
+    iterations_ += s.iterations;
+    contacts_ = s.contacts;
+    if (!s.converged) {
+      ++unconverged_;
+      logger().warn("{}: a solve of step {} did not converge ({} iterations)", kind_, steps_, s.iterations);
+    }
+  }
+
+  void checkFinite(long stepIndex, double time) const override {
+    for (std::size_t v = 0; v < system_.size(); ++v)
+      if (!system_.x[v].allFinite() || !system_.v[v].allFinite())
+        throw SimulationError(fmt::format("{}: vertex {} is not finite at step {} (t = {:.4g} s)", kind_, v, stepIndex, time));
+    const double strain = maxStrain();
+    if (strain > kExplodedStrain)
+      throw SimulationError(fmt::format("{}: a spring is stretched to {:.3g} times its length at step {} (t = {:.4g} s): "
+                                        "the {} exploded; lower time.cfl or the stiffness",
+                                        kind_, strain + 1.0, stepIndex, time, kind_));
+  }
+
+  // The vertices (positions, velocities) for --resume and tools.
+  void writeVolume(io::VdbWriter& writer) const override {
+    io::PointCloud cloud;
+    std::vector<io::PointAttribute> v = {{"vx", {}}, {"vy", {}}, {"vz", {}}};
+    for (std::size_t p = 0; p < system_.size(); ++p) {
+      cloud.positions.push_back(system_.x[p].cast<float>());
+      for (int a = 0; a < 3; ++a) v[a].values.push_back(static_cast<float>(system_.v[p][a]));
+    }
+    cloud.attributes = std::move(v);
+    writer.addPoints(vertices_, cloud, spec_.dx);
+  }
+
+  // mesh/<name>_NNNN.ply (and .obj): the surface's triangles, vertices in the same order every frame
+  // (a solid's interior vertices are written too, unreferenced, so the order stays the system's).
+  void writeFrameData(const fs::path& runDir, int frame) const override {
+    if (meshFormat_ == "none") return;
+    const fs::path dir = runDir / "mesh";
+    fs::create_directories(dir);
+    TriangleMesh now = mesh_;
+    now.vertices = system_.x;
+    const std::string stem = fmt::format("{}_{:04d}", name_, frame);
+    if (meshFormat_ != "obj") io::writePlyMesh(dir / (stem + ".ply"), now);
+    if (meshFormat_ == "obj" || meshFormat_ == "both") io::writeObj(dir / (stem + ".obj"), now);
+  }
+
+  io::Image preview() const override {
+    // The surface's triangles marked in the cells they pass through, seen as a dense medium.
+    coverage_.fill(0.0f);
+    for (const auto& t : mesh_.triangles) {
+      const Vec3 a = system_.x[t[0]], b = system_.x[t[1]], c = system_.x[t[2]];
+      const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+      const int n = std::max(1, static_cast<int>(std::ceil(2.0 * longest / spec_.dx)));
+      for (int i = 0; i <= n; ++i)
+        for (int j = 0; i + j <= n; ++j) {
+          const Vec3 x = a + (double(i) / n) * (b - a) + (double(j) / n) * (c - a);
+          const Vec3 s = (x - spec_.origin) / spec_.dx;
+          const IVec3 cell = s.array().floor().cast<int>();
+          if ((cell.array() < 0).any() || (cell.array() >= spec_.res.array()).any()) continue;
+          coverage_(cell) = 1.0f;
+        }
+    }
+    return render::renderDensityPreview(coverage_, preview_, bodyShapes_.empty() ? nullptr : &solid_);
+  }
+
+  void restore(const fs::path& vdbFile, double time) override {
+    time_ = time;
+    const io::VdbFile saved(vdbFile, io::VdbProvenance::MsimRun);
+    const io::PointCloud cloud = saved.points(vertices_);
+    if (cloud.positions.size() != system_.size())
+      throw InputError(fmt::format("{}: '{}' holds {} vertices, the {} has {}", vdbFile.string(), vertices_,
+                                   cloud.positions.size(), kind_, system_.size()));
+    const char* names[3] = {"vx", "vy", "vz"};
+    for (int a = 0; a < 3; ++a) {
+      const auto& v = savedPointAttribute(cloud, names[a], vdbFile, source_);
+      for (std::size_t p = 0; p < system_.size(); ++p) system_.v[p][a] = v[p];
+    }
+    for (std::size_t p = 0; p < system_.size(); ++p) system_.x[p] = cloud.positions[p].cast<double>();
+  }
+
+  json statistics() const override {
+    double sum = 0.0;
+    for (std::size_t s = 0; s < system_.springs.size(); ++s) sum += std::abs(system_.strain(s));
+    json j = {{"kinetic_energy_J", system_.kineticEnergy()},
+            {"potential_energy_J", system_.potentialEnergy()},
+            {"max_strain", maxStrain()},
+            {"mean_strain", system_.springs.empty() ? 0.0 : sum / static_cast<double>(system_.springs.size())},
+            {"contacts", contacts_},
+            {"cg_iterations_per_step", steps_ > 0 ? double(iterations_) / double(steps_) : 0.0},
+            {"unconverged_solves", unconverged_},
+            {"vertices", system_.size()},
+            {"triangles", mesh_.triangles.size()}};
+    if (!system_.tetrahedra.empty()) {
+      long inverted = 0;
+      for (const solids::TetrahedronSpring& t : system_.tetrahedra) inverted += solids::tetrahedronVolume6(system_, t.v) <= 0.0;
+      j["tetrahedra"] = system_.tetrahedra.size();
+      j["inverted_tetrahedra"] = inverted;
+    }
+    return j;
+  }
+
+ private:
+  // Each triangle's drag c A ((u - v) . n) n at the step's start, u the winds at its centroid and
+  // v its mean velocity, a third on each vertex (linear drag along the normal, as in Selle ch. 6's
+  // leaves and wardrobe).
+  void windForces() {
+    system_.external.assign(system_.size(), Vec3::Zero());
+    for (const auto& t : mesh_.triangles) {
+      const Vec3 a = system_.x[t[0]], b = system_.x[t[1]], c = system_.x[t[2]];
+      const Vec3 cross = (b - a).cross(c - a);
+      const double twiceArea = cross.norm();
+      if (!(twiceArea > 0.0)) continue;
+      const Vec3 n = cross / twiceArea, centroid = (a + b + c) / 3.0;
+      Vec3 wind = Vec3::Zero();
+      for (const auto& w : winds_) wind += w.velocity(centroid, time_);
+      const Vec3 v = (system_.v[t[0]] + system_.v[t[1]] + system_.v[t[2]]) / 3.0;
+      const Vec3 f = windDrag_ * 0.5 * twiceArea * (wind - v).dot(n) * n;
+      for (const int k : t) system_.external[static_cast<std::size_t>(k)] += f / 3.0;
+    }
+  }
+
+  double maxStrain() const {
+    double largest = 0.0;
+    for (std::size_t s = 0; s < system_.springs.size(); ++s) largest = std::max(largest, std::abs(system_.strain(s)));
+    return largest;
+  }
+
+  void buildCloth(const Scene& scene, const json& c) {
+    mesh_ = clothMesh(scene, c);
+    solids::ClothMaterial material;
+    material.arealDensity = c.at("density").get<double>();
+    material.edgeStiffness = c.at("edge_stiffness").get<double>();
+    material.edgeDamping = c.at("edge_damping").get<double>();
+    material.bendStiffness = c.at("bend_stiffness").get<double>();
+    material.bendDamping = c.at("bend_damping").get<double>();
+    try {
+      system_ = solids::clothSystem(mesh_, material);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(fmt::format("{}: 'cloth': {}", meshSource_, e.what()));
+    }
+  }
+
+  // BCC tetrahedra of the shape, their surface for outputs, then the initial squash.
+  void buildSolid(const Scene& scene, const json& c) {
+    const auto shape = sceneShape<3>(scene, c.at("shape"), "solid.shape");
+    solids::TetMesh tets;
+    try {
+      tets = solids::bccTetMesh(*shape, c.at("spacing").get<double>());
+    } catch (const std::invalid_argument& e) {
+      throw InputError(fmt::format("{}: 'solid.shape': {}", source_, e.what()));
+    }
+    if (tets.tetrahedra.empty())
+      throw InputError(fmt::format("{}: 'solid.spacing': no tetrahedron of that size fits in 'solid.shape'; make it smaller",
+                                   source_));
+    solids::SolidMaterial material;
+    material.density = c.at("density").get<double>();
+    material.edgeStiffness = c.at("edge_stiffness").get<double>();
+    material.edgeDamping = c.at("edge_damping").get<double>();
+    material.altitudeStiffness = c.at("altitude_stiffness").get<double>();
+    material.altitudeDamping = c.at("altitude_damping").get<double>();
+    system_ = solids::solidSystem(tets, material);
+    mesh_.vertices = tets.vertices;
+    mesh_.triangles = solids::boundaryTriangles(tets);
+    const Vec3 scale = sceneVector<3>(c.at("initial_scale"));
+    Vec3 centre = Vec3::Zero();
+    for (const Vec3& x : system_.x) centre += x / static_cast<double>(system_.size());
+    for (Vec3& x : system_.x) x = centre + (x - centre).cwiseProduct(scale);
+  }
+
+  TriangleMesh clothMesh(const Scene& scene, const json& c) {
+    const json& m = c.at("mesh");
+    const std::string file = m.at("file").get<std::string>();
+    if (file.empty()) {
+      const json& p = c.at("patch");
+      const Vec3 quads = Vec3(p.at("quads")[0].get<double>(), p.at("quads")[1].get<double>(), 0.0);
+      meshSource_ = source_;
+      try {
+        return solids::clothPatch(sceneVector<3>(p.at("origin")), sceneVector<3>(p.at("edge_u")),
+                                  sceneVector<3>(p.at("edge_v")), static_cast<int>(quads[0]), static_cast<int>(quads[1]));
+      } catch (const std::invalid_argument& e) {
+        throw InputError(fmt::format("{}: 'cloth.patch': {}", source_, e.what()));
+      }
+    }
+    const fs::path path = scene.directory() / file;
+    meshSource_ = path.string();
+    if (!fs::exists(path)) throw InputError(fmt::format("{}: 'cloth.mesh.file': {} does not exist", source_, path.string()));
+    TriangleMesh mesh = path.extension() == ".ply" ? io::readPlyMesh(path).mesh : io::readObj(path);
+    const double scale = m.at("scale").get<double>();
+    const Vec3 translate = sceneVector<3>(m.at("translate"));
+    for (Vec3& x : mesh.vertices) x = scale * x + translate;
+    return mesh;
+  }
+
+  std::string kind_, vertices_;
+  std::string source_, meshSource_, name_, meshFormat_;
+  StageTimers& timers_;
+  GridSpec<3> spec_;
+  double cfl_;
+  TriangleMesh mesh_;
+  solids::MassSpringSystem system_;
+  solids::BodyContact contact_;
+  std::vector<std::shared_ptr<const geometry::Shape3>> bodyShapes_;
+  solids::NewmarkStepper stepper_;
+  bool implicitSprings_ = true;
+  std::vector<double> springMass_;  // each spring's reduced mass (the free end's with one end pinned)
+  render::PreviewSettings preview_;
+  mutable Grid<float, 3> coverage_;
+  Grid<float, 3> solid_;
+  std::vector<turbulence::TurbulentWind<3>> winds_;
+  double windDrag_ = 0.0;
+  double time_ = 0.0;  // simulated [s]
+  long steps_ = 0, iterations_ = 0, unconverged_ = 0;
+  int contacts_ = 0;
+};
+
+std::unique_ptr<Phenomenon> createCloth(const Scene& scene, StageTimers& timers) {
+  return std::make_unique<MassSpringPhenomenon>(scene, timers, "cloth");
+}
+
+std::unique_ptr<Phenomenon> createSolid(const Scene& scene, StageTimers& timers) {
+  return std::make_unique<MassSpringPhenomenon>(scene, timers, "solid");
+}
+
+}  // namespace
+
+PhenomenonType clothPhenomenonType() {
+  return {"cloth", "a mass-spring cloth on bodies with friction (Selle ch. 5-6)", &declareCloth, &massSpringBytesPerCell,
+          &createCloth};
+}
+
+PhenomenonType solidPhenomenonType() {
+  return {"solid", "a mass-spring solid of BCC tetrahedra with altitude springs (Selle ch. 5)", &declareSolid,
+          &massSpringBytesPerCell, &createSolid};
+}
+
+}  // namespace msim::scene
