@@ -242,20 +242,30 @@ class MassSpringPhenomenon final : public Phenomenon {
   }
 
   io::Image preview() const override {
-    // The surface's triangles marked in the cells they pass through, seen as a dense medium.
+    // The cells the cloth's triangles, or the solid's tetrahedra, pass through, seen as a dense
+    // medium (a solid filled, not only its surface).
     coverage_.fill(0.0f);
-    for (const auto& t : mesh_.triangles) {
-      const Vec3 a = system_.x[t[0]], b = system_.x[t[1]], c = system_.x[t[2]];
-      const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+    auto mark = [&](const Vec3& x) {
+      const IVec3 cell = ((x - spec_.origin) / spec_.dx).array().floor().cast<int>();
+      if ((cell.array() >= 0).all() && (cell.array() < spec_.res.array()).all()) coverage_(cell) = 1.0f;
+    };
+    // Samples of the simplex spanned by corners[0..count) at about half a cell apart.
+    auto sampleSimplex = [&](const std::array<Vec3, 4>& corners, int count) {
+      double longest = 0.0;
+      for (int i = 0; i < count; ++i)
+        for (int j = i + 1; j < count; ++j) longest = std::max(longest, (corners[j] - corners[i]).norm());
       const int n = std::max(1, static_cast<int>(std::ceil(2.0 * longest / spec_.dx)));
       for (int i = 0; i <= n; ++i)
-        for (int j = 0; i + j <= n; ++j) {
-          const Vec3 x = a + (double(i) / n) * (b - a) + (double(j) / n) * (c - a);
-          const Vec3 s = (x - spec_.origin) / spec_.dx;
-          const IVec3 cell = s.array().floor().cast<int>();
-          if ((cell.array() < 0).any() || (cell.array() >= spec_.res.array()).any()) continue;
-          coverage_(cell) = 1.0f;
-        }
+        for (int j = 0; i + j <= n; ++j)
+          for (int k = 0; i + j + k <= (count == 4 ? n : 0); ++k)
+            mark(corners[0] + (double(i) / n) * (corners[1] - corners[0]) + (double(j) / n) * (corners[2] - corners[0]) +
+                 (count == 4 ? (double(k) / n) * (corners[3] - corners[0]) : Vec3(Vec3::Zero())));
+    };
+    if (system_.tetrahedra.empty()) {
+      for (const auto& t : mesh_.triangles) sampleSimplex({system_.x[t[0]], system_.x[t[1]], system_.x[t[2]], Vec3::Zero()}, 3);
+    } else {
+      for (const auto& t : system_.tetrahedra)
+        sampleSimplex({system_.x[t.v[0]], system_.x[t.v[1]], system_.x[t.v[2]], system_.x[t.v[3]]}, 4);
     }
     return render::renderDensityPreview(coverage_, preview_, bodyShapes_.empty() ? nullptr : &solid_);
   }
