@@ -4,6 +4,7 @@
 // springs back.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -76,6 +77,26 @@ TEST(ClothCli, WindPushesTheClothAlongItsNormal) {
   EXPECT_NEAR(meanZ("cloth_no_wind", scene), 0.0, 1e-9) << "without wind the cloth hangs in its plane";
   const std::string windy = replaced(scene, R"("bodies": [)", R"("winds": [{"speed_rms": 0.1, "mean_velocity": [0, 0, 5]}], "bodies": [)");
   EXPECT_GT(meanZ("cloth_wind", windy), 0.01) << "the wind should blow the cloth along +z";
+}
+
+TEST(ClothCli, StrainLimitHoldsASoftClothAtTheLimit) {
+  // A soft patch (k = 0.5 N) hanging from one edge stretches far beyond 10% without the limit and
+  // not beyond it with cloth.strain_limit = 0.1.
+  const std::string soft = replaced(tinyCloth(R"(, "edge_stiffness": 0.5, "density": 1.0,
+      "pins": [{"shape": {"type": "box", "min": [-1, 0.5, -0.31], "max": [1, 0.7, -0.29]}}])"),
+                                    R"("duration": 0.2)", R"("duration": 1.0)");
+  auto largestStretch = [&](const std::string& name, const std::string& text) {
+    const fs::path dir = scratch(name);
+    writeText(dir / "s.json", text);
+    const Result r = runMsim("run " + (dir / "s.json").string() + " -q --out " + (dir / "out").string());
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    const json run = readJson(dir / "out" / "run.json");
+    double largest = 0.0;
+    for (const json& f : run.at("frames")) largest = std::max(largest, f.at("max_strain").get<double>());
+    return largest;
+  };
+  EXPECT_GT(largestStretch("cloth_unlimited", replaced(soft, R"("edge_stiffness": 0.5)", R"("edge_stiffness": 0.5, "strain_limit": 0)")), 0.2);
+  EXPECT_LE(largestStretch("cloth_limited", soft), 0.12);
 }
 
 TEST(ClothCli, BadInputNamesTheKeyOrFile) {

@@ -22,6 +22,7 @@
 #include "msim/scene/turbulent_wind_keys.hpp"
 #include "msim/solids/cloth_mesh.hpp"
 #include "msim/solids/newmark.hpp"
+#include "msim/solids/strain_limit.hpp"
 #include "msim/solids/tet_mesh.hpp"
 
 namespace msim::scene {
@@ -32,15 +33,22 @@ using nlohmann::json;
 namespace fs = std::filesystem;
 
 constexpr double kExplodedStrain = 10.0;  // a spring stretched to 11 times its length: the run failed
+// Symmetric Gauss-Seidel sweeps of strain limiting per step: a hanging chain of 10 springs at 49%
+// stretch comes to rest at the limit (tests/solids/strain_limit_test.cpp).
+constexpr int kStrainLimitSweeps = 50;
 
 // The keys cloth and solid share, in their object: gravity, the solver, outputs, pins.
-void declareMassSpringKeys(Schema& object, const char* what) {
+void declareMassSpringKeys(Schema& object, const char* what, double strainLimit) {
   object.vector("gravity", "m/s^2", {0.0, -9.8, 0.0}, "acceleration of gravity").lengths({3});
   object.number("wind_drag", "kg/(m^2 s)", 1.0,
                 "c of the wind's drag c A ((u - v) . n) n on each surface triangle, along its normal (linear, as Selle "
                 "ch. 6's leaves), from winds[]")
       .min(0.0);
   object.boolean("implicit_springs", true, "springs implicit along themselves (Selle ch. 5.5)");
+  object.number("strain_limit", "", strainLimit,
+                "springs stretched further are shortened to this strain after every step (Provot 1995, Bridson et al. "
+                "2003); 0 = off")
+      .min(0.0);
   object.number("cg_tolerance", "", 1e-3, "relative residual of the step's solves (Table 6.1)").min(0.0, Bound::Exclusive).max(1.0);
   object.string("mesh_format", "ply", fmt::format("the {} surface mesh written per frame (mesh/<name>_NNNN.*): ply, obj, both or none", what))
       .choices({"ply", "obj", "both", "none"});
@@ -76,7 +84,7 @@ void declareCloth(Schema& root) {
   cloth.number("edge_damping", "N s/m", 0.01, "damping along the edge springs").min(0.0);
   cloth.number("bend_stiffness", "N", 2.0, "k of the bending springs across each interior edge").min(0.0);
   cloth.number("bend_damping", "N s/m", 0.001, "damping along the bending springs").min(0.0);
-  declareMassSpringKeys(cloth, "cloth");
+  declareMassSpringKeys(cloth, "cloth", 0.1);
   root.field("cloth", cloth);
   declareBodiesAndWinds(root);
 }
@@ -95,7 +103,7 @@ void declareSolid(Schema& root) {
                "the solid starts scaled by these factors about its centre (crushed: [1, 0.05, 1]) and springs back")
       .lengths({3})
       .min(0.0);
-  declareMassSpringKeys(solid, "solid's");
+  declareMassSpringKeys(solid, "solid's", 0.0);
   root.field("solid", solid);
   declareBodiesAndWinds(root);
 }
@@ -152,6 +160,7 @@ class MassSpringPhenomenon final : public Phenomenon {
     settings.implicitSprings = c.at("implicit_springs").get<bool>();
     settings.cgTolerance = c.at("cg_tolerance").get<double>();
     stepper_ = solids::NewmarkStepper(settings);
+    strainLimit_ = c.at("strain_limit").get<double>();
     implicitSprings_ = settings.implicitSprings;
     springMass_.resize(system_.springs.size());
     for (std::size_t i = 0; i < system_.springs.size(); ++i) {
@@ -195,6 +204,7 @@ class MassSpringPhenomenon final : public Phenomenon {
     }
     ScopedStage stage(timers_, kind_ == "cloth" ? "cloth: step" : "solid: step");
     const solids::NewmarkStats s = stepper_.step(system_, dt, contact_.empty() ? nullptr : &contact_);
+    if (strainLimit_ > 0.0) solids::limitStrain(system_, strainLimit_, kStrainLimitSweeps, dt);
     ++steps_;
     time_ += dt;
     iterations_ += s.iterations;
@@ -326,9 +336,11 @@ class MassSpringPhenomenon final : public Phenomenon {
     }
   }
 
+  // The largest stretch of any spring (compression, of bending springs across a fold above all, is
+  // not a failure).
   double maxStrain() const {
     double largest = 0.0;
-    for (std::size_t s = 0; s < system_.springs.size(); ++s) largest = std::max(largest, std::abs(system_.strain(s)));
+    for (std::size_t s = 0; s < system_.springs.size(); ++s) largest = std::max(largest, system_.strain(s));
     return largest;
   }
 
@@ -409,6 +421,7 @@ class MassSpringPhenomenon final : public Phenomenon {
   std::vector<std::shared_ptr<const geometry::Shape3>> bodyShapes_;
   solids::NewmarkStepper stepper_;
   bool implicitSprings_ = true;
+  double strainLimit_ = 0.0;
   std::vector<double> springMass_;  // each spring's reduced mass (the free end's with one end pinned)
   render::PreviewSettings preview_;
   mutable Grid<float, 3> coverage_;
