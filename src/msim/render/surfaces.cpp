@@ -66,7 +66,7 @@ void PointSet::validate() const {
 SurfaceScene::SurfaceScene(const std::vector<const TriangleMesh*>& meshes, const std::vector<PointSet>& points,
                            const Vec3& meshAlbedo)
     : meshes_(meshes), points_(points), meshAlbedo_(meshAlbedo) {
-  std::vector<Aabb> boxes;
+  std::vector<numerics::Aabb> boxes;
   for (std::size_t m = 0; m < meshes_.size(); ++m) {
     if (!meshes_[m]) throw std::invalid_argument("surfaces: mesh " + std::to_string(m) + " is null");
     const TriangleMesh& mesh = *meshes_[m];
@@ -78,7 +78,7 @@ SurfaceScene::SurfaceScene(const std::vector<const TriangleMesh*>& meshes, const
       const auto& [a, b, c] = mesh.triangles[t];
       const Vec3& va = mesh.vertices[static_cast<std::size_t>(a)];
       const Vec3 n = (mesh.vertices[static_cast<std::size_t>(b)] - va).cross(mesh.vertices[static_cast<std::size_t>(c)] - va);
-      Aabb box;
+      numerics::Aabb box;
       for (int k : mesh.triangles[t]) {
         normals[static_cast<std::size_t>(k)] += n;
         box.grow(mesh.vertices[static_cast<std::size_t>(k)]);
@@ -105,7 +105,7 @@ SurfaceScene::SurfaceScene(const std::vector<const TriangleMesh*>& meshes, const
       primitives_.push_back({static_cast<int>(s), static_cast<int>(i), true});
     }
   }
-  bvh_ = Bvh(boxes);
+  bvh_ = numerics::Bvh(boxes);
 }
 
 bool SurfaceScene::hitPrimitive(const Primitive& p, const Vec3& o, const Vec3& d, double& tMax, SurfaceHit* hit) const {

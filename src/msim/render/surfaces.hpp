@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "msim/core/triangle_mesh.hpp"
-#include "msim/render/bvh.hpp"
+#include "msim/numerics/bvh.hpp"
 #include "msim/render/camera.hpp"
 
 namespace msim::render {
@@ -59,7 +59,7 @@ class SurfaceScene {
   std::vector<PointSet> points_;
   Vec3 meshAlbedo_;
   std::vector<Primitive> primitives_;
-  Bvh bvh_;
+  numerics::Bvh bvh_;
 };
 
 // Index of the first mesh that encloses x, -1 if none: a ray from x crosses a closed surface an odd

@@ -20,7 +20,9 @@
 #include "msim/scene/scene_file.hpp"
 #include "msim/scene/schema/shape_schema.hpp"
 #include "msim/scene/turbulent_wind_keys.hpp"
+#include "msim/solids/cloth_collision_loop.hpp"
 #include "msim/solids/cloth_mesh.hpp"
+#include "msim/solids/collision/triangle_intersection.hpp"
 #include "msim/solids/newmark.hpp"
 #include "msim/solids/strain_limit.hpp"
 #include "msim/solids/tet_mesh.hpp"
@@ -52,8 +54,13 @@ void declareMassSpringKeys(Schema& object, const char* what, double strainLimit)
   object.number("cg_tolerance", "", 1e-3, "relative residual of the step's solves (Table 6.1)").min(0.0, Bound::Exclusive).max(1.0);
   object.string("mesh_format", "ply", fmt::format("the {} surface mesh written per frame (mesh/<name>_NNNN.*): ply, obj, both or none", what))
       .choices({"ply", "obj", "both", "none"});
-  Schema pin = Schema::object("vertices inside this shape do not move");
+  Schema pin = Schema::object("vertices inside this shape are scripted: still, or moving rigidly as given below");
   pin.field("shape", shapeSchema());
+  pin.vector("velocity", "m/s", {0.0, 0.0, 0.0}, "the pinned vertices translate at this velocity").lengths({3});
+  pin.vector("angular_velocity", "rad/s", {0.0, 0.0, 0.0},
+             "and turn at this angular velocity (world frame) about `center`, which moves with them")
+      .lengths({3});
+  pin.vector("center", "m", {0.0, 0.0, 0.0}, "the point the pinned vertices turn about, at t = 0").lengths({3});
   object.array("pins", pin, "pinned vertices");
 }
 
@@ -85,6 +92,14 @@ void declareCloth(Schema& root) {
   cloth.number("bend_stiffness", "N", 2.0, "k of the bending springs across each interior edge").min(0.0);
   cloth.number("bend_damping", "N s/m", 0.001, "damping along the bending springs").min(0.0);
   declareMassSpringKeys(cloth, "cloth", 0.1);
+  cloth.boolean("self_collisions", true,
+                "the outer collision loop of Selle ch. 6: history-based self-repulsion, continuous collision detection "
+                "and rigid impact zones keep the cloth from passing through itself");
+  cloth.number("thickness", "m", 0.01, "h of eqs. 6.1-6.2: the distance self-repulsion keeps (Table 6.1)")
+      .min(0.0, Bound::Exclusive);
+  cloth.number("repulsion_stiffness", "N/m", 0.0, "k of eq. 6.1; 0 = the edge springs' k / l0 (mean over the mesh)").min(0.0);
+  cloth.number("self_friction", "", 0.3, "mu of cloth sliding on itself").min(0.0);
+  cloth.integer("inner_steps", 16, "k_i: inner steps per outer collision step (Selle ch. 6.3: 4-16)").min(1).max(64);
   root.field("cloth", cloth);
   declareBodiesAndWinds(root);
 }
@@ -138,11 +153,16 @@ class MassSpringPhenomenon final : public Phenomenon {
       const std::string key = fmt::format("{}.pins[{}].shape", kind_, i);
       const auto shape = sceneShape<3>(scene, pins[i].at("shape"), key);
       int pinned = 0;
+      Script script{sceneVector<3>(pins[i].at("velocity")), sceneVector<3>(pins[i].at("angular_velocity")),
+                    sceneVector<3>(pins[i].at("center")), {}, {}};
       for (std::size_t v = 0; v < system_.size(); ++v)
-        if (shape->distance(system_.x[v]) <= 0.0) {
+        if (shape->distance(system_.x[v]) <= 0.0 && !system_.pinned[v]) {
           system_.pinned[v] = 1;
+          script.vertices.push_back(static_cast<int>(v));
+          script.rest.push_back(system_.x[v]);
           ++pinned;
         }
+      if (script.velocity.norm() > 0.0 || script.angularVelocity.norm() > 0.0) scripts_.push_back(std::move(script));
       if (pinned == 0) throw InputError(fmt::format("{}: '{}' holds no vertex of the {}: nothing to pin", source_, key, kind_));
     }
     const json& bodies = scene.resolved.at("bodies");
@@ -161,6 +181,7 @@ class MassSpringPhenomenon final : public Phenomenon {
     settings.cgTolerance = c.at("cg_tolerance").get<double>();
     stepper_ = solids::NewmarkStepper(settings);
     strainLimit_ = c.at("strain_limit").get<double>();
+    if (kind_ == "cloth" && c.at("self_collisions").get<bool>()) buildCollisionLoop(c, settings);
     implicitSprings_ = settings.implicitSprings;
     springMass_.resize(system_.springs.size());
     for (std::size_t i = 0; i < system_.springs.size(); ++i) {
@@ -180,11 +201,14 @@ class MassSpringPhenomenon final : public Phenomenon {
     }
   }
 
+  // With the collision loop a step is an outer step of up to k_i inner steps.
+  double stableTimestep() const override { return innerStableTimestep() * (loop_ ? loop_->settings().innerSteps : 1); }
+
   // The explicit part's limit 2 / omega over the springs. Explicit springs: omega^2 = k / (l0 mu)
   // along each. Implicit springs (ch. 5.5) are stable along themselves; what stays explicit is
   // the sideways stiffness of their tension T = k |strain|, omega^2 = T / (L mu), taken at a
   // strain of at least 1% (a slack cloth tightens within a step).
-  double stableTimestep() const override {
+  double innerStableTimestep() const {
     double step = std::numeric_limits<double>::infinity();
     for (std::size_t i = 0; i < system_.springs.size(); ++i) {
       const solids::Spring& s = system_.springs[i];
@@ -202,11 +226,18 @@ class MassSpringPhenomenon final : public Phenomenon {
       ScopedStage stage(timers_, kind_ == "cloth" ? "cloth: wind" : "solid: wind");
       windForces();
     }
-    ScopedStage stage(timers_, kind_ == "cloth" ? "cloth: step" : "solid: step");
-    const solids::NewmarkStats s = stepper_.step(system_, dt, contact_.empty() ? nullptr : &contact_);
-    if (strainLimit_ > 0.0) solids::limitStrain(system_, strainLimit_, kStrainLimitSweeps, dt);
+    scriptPins(time_, dt);
+    solids::NewmarkStats s;
+    if (loop_) {
+      s = collisionStep(dt);
+    } else {
+      ScopedStage stage(timers_, kind_ == "cloth" ? "cloth: step" : "solid: step");
+      s = stepper_.step(system_, dt, contact_.empty() ? nullptr : &contact_);
+      if (strainLimit_ > 0.0) solids::limitStrain(system_, strainLimit_, kStrainLimitSweeps, dt);
+    }
     ++steps_;
     time_ += dt;
+    placePins(time_);
     iterations_ += s.iterations;
     contacts_ = s.contacts;
     if (!s.converged) {
@@ -307,6 +338,23 @@ class MassSpringPhenomenon final : public Phenomenon {
             {"unconverged_solves", unconverged_},
             {"vertices", system_.size()},
             {"triangles", mesh_.triangles.size()}};
+    if (loop_) {
+      j["repulsion_pairs"] = last_.pointTrianglePairs + last_.edgeEdgePairs;
+      j["repulsions"] = last_.repulsions;
+      j["inner_steps"] = last_.innerSteps;
+      j["self_collisions"] = last_.collisions.collisions;
+      j["impact_zones"] = last_.collisions.impactZones;
+      j["collision_passes"] = last_.collisions.passes;
+      j["unresolved_collision_steps"] = unresolvedSteps_;
+    }
+    if (kind_ == "cloth") {
+      // The exact referee, independent of the collision handling (collision/triangle_intersection.hpp).
+      j["self_intersections"] = solids::countSelfIntersections(system_.x, mesh_.triangles);
+      long inside = 0;
+      for (std::size_t v = 0; v < system_.size(); ++v)
+        for (const auto& shape : bodyShapes_) inside += shape->distance(system_.x[v]) < -1e-9;
+      j["vertices_inside_bodies"] = inside;
+    }
     if (!system_.tetrahedra.empty()) {
       long inverted = 0;
       for (const solids::TetrahedronSpring& t : system_.tetrahedra) inverted += solids::tetrahedronVolume6(system_, t.v) <= 0.0;
@@ -334,6 +382,66 @@ class MassSpringPhenomenon final : public Phenomenon {
       const Vec3 f = windDrag_ * 0.5 * twiceArea * (wind - v).dot(n) * n;
       for (const int k : t) system_.external[static_cast<std::size_t>(k)] += f / 3.0;
     }
+  }
+
+  struct Script {  // pinned vertices that move (pins[].velocity, angular_velocity, center)
+    Vec3 velocity, angularVelocity, center;
+    std::vector<int> vertices;
+    std::vector<Vec3> rest;  // their positions at t = 0
+  };
+
+  // A scripted pin moves rigidly: x(t) = c + v t + R(omega t) (x(0) - c). Over a step its
+  // vertices move at the chord's velocity (x(t + dt) - x(t)) / dt, so the step's linear motion
+  // lands on the exact positions, which placePins then sets (no drift of the radius).
+  Vec3 scriptedPosition(const Script& script, const Vec3& rest, double t) const {
+    const double angle = script.angularVelocity.norm() * t;
+    const Vec3 arm = rest - script.center;
+    const Vec3 turned = angle > 0.0 ? Vec3(Eigen::AngleAxisd(angle, script.angularVelocity.normalized()) * arm) : arm;
+    return script.center + script.velocity * t + turned;
+  }
+  void scriptPins(double t, double dt) {
+    for (const Script& script : scripts_)
+      for (std::size_t k = 0; k < script.vertices.size(); ++k)
+        system_.v[static_cast<std::size_t>(script.vertices[k])] =
+            (scriptedPosition(script, script.rest[k], t + dt) - scriptedPosition(script, script.rest[k], t)) / dt;
+  }
+  void placePins(double t) {
+    for (const Script& script : scripts_)
+      for (std::size_t k = 0; k < script.vertices.size(); ++k)
+        system_.x[static_cast<std::size_t>(script.vertices[k])] = scriptedPosition(script, script.rest[k], t);
+  }
+
+  // One outer step of the collision loop (Selle ch. 6.2), its stages timed as Table 6.3's A, B, C.
+  solids::NewmarkStats collisionStep(double dt) {
+    last_ = loop_->step(system_, dt, [this] { return innerStableTimestep(); }, contact_.empty() ? nullptr : &contact_);
+    timers_.add("cloth: pairs (A)", last_.secondsPairs);
+    timers_.add("cloth: inner steps (B)", last_.secondsInner);
+    timers_.add("cloth: collisions (C)", last_.secondsCollisions);
+    if (last_.collisions.unresolved > 0) {
+      ++unresolvedSteps_;
+      logger().warn("cloth: {} self-collisions left unresolved after {} passes at step {} (impact zones of {} particles)",
+                    last_.collisions.unresolved, last_.collisions.passes, steps_ + 1, last_.collisions.zoneParticles);
+    }
+    return last_.newmark;
+  }
+
+  void buildCollisionLoop(const json& c, const solids::NewmarkSettings& newmark) {
+    solids::ClothCollisionSettings settings;
+    settings.innerSteps = static_cast<int>(c.at("inner_steps").get<long long>());
+    settings.repulsion.thickness = c.at("thickness").get<double>();
+    settings.repulsion.friction = c.at("self_friction").get<double>();
+    double stiffness = c.at("repulsion_stiffness").get<double>();
+    if (stiffness == 0.0) {
+      // The edge springs' k / l0 [N/m], averaged over the triangles' edges at rest.
+      double inverseLength = 0.0;
+      for (const auto& t : mesh_.triangles)
+        for (int k = 0; k < 3; ++k) inverseLength += 1.0 / (system_.x[t[k]] - system_.x[t[(k + 1) % 3]]).norm();
+      stiffness = c.at("edge_stiffness").get<double>() * inverseLength / (3.0 * static_cast<double>(mesh_.triangles.size()));
+    }
+    settings.repulsion.stiffness = stiffness;
+    settings.strainLimit = strainLimit_;
+    settings.strainLimitSweeps = kStrainLimitSweeps;
+    loop_ = std::make_unique<solids::ClothCollisionLoop>(mesh_.triangles, system_.size(), newmark, settings);
   }
 
   // The largest stretch of any spring (compression, of bending springs across a fold above all, is
@@ -420,6 +528,10 @@ class MassSpringPhenomenon final : public Phenomenon {
   solids::BodyContact contact_;
   std::vector<std::shared_ptr<const geometry::Shape3>> bodyShapes_;
   solids::NewmarkStepper stepper_;
+  std::vector<Script> scripts_;
+  std::unique_ptr<solids::ClothCollisionLoop> loop_;  // cloth with self-collisions
+  solids::ClothCollisionStats last_;                  // of the last outer step
+  long unresolvedSteps_ = 0;
   bool implicitSprings_ = true;
   double strainLimit_ = 0.0;
   std::vector<double> springMass_;  // each spring's reduced mass (the free end's with one end pinned)

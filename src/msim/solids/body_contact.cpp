@@ -48,4 +48,27 @@ Vec3 BodyContact::move(const Vec3& x, const Vec3& v, double dt, int& body) const
   return end;
 }
 
+int BodyContact::pushOut(Vec3& x) const {
+  int inside = -1;
+  for (std::size_t b = 0; b < bodies_.size(); ++b) {
+    const double depth = distance(b, x);
+    if (!(depth < 0.0)) continue;
+    x -= depth * normal(b, x);
+    inside = static_cast<int>(b);
+  }
+  return inside;
+}
+
+int BodyContact::pushOut(std::vector<Vec3>& x, std::vector<Vec3>& v, const std::vector<char>& pinned) const {
+  int moved = 0;
+  for (std::size_t p = 0; p < x.size(); ++p) {
+    if (pinned[p]) continue;
+    const int body = pushOut(x[p]);
+    if (body < 0) continue;
+    v[p] = gamma(static_cast<std::size_t>(body), x[p], v[p]);
+    ++moved;
+  }
+  return moved;
+}
+
 }  // namespace msim::solids

@@ -39,6 +39,12 @@ class BodyContact {
   // x(n+1); `body` is the body it met, or -1. The start's distance is phi(x(n)) + dt v_BN (a
   // moving body approaches).
   Vec3 move(const Vec3& x, const Vec3& v, double dt, int& body) const;
+  // Particles that corrections after the contact step (strain limiting, self-collisions) left
+  // inside a body are put back on its surface along its normal, their velocities through Gamma;
+  // pinned ones are left alone. Returns how many moved.
+  int pushOut(std::vector<Vec3>& x, std::vector<Vec3>& v, const std::vector<char>& pinned) const;
+  // The same for one position; returns the body it was inside, or -1.
+  int pushOut(Vec3& x) const;
 
  private:
   double distance(std::size_t b, const Vec3& x) const { return bodies_[b].shape->distance(x); }

@@ -16,12 +16,16 @@
 // With bodies (ch. 6.2 B, 6.5) the step becomes the seed's inner step without self-collisions:
 // step 2 moves each particle with BodyContact::move (cut where it meets a body, the rest of the
 // step with Gamma of its velocity); particles that met a body restart step 3 from Gamma(v(n)) and
-// end with Gamma of their new velocity (object friction, step B.7).
+// end with Gamma of their new velocity (object friction, step B.7). With self-repulsion the
+// velocity that moves the positions gets the inelastic and elastic repulsions before step 2 (step
+// B.2) and the end velocity the inelastic ones with friction (step B.8; self_repulsion.hpp).
+#include <array>
 #include <vector>
 
 #include "msim/core/vec.hpp"
 #include "msim/solids/body_contact.hpp"
 #include "msim/solids/mass_spring.hpp"
+#include "msim/solids/self_repulsion.hpp"
 
 namespace msim::solids {
 
@@ -35,13 +39,16 @@ struct NewmarkStats {
   int iterations = 0;        // CG iterations of the step's two solves
   bool converged = true;     // both reached the tolerance
   int contacts = 0;          // particles that met a body
+  int repulsions = 0;        // self-repulsion pairs closer than the thickness (step B.2)
 };
 
 class NewmarkStepper {
  public:
   explicit NewmarkStepper(const NewmarkSettings& settings = {}) : settings_(settings) {}
-  // Advances the system by dt, against `bodies` when given; std::invalid_argument for dt <= 0.
-  NewmarkStats step(MassSpringSystem& system, double dt, const BodyContact* bodies = nullptr);
+  // Advances the system by dt, against `bodies` and with `repulsion` when given;
+  // std::invalid_argument for dt <= 0.
+  NewmarkStats step(MassSpringSystem& system, double dt, const BodyContact* bodies = nullptr,
+                    const SelfRepulsion* repulsion = nullptr);
   const NewmarkSettings& settings() const { return settings_; }
 
  private:
@@ -52,6 +59,17 @@ class NewmarkStepper {
   NewmarkSettings settings_;
   std::vector<Vec3> forces_, start_, half_, mid_;
   std::vector<int> touched_;  // the body each particle met in the step, or -1
+  std::vector<double> inverseMass_;
+  // A term of the step's matrix: c (sum_i w_i v_i . d) d on each node i, weighted w_i.
+  struct Term {
+    std::array<int, 4> node{};
+    std::array<double, 4> weight{};
+    int count = 0;
+    Vec3 direction = Vec3::Zero();
+    double coefficient = 0.0;
+  };
+  std::vector<Term> terms_;
+  std::vector<Vec3> inverseDiagonal_, residual_, product_, search_, precond_;
 };
 
 }  // namespace msim::solids

@@ -1,9 +1,10 @@
-#include "msim/render/bvh.hpp"
+#include "msim/numerics/bvh.hpp"
 
 #include <algorithm>
 #include <array>
+#include <stdexcept>
 
-namespace msim::render {
+namespace msim::numerics {
 
 namespace {
 
@@ -104,4 +105,23 @@ void Bvh::build(int node, int begin, int end, int depth, const std::vector<Aabb>
   build(left + 1, mid, end, depth + 1, boxes, centres);
 }
 
-}  // namespace msim::render
+void Bvh::refit(const std::vector<Aabb>& boxes) {
+  if (boxes.size() != primitives_.size()) throw std::invalid_argument("Bvh::refit: the box count differs from the tree's");
+  if (!nodes_.empty()) refitNode(0, boxes);
+}
+
+void Bvh::refitNode(int node, const std::vector<Aabb>& boxes) {
+  Node& n = nodes_[static_cast<std::size_t>(node)];
+  Aabb box;
+  if (n.count > 0) {
+    for (int k = n.first; k < n.first + n.count; ++k) box.grow(boxes[static_cast<std::size_t>(primitives_[static_cast<std::size_t>(k)])]);
+  } else {
+    refitNode(n.first, boxes);
+    refitNode(n.first + 1, boxes);
+    box = nodes_[static_cast<std::size_t>(n.first)].box;
+    box.grow(nodes_[static_cast<std::size_t>(n.first) + 1].box);
+  }
+  nodes_[static_cast<std::size_t>(node)].box = box;
+}
+
+}  // namespace msim::numerics

@@ -1,15 +1,16 @@
 #pragma once
-// Bounding volume hierarchy over axis-aligned boxes, for the rays the renderer traces against
-// opaque primitives (triangles of meshes, spheres of point sets; surfaces.hpp). Built once per
-// render by the binned surface area heuristic; a query walks it with a fixed stack, so tracing
-// allocates nothing.
+// Bounding volume hierarchy over axis-aligned boxes: for the rays the renderer traces against
+// opaque primitives (render/surfaces.hpp), and for the boxes cloth collisions look for near
+// primitives with (solids/collision). Built by the binned surface area heuristic; a moving mesh
+// refits the boxes of the same tree (its topology kept, as Selle ch. 6.2 rebuilds only the
+// boxes); a query walks it with a fixed stack, so it allocates nothing.
 #include <limits>
 #include <utility>
 #include <vector>
 
 #include "msim/core/vec.hpp"
 
-namespace msim::render {
+namespace msim::numerics {
 
 struct Aabb {
   Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
@@ -24,6 +25,11 @@ struct Aabb {
     hi = hi.cwiseMax(b.hi);
   }
   Vec3 centre() const { return 0.5 * (lo + hi); }
+  bool overlaps(const Aabb& b) const { return (lo.array() <= b.hi.array()).all() && (b.lo.array() <= hi.array()).all(); }
+  void inflate(double margin) {
+    lo.array() -= margin;
+    hi.array() += margin;
+  }
   double halfArea() const {  // half the surface area: the SAH only compares areas
     const Vec3 e = (hi - lo).cwiseMax(0.0);
     return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
@@ -37,6 +43,28 @@ class Bvh {
   explicit Bvh(const std::vector<Aabb>& boxes);
 
   bool empty() const { return nodes_.empty(); }
+  // New boxes for the same primitives (as many as the tree was built with): the nodes' boxes are
+  // recomputed bottom up, the tree kept. Cheaper than a rebuild when the primitives move a little.
+  void refit(const std::vector<Aabb>& boxes);
+
+  // Calls f(primitive) for every primitive whose box overlaps `query`.
+  template <typename F>
+  void forEachOverlap(const Aabb& query, F&& f) const {
+    if (nodes_.empty()) return;
+    int stack[kMaxDepth + 2];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+      const Node& node = nodes_[static_cast<std::size_t>(stack[--top])];
+      if (!node.box.overlaps(query)) continue;
+      if (node.count > 0) {
+        for (int k = node.first; k < node.first + node.count; ++k) f(primitives_[static_cast<std::size_t>(k)]);
+        continue;
+      }
+      stack[top++] = node.first + 1;
+      stack[top++] = node.first;
+    }
+  }
 
   // Calls hit(primitive, tMax) for the primitives whose boxes the ray origin + t dir meets for t in
   // [0, tMax], near subtrees first; hit returns true when the primitive was hit before tMax (and
@@ -92,9 +120,10 @@ class Bvh {
   }
 
   void build(int node, int begin, int end, int depth, const std::vector<Aabb>& boxes, std::vector<Vec3>& centres);
+  void refitNode(int node, const std::vector<Aabb>& boxes);
 
   std::vector<Node> nodes_;
   std::vector<int> primitives_;
 };
 
-}  // namespace msim::render
+}  // namespace msim::numerics

@@ -1,0 +1,55 @@
+#pragma once
+// The broad phase of cloth collisions (Selle ch. 6.2 step A and 6.3 step C.2): candidate
+// point-triangle and edge-edge pairs of one triangle mesh whose boxes overlap, found with
+// bounding-volume trees over the triangles' and the edges' boxes. A primitive's box spans its
+// vertices at the start and at the end of a motion, grown by a margin: for a mesh at rest
+// (start = end) the pairs within the margin (repulsions, step A), for a moving one the pairs
+// that may meet during the motion (continuous collision detection, step C). The pruning is loose
+// on purpose (ch. 6.2): the narrow phase decides. Pairs that share a vertex are never reported
+// (a triangle's own vertices, edges meeting at a vertex).
+#include <array>
+#include <vector>
+
+#include "msim/core/vec.hpp"
+#include "msim/numerics/bvh.hpp"
+
+namespace msim::solids {
+
+struct PointTrianglePair {
+  int point = 0;     // vertex index
+  int triangle = 0;  // triangle index
+  bool operator<(const PointTrianglePair& o) const { return point != o.point ? point < o.point : triangle < o.triangle; }
+  bool operator==(const PointTrianglePair& o) const = default;
+};
+
+struct EdgeEdgePair {
+  int first = 0, second = 0;  // edge indices, first < second
+  bool operator<(const EdgeEdgePair& o) const { return first != o.first ? first < o.first : second < o.second; }
+  bool operator==(const EdgeEdgePair& o) const = default;
+};
+
+class CollisionPairs {
+ public:
+  // The mesh's triangles over `vertexCount` vertices; its edges are derived (each once).
+  CollisionPairs(std::vector<std::array<int, 3>> triangles, std::size_t vertexCount);
+
+  const std::vector<std::array<int, 3>>& triangles() const { return triangles_; }
+  const std::vector<std::array<int, 2>>& edges() const { return edges_; }
+
+  // Pairs whose boxes over `start` and `end` (the same vector for a mesh at rest), each grown by
+  // `margin`, overlap; sorted, so the result does not depend on the thread count. `moved`, when
+  // given, keeps only pairs with at least one vertex flagged (the later passes of step C.5).
+  void find(const std::vector<Vec3>& start, const std::vector<Vec3>& end, double margin,
+            std::vector<PointTrianglePair>& pointTriangle, std::vector<EdgeEdgePair>& edgeEdge,
+            const std::vector<char>* moved = nullptr);
+
+ private:
+  std::vector<std::array<int, 3>> triangles_;
+  std::vector<std::array<int, 2>> edges_;
+  std::size_t vertexCount_;
+  std::vector<numerics::Aabb> vertexBoxes_, triangleBoxes_, edgeBoxes_;
+  numerics::Bvh triangleTree_, edgeTree_;
+  long queries_ = 0;
+};
+
+}  // namespace msim::solids
