@@ -2,10 +2,20 @@
 // linear springs (ch. 5.5) at dt = 1/24 s: two half-step solves by CG (tolerance 1e-3, the seed's
 // Table 6.1). Argument: quads per side (triangles = 2 n^2). Counters: CG iterations per step,
 // particles, springs.
+// The collision loop's stages (ch. 6.2-6.3) on a cloth folded into pleats 1.5 thicknesses apart
+// (every layer near two others): step A, the pairs within the thickness with their sides, and
+// step C, continuous collision detection of a motion that shakes every vertex by up to 0.3
+// thicknesses (no crossing: the cost of proving that). Counters: pairs, collisions.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <random>
+
 #include "msim/solids/cloth_mesh.hpp"
+#include "msim/solids/collision_pairs.hpp"
 #include "msim/solids/newmark.hpp"
+#include "msim/solids/self_collision.hpp"
+#include "msim/solids/self_repulsion.hpp"
 
 using namespace msim;
 
@@ -29,6 +39,56 @@ void BM_ClothNewmarkStep(benchmark::State& state) {
   state.counters["springs"] = static_cast<double>(cloth.springs.size());
 }
 
+constexpr double kThickness = 0.002;  // below the edge length (1/224 m), as cloth.md asks
+
+// An n x n quad patch of 1 m folded every n / 16 rows into pleats 1.5 thicknesses apart.
+TriangleMesh pleatedCloth(int n) {
+  TriangleMesh mesh = solids::clothPatch(Vec3::Zero(), Vec3(1.0, 0.0, 0.0), Vec3(0.0, 0.0, 1.0), n, n);
+  const int rowsPerPleat = std::max(2, n / 16);
+  const double rowLength = 1.0 / n;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      const int pleat = j / rowsPerPleat, along = j % rowsPerPleat;
+      const double z = (pleat % 2 == 0 ? along : rowsPerPleat - along) * rowLength;
+      mesh.vertices[static_cast<std::size_t>(j * (n + 1) + i)] = Vec3(i * rowLength, pleat * 1.5 * kThickness, z);
+    }
+  return mesh;
+}
+
+void BM_ClothCollisionPairs(benchmark::State& state) {
+  const TriangleMesh mesh = pleatedCloth(static_cast<int>(state.range(0)));
+  solids::CollisionPairs pairs(mesh.triangles, mesh.vertices.size());
+  solids::RepulsionSettings settings;
+  settings.thickness = kThickness;
+  solids::SelfRepulsion repulsion(settings);
+  for (auto _ : state) repulsion.findPairs(pairs, mesh.vertices, mesh.vertices);
+  state.counters["pairs"] = repulsion.stats().pointTrianglePairs + repulsion.stats().edgeEdgePairs;
+  state.counters["triangles"] = static_cast<double>(mesh.triangles.size());
+}
+
+void BM_ClothContinuousCollisions(benchmark::State& state) {
+  const TriangleMesh mesh = pleatedCloth(static_cast<int>(state.range(0)));
+  solids::CollisionPairs pairs(mesh.triangles, mesh.vertices.size());
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> shake(-0.3 * kThickness, 0.3 * kThickness);
+  std::vector<Vec3> end = mesh.vertices;
+  for (Vec3& x : end) x += Vec3(shake(rng), shake(rng), shake(rng));
+  const std::vector<double> mass(mesh.vertices.size(), 1e-4);
+  const std::vector<char> pinned(mesh.vertices.size(), 0);
+  solids::RepulsionSettings repulsion;
+  repulsion.thickness = kThickness;
+  solids::SelfCollisionResolver resolver;
+  solids::SelfCollisionStats stats;
+  for (auto _ : state) {
+    std::vector<Vec3> x1 = end;
+    stats = resolver.resolve(pairs, mesh.vertices, x1, mass, pinned, 1.0 / 24.0, 1.0 / 192.0, repulsion);
+  }
+  state.counters["collisions"] = stats.collisions;
+  state.counters["triangles"] = static_cast<double>(mesh.triangles.size());
+}
+
 }  // namespace
 
 BENCHMARK(BM_ClothNewmarkStep)->Arg(64)->Arg(224)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ClothCollisionPairs)->Arg(224)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ClothContinuousCollisions)->Arg(224)->Unit(benchmark::kMillisecond);
