@@ -124,6 +124,26 @@ TEST(ClothCli, ScriptedPinsTurnExactlyAndTheClothStaysFreeOfIntersections) {
   }
 }
 
+TEST(ClothCli, AMovingBallPushesTheClothWithoutEnteringIt) {
+  // The patch falls onto the ball, which moves along +x at 0.5 m/s with friction 0.8: the cloth
+  // is carried along +x, and no vertex is ever inside the ball or below the floor.
+  const fs::path dir = scratch("cloth_moving_ball");
+  writeText(dir / "s.json", replaced(replaced(tinyCloth(), R"("friction": 0.5})", R"("friction": 0.8, "velocity": [0.5, 0, 0]})"),
+                                     R"("duration": 0.2)", R"("duration": 0.6)"));
+  const Result r = runMsim("run " + (dir / "s.json").string() + " -q --out " + (dir / "out").string());
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  const auto first = io::readPlyMesh(dir / "out" / "mesh" / "tiny_0001.ply").mesh;
+  const auto last = io::readPlyMesh(dir / "out" / "mesh" / "tiny_0006.ply").mesh;
+  double shift = 0.0;
+  for (std::size_t v = 0; v < first.vertices.size(); ++v) shift += (last.vertices[v][0] - first.vertices[v][0]) / first.vertices.size();
+  EXPECT_GT(shift, 0.05) << "carried along by the ball";
+  const json run = readJson(dir / "out" / "run.json");
+  for (const json& f : run.at("frames")) {
+    EXPECT_EQ(f.at("vertices_inside_bodies").get<long>(), 0);
+    EXPECT_EQ(f.at("self_intersections").get<long>(), 0);
+  }
+}
+
 TEST(ClothCli, BadInputNamesTheKeyOrFile) {
   expectInputError("cloth_pin_nothing", tinyCloth(R"(, "pins": [{"shape": {"type": "sphere", "center": [5, 5, 5], "radius": 0.1}}])"),
                    {"cloth.pins[0].shape", "no vertex"});

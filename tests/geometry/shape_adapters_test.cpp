@@ -1,4 +1,4 @@
-// Inverted (containers) and Sampled (a mesh's distance on a grid) against their exact shapes.
+// Inverted (containers), Translated (moving bodies) and Sampled (a mesh's distance on a grid) against their exact shapes.
 #include "msim/geometry/shape_adapters.hpp"
 
 #include <gtest/gtest.h>
@@ -15,6 +15,15 @@ TEST(ShapeAdapters, InvertedSwapsInsideAndOutside) {
   const Inverted<3> cavity(ball);
   EXPECT_DOUBLE_EQ(cavity.distance(Vec3(0.25, 0, 0)), 0.75);  // inside the ball = outside the solid
   EXPECT_DOUBLE_EQ(cavity.distance(Vec3(3, 0, 0)), -2.0);
+}
+
+TEST(ShapeAdapters, TranslatedMovesTheSurfaceAndTheBounds) {
+  const auto ball = std::make_shared<Sphere<3>>(Vec3(1, 0, 0), 0.5);
+  const Translated<3> moved(ball, Vec3(0, 2, 0));
+  EXPECT_DOUBLE_EQ(moved.distance(Vec3(1, 2, 0)), -0.5);  // the centre moved to (1, 2, 0)
+  EXPECT_DOUBLE_EQ(moved.distance(Vec3(1, 3, 0)), 0.5);
+  EXPECT_DOUBLE_EQ(moved.bounds().min[1], 1.5);
+  EXPECT_DOUBLE_EQ(moved.bounds().max[1], 2.5);
 }
 
 TEST(ShapeAdapters, SampledMatchesTheExactDistanceWithinTheSamplingError) {

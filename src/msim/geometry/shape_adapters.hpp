@@ -1,6 +1,6 @@
 #pragma once
-// Shapes made from other shapes: the complement (a container is everything outside its cavity)
-// and a grid-sampled copy (a mesh queried per particle and step is O(triangles) per call; a
+// Shapes made from other shapes: the complement (a container is everything outside its cavity),
+// a translated copy (a body moving without turning) and a grid-sampled copy (a mesh queried per particle and step is O(triangles) per call; a
 // sampled distance is O(1), exact enough within the sampling cell near the surface).
 #include <memory>
 
@@ -19,6 +19,22 @@ class Inverted final : public Shape<D> {
 
  private:
   std::shared_ptr<const Shape<D>> inner_;
+};
+
+// `inner` moved by `offset`: distance inner(x - offset).
+template <int D>
+class Translated final : public Shape<D> {
+ public:
+  Translated(std::shared_ptr<const Shape<D>> inner, const Vec<D>& offset) : inner_(std::move(inner)), offset_(offset) {}
+  double distance(const Vec<D>& x) const override { return inner_->distance(x - offset_); }
+  Bounds<D> bounds() const override {
+    const Bounds<D> b = inner_->bounds();
+    return {b.min + offset_, b.max + offset_};
+  }
+
+ private:
+  std::shared_ptr<const Shape<D>> inner_;
+  Vec<D> offset_;
 };
 
 // `exact` sampled at the cell centres of `spec` and interpolated D-linearly inside it; outside

@@ -13,6 +13,7 @@
 #include "msim/core/log.hpp"
 #include "msim/io/obj.hpp"
 #include "msim/io/ply.hpp"
+#include "msim/geometry/shape_adapters.hpp"
 #include "msim/io/vdb.hpp"
 #include "msim/render/density_preview.hpp"
 #include "msim/scene/json_vectors.hpp"
@@ -68,6 +69,7 @@ void declareBodiesAndWinds(Schema& root) {
   Schema body = Schema::object("a solid the cloth or solid lands on and slides over");
   body.field("shape", shapeSchema());
   body.number("friction", "", 0.3, "mu of Coulomb friction (Selle ch. 6.5)").min(0.0);
+  body.vector("velocity", "m/s", {0.0, 0.0, 0.0}, "the body translates at this velocity from its place at t = 0").lengths({3});
   root.array("bodies", body, "solids in contact");
   declareTurbulentWinds(root);
 }
@@ -173,8 +175,11 @@ class MassSpringPhenomenon final : public Phenomenon {
           throw InputError(fmt::format("{}: 'bodies[{}].shape' holds {} vertex {} at the start: the {} must begin "
                                        "outside the bodies",
                                        source_, i, kind_, v, kind_));
-      contact_.addBody({shape, Vec3::Zero(), bodies[i].at("friction").get<double>()});
-      bodyShapes_.push_back(std::move(shape));
+      const Vec3 velocity = sceneVector<3>(bodies[i].at("velocity"));
+      contactFriction_.push_back(bodies[i].at("friction").get<double>());
+      contact_.addBody({shape, velocity, bodies[i].at("friction").get<double>()});
+      bodyShapes_.push_back(shape);
+      bodyRest_.push_back({std::move(shape), velocity});
     }
     solids::NewmarkSettings settings;
     settings.implicitSprings = c.at("implicit_springs").get<bool>();
@@ -193,12 +198,7 @@ class MassSpringPhenomenon final : public Phenomenon {
     preview_ = previewSettings(scene);
     preview_.colour = {0.85f, 0.45f, 0.30f};
     coverage_ = Grid<float, 3>(spec_, 0.0f);
-    solid_ = Grid<float, 3>(spec_, 0.0f);
-    for (const auto& shape : bodyShapes_) {
-      const Grid<float, 3> d = shape->distanceField(spec_);
-      for (std::size_t i = 0; i < solid_.count(); ++i)
-        if (d[i] < 0.0f) solid_[i] = 1.0f;
-    }
+    markBodies();
   }
 
   // With the collision loop a step is an outer step of up to k_i inner steps.
@@ -227,6 +227,7 @@ class MassSpringPhenomenon final : public Phenomenon {
       windForces();
     }
     scriptPins(time_, dt);
+    moveBodies(time_ + dt);
     solids::NewmarkStats s;
     if (loop_) {
       s = collisionStep(dt);
@@ -308,11 +309,14 @@ class MassSpringPhenomenon final : public Phenomenon {
       for (const auto& t : system_.tetrahedra)
         sampleSimplex({system_.x[t.v[0]], system_.x[t.v[1]], system_.x[t.v[2]], system_.x[t.v[3]]}, 4);
     }
+    if (std::any_of(bodyRest_.begin(), bodyRest_.end(), [](const BodyAtRest& b) { return b.velocity.norm() > 0.0; }))
+      markBodies();
     return render::renderDensityPreview(coverage_, preview_, bodyShapes_.empty() ? nullptr : &solid_);
   }
 
   void restore(const fs::path& vdbFile, double time) override {
     time_ = time;
+    moveBodies(time);
     const io::VdbFile saved(vdbFile, io::VdbProvenance::MsimRun);
     const io::PointCloud cloud = saved.points(vertices_);
     if (cloud.positions.size() != system_.size())
@@ -389,6 +393,26 @@ class MassSpringPhenomenon final : public Phenomenon {
     std::vector<int> vertices;
     std::vector<Vec3> rest;  // their positions at t = 0
   };
+
+  // The cells inside the bodies as they stand, grey in the previews.
+  void markBodies() const {
+    solid_ = Grid<float, 3>(spec_, 0.0f);
+    for (const auto& shape : bodyShapes_) {
+      const Grid<float, 3> d = shape->distanceField(spec_);
+      for (std::size_t i = 0; i < solid_.count(); ++i)
+        if (d[i] < 0.0f) solid_[i] = 1.0f;
+    }
+  }
+
+  // Moving bodies (bodies[].velocity) as they stand at time t: the contact step evaluates them at
+  // the step's end (Selle ch. 6.5).
+  void moveBodies(double t) {
+    for (std::size_t b = 0; b < bodyRest_.size(); ++b) {
+      if (bodyRest_[b].velocity.norm() == 0.0) continue;
+      bodyShapes_[b] = std::make_shared<geometry::Translated<3>>(bodyRest_[b].shape, bodyRest_[b].velocity * t);
+      contact_.setBody(b, {bodyShapes_[b], bodyRest_[b].velocity, contactFriction_[b]});
+    }
+  }
 
   // A scripted pin moves rigidly: x(t) = c + v t + R(omega t) (x(0) - c). Over a step its
   // vertices move at the chord's velocity (x(t + dt) - x(t)) / dt, so the step's linear motion
@@ -526,7 +550,13 @@ class MassSpringPhenomenon final : public Phenomenon {
   TriangleMesh mesh_;
   solids::MassSpringSystem system_;
   solids::BodyContact contact_;
-  std::vector<std::shared_ptr<const geometry::Shape3>> bodyShapes_;
+  std::vector<std::shared_ptr<const geometry::Shape3>> bodyShapes_;  // as they stand now
+  struct BodyAtRest {
+    std::shared_ptr<const geometry::Shape3> shape;  // at t = 0
+    Vec3 velocity;
+  };
+  std::vector<BodyAtRest> bodyRest_;
+  std::vector<double> contactFriction_;
   solids::NewmarkStepper stepper_;
   std::vector<Script> scripts_;
   std::unique_ptr<solids::ClothCollisionLoop> loop_;  // cloth with self-collisions
@@ -537,7 +567,7 @@ class MassSpringPhenomenon final : public Phenomenon {
   std::vector<double> springMass_;  // each spring's reduced mass (the free end's with one end pinned)
   render::PreviewSettings preview_;
   mutable Grid<float, 3> coverage_;
-  Grid<float, 3> solid_;
+  mutable Grid<float, 3> solid_;
   std::vector<turbulence::TurbulentWind<3>> winds_;
   double windDrag_ = 0.0;
   double time_ = 0.0;  // simulated [s]

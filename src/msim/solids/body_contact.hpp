@@ -31,6 +31,8 @@ class BodyContact {
  public:
   explicit BodyContact(ContactMethod method = ContactMethod::CrossingFraction) : method_(method) {}
   void addBody(ContactBody body) { bodies_.push_back(std::move(body)); }
+  // Replaces body b (a moving body's shape at the end of the next step).
+  void setBody(std::size_t b, ContactBody body) { bodies_.at(b) = std::move(body); }
   bool empty() const { return bodies_.empty(); }
 
   // Gamma for body b at x (its outward normal there) applied to v.
