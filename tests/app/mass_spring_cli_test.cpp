@@ -151,6 +151,7 @@ TEST(ClothCli, BadInputNamesTheKeyOrFile) {
                    replaced(tinyCloth(), R"("center": [0, 0.3, 0], "radius": 0.2)", R"("center": [0, 0.6, 0], "radius": 0.2)"),
                    {"bodies[0].shape"});
   expectInputError("cloth_stiffness", tinyCloth(R"(, "edge_stiffness": 0)"), {"cloth.edge_stiffness"});
+  expectInputError("cloth_thickness", tinyCloth(R"(, "thickness": 0.1)"), {"cloth.thickness", "edge length"});
   // A mesh with an edge shared by three triangles.
   const fs::path dir = scratch("cloth_fan_mesh");
   writeText(dir / "fan.obj", "v 0 0.5 0\nv 0.1 0.5 0\nv 0 0.6 0\nv 0 0.5 0.1\nv 0 0.4 0\nf 1 2 3\nf 1 2 4\nf 1 2 5\n");

@@ -453,6 +453,18 @@ class MassSpringPhenomenon final : public Phenomenon {
     solids::ClothCollisionSettings settings;
     settings.innerSteps = static_cast<int>(c.at("inner_steps").get<long long>());
     settings.repulsion.thickness = c.at("thickness").get<double>();
+    // Repulsion holds apart the closest points of edges that share no vertex; with a thickness
+    // above the edge length, neighbouring edges of a flat sheet are such pairs, and the cloth
+    // would push itself apart.
+    std::vector<double> lengths;
+    for (const auto& t : mesh_.triangles)
+      for (int k = 0; k < 3; ++k) lengths.push_back((system_.x[t[k]] - system_.x[t[(k + 1) % 3]]).norm());
+    std::nth_element(lengths.begin(), lengths.begin() + lengths.size() / 2, lengths.end());
+    const double median = lengths[lengths.size() / 2];
+    if (!(settings.repulsion.thickness < median))
+      throw InputError(fmt::format("{}: 'cloth.thickness' {:.3g} m is not below the mesh's median edge length {:.3g} m: "
+                                   "neighbouring edges would repel each other; lower it or refine the mesh",
+                                   source_, settings.repulsion.thickness, median));
     settings.repulsion.friction = c.at("self_friction").get<double>();
     double stiffness = c.at("repulsion_stiffness").get<double>();
     if (stiffness == 0.0) {
