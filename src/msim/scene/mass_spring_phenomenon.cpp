@@ -437,7 +437,9 @@ class MassSpringPhenomenon final : public Phenomenon {
 
   // One outer step of the collision loop (Selle ch. 6.2), its stages timed as Table 6.3's A, B, C.
   solids::NewmarkStats collisionStep(double dt) {
-    last_ = loop_->step(system_, dt, [this] { return innerStableTimestep(); }, contact_.empty() ? nullptr : &contact_);
+    const double start = time_;
+    last_ = loop_->step(system_, dt, [this] { return innerStableTimestep(); }, contact_.empty() ? nullptr : &contact_,
+                        [this, start](double t) { moveBodies(start + t); });
     timers_.add("cloth: pairs (A)", last_.secondsPairs);
     timers_.add("cloth: inner steps (B)", last_.secondsInner);
     timers_.add("cloth: collisions (C)", last_.secondsCollisions);

@@ -30,7 +30,7 @@ ClothCollisionLoop::ClothCollisionLoop(std::vector<std::array<int, 3>> triangles
 }
 
 ClothCollisionStats ClothCollisionLoop::step(MassSpringSystem& system, double T, const std::function<double()>& innerLimit,
-                                             const BodyContact* bodies) {
+                                             const BodyContact* bodies, const std::function<void(double)>& placeBodies) {
   if (!(T > 0.0)) throw std::invalid_argument("cloth collisions: the outer step must be > 0");
   ClothCollisionStats stats;
   const std::size_t n = system.size();
@@ -63,6 +63,7 @@ ClothCollisionStats ClothCollisionLoop::step(MassSpringSystem& system, double T,
     const double innerDt = remaining / std::ceil(remaining / limit - 1e-9);  // the rest in equal steps within the limit
     elapsed += innerDt;
     ++stats.innerSteps;
+    if (placeBodies) placeBodies(elapsed);
     const NewmarkStats s = stepper_.step(system, innerDt, bodies, &repulsion_);
     if (settings_.strainLimit > 0.0) {
       limitStrain(system, settings_.strainLimit, settings_.strainLimitSweeps, innerDt);

@@ -54,8 +54,10 @@ class ClothCollisionLoop {
   // left of T equally within the stable step innerLimit(), asked before each (the cloth's tension
   // changes it). The caller makes T about k_i stable steps; a step cut short by a frame's end
   // takes fewer.
+  // placeBodies(t), when given, is called before each inner step with the time t (from the outer
+  // step's start) at which it ends, so that moving bodies stand where the step ends (ch. 6.5).
   ClothCollisionStats step(MassSpringSystem& system, double T, const std::function<double()>& innerLimit,
-                           const BodyContact* bodies);
+                           const BodyContact* bodies, const std::function<void(double)>& placeBodies = {});
 
   const ClothCollisionSettings& settings() const { return settings_; }
 
