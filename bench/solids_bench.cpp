@@ -5,13 +5,15 @@
 // The collision loop's stages (ch. 6.2-6.3) on a cloth folded into pleats 1.5 thicknesses apart
 // (every layer near two others): step A, the pairs within the thickness with their sides, and
 // step C, continuous collision detection of a motion that shakes every vertex by up to 0.3
-// thicknesses (no crossing: the cost of proving that). Counters: pairs, collisions.
+// thicknesses (no crossing: the cost of proving that). Counters: pairs, collisions. And the exact
+// intersection referee (collision/triangle_intersection.hpp) counting the same folded cloth.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
 #include <random>
 
 #include "msim/solids/cloth_mesh.hpp"
+#include "msim/solids/collision/triangle_intersection.hpp"
 #include "msim/solids/collision_pairs.hpp"
 #include "msim/solids/newmark.hpp"
 #include "msim/solids/self_collision.hpp"
@@ -87,8 +89,17 @@ void BM_ClothContinuousCollisions(benchmark::State& state) {
   state.counters["triangles"] = static_cast<double>(mesh.triangles.size());
 }
 
+void BM_IntersectionReferee(benchmark::State& state) {
+  const TriangleMesh mesh = pleatedCloth(static_cast<int>(state.range(0)));
+  std::size_t found = 0;
+  for (auto _ : state) found = solids::countSelfIntersections(mesh.vertices, mesh.triangles);
+  state.counters["intersections"] = static_cast<double>(found);
+  state.counters["triangles"] = static_cast<double>(mesh.triangles.size());
+}
+
 }  // namespace
 
 BENCHMARK(BM_ClothNewmarkStep)->Arg(64)->Arg(224)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ClothCollisionPairs)->Arg(224)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ClothContinuousCollisions)->Arg(224)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_IntersectionReferee)->Arg(224)->Unit(benchmark::kMillisecond);

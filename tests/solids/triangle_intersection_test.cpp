@@ -5,7 +5,6 @@
 // counts of intersecting pairs between and within constructed meshes.
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <cmath>
 #include <vector>
 
@@ -287,15 +286,12 @@ TEST(Intersection, CountsPairsBetweenAndWithinMeshes) {
   EXPECT_EQ(wallPairs, 2u * (30u + 1u));
 }
 
-TEST(Intersection, LargeMeshCountsQuickly) {
-  // 100,352 triangles, gently crumpled so that no two non-neighbours meet. The grid keeps the broad
-  // phase linear (all pairs would be 5e9 box tests); sanitized builds check a smaller sheet.
+TEST(Intersection, LargeCrumpledMeshHasNone) {
+  // 100,352 triangles, gently crumpled so that no two non-neighbours meet (the grid broad phase
+  // keeps this linear; its time is in bench/solids_bench.cpp); sanitized builds check a smaller
+  // sheet.
   Mesh grid = flatGrid(MSIM_SANITIZE ? 60 : 224);
   Rng rng(37);
   for (Vec3& v : grid.x) v.z() = 0.05 * rng.uniform();
-  const auto start = std::chrono::steady_clock::now();
   EXPECT_EQ(countSelfIntersections(grid.x, grid.triangles), 0u);
-#ifdef NDEBUG  // the time of optimised builds only
-  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 1.0);
-#endif
 }
