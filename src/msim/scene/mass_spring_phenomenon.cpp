@@ -176,10 +176,10 @@ class MassSpringPhenomenon final : public Phenomenon {
                                        "outside the bodies",
                                        source_, i, kind_, v, kind_));
       const Vec3 velocity = sceneVector<3>(bodies[i].at("velocity"));
-      contactFriction_.push_back(bodies[i].at("friction").get<double>());
-      contact_.addBody({shape, velocity, bodies[i].at("friction").get<double>()});
-      bodyShapes_.push_back(shape);
-      bodyRest_.push_back({std::move(shape), velocity});
+      const solids::ContactBody body{std::move(shape), velocity, bodies[i].at("friction").get<double>()};
+      contact_.addBody(body);
+      bodyShapes_.push_back(body.shape);
+      bodyRest_.push_back(body);
     }
     solids::NewmarkSettings settings;
     settings.implicitSprings = c.at("implicit_springs").get<bool>();
@@ -227,14 +227,17 @@ class MassSpringPhenomenon final : public Phenomenon {
       windForces();
     }
     scriptPins(time_, dt);
-    moveBodies(time_ + dt);
     solids::NewmarkStats s;
     if (loop_) {
-      s = collisionStep(dt);
+      s = collisionStep(dt);  // places moving bodies before each inner step
     } else {
       ScopedStage stage(timers_, kind_ == "cloth" ? "cloth: step" : "solid: step");
+      moveBodies(time_ + dt);
       s = stepper_.step(system_, dt, contact_.empty() ? nullptr : &contact_);
-      if (strainLimit_ > 0.0) solids::limitStrain(system_, strainLimit_, kStrainLimitSweeps, dt);
+      if (strainLimit_ > 0.0) {
+        solids::limitStrain(system_, strainLimit_, kStrainLimitSweeps, dt);
+        if (!contact_.empty()) contact_.pushOut(system_.x, system_.v, system_.pinned);
+      }
     }
     ++steps_;
     time_ += dt;
@@ -309,7 +312,7 @@ class MassSpringPhenomenon final : public Phenomenon {
       for (const auto& t : system_.tetrahedra)
         sampleSimplex({system_.x[t.v[0]], system_.x[t.v[1]], system_.x[t.v[2]], system_.x[t.v[3]]}, 4);
     }
-    if (std::any_of(bodyRest_.begin(), bodyRest_.end(), [](const BodyAtRest& b) { return b.velocity.norm() > 0.0; }))
+    if (std::any_of(bodyRest_.begin(), bodyRest_.end(), [](const solids::ContactBody& b) { return b.velocity.norm() > 0.0; }))
       markBodies();
     return render::renderDensityPreview(coverage_, preview_, bodyShapes_.empty() ? nullptr : &solid_);
   }
@@ -410,7 +413,7 @@ class MassSpringPhenomenon final : public Phenomenon {
     for (std::size_t b = 0; b < bodyRest_.size(); ++b) {
       if (bodyRest_[b].velocity.norm() == 0.0) continue;
       bodyShapes_[b] = std::make_shared<geometry::Translated<3>>(bodyRest_[b].shape, bodyRest_[b].velocity * t);
-      contact_.setBody(b, {bodyShapes_[b], bodyRest_[b].velocity, contactFriction_[b]});
+      contact_.setBody(b, {bodyShapes_[b], bodyRest_[b].velocity, bodyRest_[b].friction});
     }
   }
 
@@ -458,9 +461,13 @@ class MassSpringPhenomenon final : public Phenomenon {
     // Repulsion holds apart the closest points of edges that share no vertex; with a thickness
     // above the edge length, neighbouring edges of a flat sheet are such pairs, and the cloth
     // would push itself apart.
-    std::vector<double> lengths;
+    std::vector<double> lengths;  // of the triangles' edges at rest (interior edges twice)
+    double inverseLength = 0.0;
     for (const auto& t : mesh_.triangles)
-      for (int k = 0; k < 3; ++k) lengths.push_back((system_.x[t[k]] - system_.x[t[(k + 1) % 3]]).norm());
+      for (int k = 0; k < 3; ++k) {
+        lengths.push_back((system_.x[t[k]] - system_.x[t[(k + 1) % 3]]).norm());
+        inverseLength += 1.0 / lengths.back();
+      }
     std::nth_element(lengths.begin(), lengths.begin() + lengths.size() / 2, lengths.end());
     const double median = lengths[lengths.size() / 2];
     if (!(settings.repulsion.thickness < median))
@@ -469,13 +476,8 @@ class MassSpringPhenomenon final : public Phenomenon {
                                    source_, settings.repulsion.thickness, median));
     settings.repulsion.friction = c.at("self_friction").get<double>();
     double stiffness = c.at("repulsion_stiffness").get<double>();
-    if (stiffness == 0.0) {
-      // The edge springs' k / l0 [N/m], averaged over the triangles' edges at rest.
-      double inverseLength = 0.0;
-      for (const auto& t : mesh_.triangles)
-        for (int k = 0; k < 3; ++k) inverseLength += 1.0 / (system_.x[t[k]] - system_.x[t[(k + 1) % 3]]).norm();
-      stiffness = c.at("edge_stiffness").get<double>() * inverseLength / (3.0 * static_cast<double>(mesh_.triangles.size()));
-    }
+    if (stiffness == 0.0)  // the edge springs' k / l0 [N/m], averaged over the triangles' edges
+      stiffness = c.at("edge_stiffness").get<double>() * inverseLength / static_cast<double>(lengths.size());
     settings.repulsion.stiffness = stiffness;
     settings.strainLimit = strainLimit_;
     settings.strainLimitSweeps = kStrainLimitSweeps;
@@ -565,12 +567,7 @@ class MassSpringPhenomenon final : public Phenomenon {
   solids::MassSpringSystem system_;
   solids::BodyContact contact_;
   std::vector<std::shared_ptr<const geometry::Shape3>> bodyShapes_;  // as they stand now
-  struct BodyAtRest {
-    std::shared_ptr<const geometry::Shape3> shape;  // at t = 0
-    Vec3 velocity;
-  };
-  std::vector<BodyAtRest> bodyRest_;
-  std::vector<double> contactFriction_;
+  std::vector<solids::ContactBody> bodyRest_;  // as they stand at t = 0
   solids::NewmarkStepper stepper_;
   std::vector<Script> scripts_;
   std::unique_ptr<solids::ClothCollisionLoop> loop_;  // cloth with self-collisions

@@ -5,8 +5,6 @@
 #include <stdexcept>
 #include <string>
 
-#include <tbb/enumerable_thread_specific.h>
-
 #include "msim/core/parallel.hpp"
 
 namespace msim::solids {
@@ -21,11 +19,15 @@ bool sharesVertex(const std::array<int, 2>& e, const std::array<int, 2>& f) {
   return e[0] == f[0] || e[0] == f[1] || e[1] == f[0] || e[1] == f[1];
 }
 
-// Per-thread pair lists, concatenated and sorted: the same result whatever the thread count.
+// Per-thread pair lists, concatenated and sorted: the same result whatever the thread count. The
+// lists are emptied for the next query, keeping their memory.
 template <typename Pair>
 void gather(tbb::enumerable_thread_specific<std::vector<Pair>>& local, std::vector<Pair>& out) {
   out.clear();
-  for (auto& part : local) out.insert(out.end(), part.begin(), part.end());
+  for (auto& part : local) {
+    out.insert(out.end(), part.begin(), part.end());
+    part.clear();
+  }
   std::sort(out.begin(), out.end());
 }
 
@@ -80,11 +82,10 @@ void CollisionPairs::find(const std::vector<Vec3>& start, const std::vector<Vec3
   ++queries_;
   const auto isMoved = [&](int v) { return moved == nullptr || (*moved)[static_cast<std::size_t>(v)] != 0; };
 
-  tbb::enumerable_thread_specific<std::vector<PointTrianglePair>> localPointTriangle;
   parallelFor(
       0, vertexCount_,
       [&](std::size_t v) {
-        auto& out = localPointTriangle.local();
+        auto& out = localPointTriangle_.local();
         const int point = static_cast<int>(v);
         triangleTree_.forEachOverlap(vertexBoxes_[v], [&](int t) {
           const auto& tri = triangles_[static_cast<std::size_t>(t)];
@@ -94,13 +95,12 @@ void CollisionPairs::find(const std::vector<Vec3>& start, const std::vector<Vec3
         });
       },
       256);
-  gather(localPointTriangle, pointTriangle);
+  gather(localPointTriangle_, pointTriangle);
 
-  tbb::enumerable_thread_specific<std::vector<EdgeEdgePair>> localEdgeEdge;
   parallelFor(
       0, edges_.size(),
       [&](std::size_t e) {
-        auto& out = localEdgeEdge.local();
+        auto& out = localEdgeEdge_.local();
         const auto& edge = edges_[e];
         edgeTree_.forEachOverlap(edgeBoxes_[e], [&](int f) {
           if (f <= static_cast<int>(e)) return;  // each pair once
@@ -111,7 +111,7 @@ void CollisionPairs::find(const std::vector<Vec3>& start, const std::vector<Vec3
         });
       },
       256);
-  gather(localEdgeEdge, edgeEdge);
+  gather(localEdgeEdge_, edgeEdge);
 }
 
 }  // namespace msim::solids

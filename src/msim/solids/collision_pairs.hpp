@@ -10,6 +10,8 @@
 #include <array>
 #include <vector>
 
+#include <tbb/enumerable_thread_specific.h>
+
 #include "msim/core/vec.hpp"
 #include "msim/numerics/bvh.hpp"
 
@@ -50,6 +52,8 @@ class CollisionPairs {
   std::vector<numerics::Aabb> vertexBoxes_, triangleBoxes_, edgeBoxes_;
   numerics::Bvh triangleTree_, edgeTree_;
   long queries_ = 0;
+  tbb::enumerable_thread_specific<std::vector<PointTrianglePair>> localPointTriangle_;  // per-thread finds
+  tbb::enumerable_thread_specific<std::vector<EdgeEdgePair>> localEdgeEdge_;
 };
 
 }  // namespace msim::solids

@@ -6,6 +6,11 @@
 
 namespace msim::solids {
 
+void inverseMasses(const std::vector<double>& mass, const std::vector<char>& pinned, std::vector<double>& out) {
+  out.resize(mass.size());
+  for (std::size_t p = 0; p < mass.size(); ++p) out[p] = pinned[p] ? 0.0 : 1.0 / mass[p];
+}
+
 int MassSpringSystem::addParticle(const Vec3& position, double particleMass, const Vec3& velocity) {
   if (!(particleMass > 0.0)) throw std::invalid_argument("mass-spring system: a particle's mass must be > 0");
   x.push_back(position);

@@ -32,6 +32,9 @@ struct TetrahedronSpring {
   double damping = 0.0;    // [N s/m] along the altitude
 };
 
+// 1 / m per particle, 0 for pinned ones (they take no impulse), into `out`.
+void inverseMasses(const std::vector<double>& mass, const std::vector<char>& pinned, std::vector<double>& out);
+
 struct MassSpringSystem {
   std::vector<Vec3> x, v;       // positions [m] and velocities [m/s]
   std::vector<double> mass;     // [kg], > 0
@@ -42,6 +45,7 @@ struct MassSpringSystem {
   std::vector<Vec3> external;           // per particle [N] (wind drag), held through a step; empty: none
 
   std::size_t size() const { return x.size(); }
+  double inverseMass(std::size_t p) const { return pinned[p] ? 0.0 : 1.0 / mass[p]; }
   // Adds a particle; returns its index.
   int addParticle(const Vec3& position, double particleMass, const Vec3& velocity = Vec3::Zero());
   // Adds a spring between a and b at rest at their current distance. std::invalid_argument for

@@ -125,8 +125,7 @@ NewmarkStats NewmarkStepper::step(MassSpringSystem& system, double dt, const Bod
   start_ = system.v;
   NewmarkStats first = solveHalfStep(system, system.x, start_, h, half_);
   if (repulsion) {
-    inverseMass_.resize(n);
-    for (std::size_t p = 0; p < n; ++p) inverseMass_[p] = system.pinned[p] ? 0.0 : 1.0 / system.mass[p];
+    inverseMasses(system.mass, system.pinned, inverseMass_);
     first.repulsions = repulsion->repelPositionVelocity(system.x, half_, inverseMass_, dt);
   }
   mid_.resize(n);

@@ -4,13 +4,13 @@
 #include <cmath>
 
 #include <Eigen/Geometry>
-#include <tbb/enumerable_thread_specific.h>
 
 #include "msim/core/parallel.hpp"
 #include "msim/solids/collision/ccd.hpp"
 #include "msim/solids/collision/impact_zone.hpp"
 #include "msim/solids/collision/proximity.hpp"
 #include "msim/solids/contact_stencil.hpp"
+#include "msim/solids/mass_spring.hpp"
 
 namespace msim::solids {
 
@@ -36,25 +36,27 @@ std::array<int, 4> SelfCollisionResolver::particles(const CollisionPairs& pairs,
 
 void SelfCollisionResolver::detect(const CollisionPairs& pairs, const std::vector<Vec3>& x0, const std::vector<Vec3>& x1) {
   const std::size_t nPoint = candidatesPointTriangle_.size(), n = nPoint + candidatesEdgeEdge_.size();
+  // Candidate k: the point-triangle pairs, then the edge-edge pairs.
+  const auto candidate = [&](std::size_t k) {
+    return k < nPoint ? Crossing{true, candidatesPointTriangle_[k].point, candidatesPointTriangle_[k].triangle}
+                      : Crossing{false, candidatesEdgeEdge_[k - nPoint].first, candidatesEdgeEdge_[k - nPoint].second};
+  };
   // One flag per candidate, filled in parallel, then read in order: deterministic.
-  std::vector<char> hit(n, 0);
+  hit_.assign(n, 0);
   parallelFor(
       0, n,
       [&](std::size_t k) {
-        const Crossing c = k < nPoint ? Crossing{true, candidatesPointTriangle_[k].point, candidatesPointTriangle_[k].triangle}
-                                      : Crossing{false, candidatesEdgeEdge_[k - nPoint].first, candidatesEdgeEdge_[k - nPoint].second};
+        const Crossing c = candidate(k);
         const std::array<int, 4> nodes = particles(pairs, c);
         const auto a0 = gatherPositions(nodes, x0), a1 = gatherPositions(nodes, x1);
         const auto t = c.pointTriangle ? pointTriangleCollisionTime(a0, a1, settings_.tolerance)
                                        : edgeEdgeCollisionTime(a0, a1, settings_.tolerance);
-        hit[k] = t.has_value() ? 1 : 0;
+        hit_[k] = t.has_value() ? 1 : 0;
       },
       64);
   crossings_.clear();
   for (std::size_t k = 0; k < n; ++k)
-    if (hit[k])
-      crossings_.push_back(k < nPoint ? Crossing{true, candidatesPointTriangle_[k].point, candidatesPointTriangle_[k].triangle}
-                                      : Crossing{false, candidatesEdgeEdge_[k - nPoint].first, candidatesEdgeEdge_[k - nPoint].second});
+    if (hit_[k]) crossings_.push_back(candidate(k));
 }
 
 bool SelfCollisionResolver::respond(const CollisionPairs& pairs, const Crossing& c, const std::vector<Vec3>& x0,
@@ -111,15 +113,14 @@ SelfCollisionStats SelfCollisionResolver::resolve(CollisionPairs& pairs, const s
                                                   double innerDt, const RepulsionSettings& repulsion,
                                                   const BodyContact* bodies) {
   const std::size_t n = x0.size();
-  inverseMass_.resize(n);
-  for (std::size_t p = 0; p < n; ++p) inverseMass_[p] = pinned[p] ? 0.0 : 1.0 / mass[p];
+  inverseMasses(mass, pinned, inverseMass_);
   velocity_.assign(n, Vec3::Zero());
   SelfCollisionStats stats;
-  std::vector<char> movedThisPass(n, 1);
+  movedThisPass_.assign(n, 1);
   ImpactZones zones(static_cast<int>(n));
   const int totalPasses = settings_.gaussSeidelPasses + settings_.impactZonePasses;
   for (int pass = 0; pass < totalPasses; ++pass) {
-    pairs.find(x0, x1, settings_.tolerance, candidatesPointTriangle_, candidatesEdgeEdge_, pass == 0 ? nullptr : &movedThisPass);
+    pairs.find(x0, x1, settings_.tolerance, candidatesPointTriangle_, candidatesEdgeEdge_, pass == 0 ? nullptr : &movedThisPass_);
     detect(pairs, x0, x1);
     ++stats.passes;
     stats.unresolved = static_cast<int>(crossings_.size());
@@ -142,11 +143,11 @@ SelfCollisionStats SelfCollisionResolver::resolve(CollisionPairs& pairs, const s
         for (const int p : zone) moved_[static_cast<std::size_t>(p)] = 1;
       }
     }
-    movedThisPass = moved_;
+    movedThisPass_ = moved_;
   }
   if (stats.unresolved > 0 && stats.passes == totalPasses) {
     // The last pass changed positions after its detection: look once more.
-    pairs.find(x0, x1, settings_.tolerance, candidatesPointTriangle_, candidatesEdgeEdge_, &movedThisPass);
+    pairs.find(x0, x1, settings_.tolerance, candidatesPointTriangle_, candidatesEdgeEdge_, &movedThisPass_);
     detect(pairs, x0, x1);
     stats.unresolved = static_cast<int>(crossings_.size());
   }

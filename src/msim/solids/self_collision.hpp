@@ -64,7 +64,7 @@ class SelfCollisionResolver {
   std::vector<PointTrianglePair> candidatesPointTriangle_;
   std::vector<EdgeEdgePair> candidatesEdgeEdge_;
   std::vector<Crossing> crossings_;
-  std::vector<char> moved_;
+  std::vector<char> hit_, moved_, movedThisPass_;
   std::vector<double> inverseMass_;
   std::vector<Vec3> velocity_;
 };

@@ -10,12 +10,11 @@ StrainLimitStats limitStrain(MassSpringSystem& system, double maxStrain, int swe
   if (!(maxStrain > 0.0) || !(dt > 0.0)) throw std::invalid_argument("strain limit: the limit and dt must be > 0");
   const std::vector<Vec3> before = system.x;
   StrainLimitStats stats;
-  auto inverseMass = [&](int p) { return system.pinned[static_cast<std::size_t>(p)] ? 0.0 : 1.0 / system.mass[static_cast<std::size_t>(p)]; };
   auto correct = [&](const Spring& s) {
     const Vec3 d = system.x[s.b] - system.x[s.a];
     const double length = d.norm(), longest = (1.0 + maxStrain) * s.restLength;
     if (!(length > longest * (1.0 + 1e-9))) return false;
-    const double wa = inverseMass(s.a), wb = inverseMass(s.b);
+    const double wa = system.inverseMass(static_cast<std::size_t>(s.a)), wb = system.inverseMass(static_cast<std::size_t>(s.b));
     if (wa + wb == 0.0) return false;
     const Vec3 move = (length - longest) / (wa + wb) * (d / length);
     system.x[s.a] += wa * move;
