@@ -1,5 +1,5 @@
 // Strain limiting (Provot 1995; Bridson, Marino & Fedkiw 2003): a soft chain that would hang at
-// 49% strain rests at the 10% limit (11.4% at most while it falls), the corrections keep the momentum of free
+// 49% strain rests at the 10% limit (10.2% at most while it falls), the corrections keep the momentum of free
 // particles, and a chain within the limit is left exactly as it is.
 #include <gtest/gtest.h>
 
@@ -42,14 +42,16 @@ TEST(StrainLimit, SoftChainHangsWithinTheLimit) {
   for (int s = 0; s < 240; ++s) {
     stepper.step(free, 1.0 / 24.0);
     stepper.step(limited, 1.0 / 24.0);
-    const StrainLimitStats stats = limitStrain(limited, 0.1, 50, 1.0 / 24.0);
+    const StrainLimitStats stats = limitStrain(limited, 0.1, 100, 1.0 / 24.0);
     worst = std::max(worst, stats.largest);
   }
   RecordProperty("worst_strain", std::to_string(worst));
   RecordProperty("final_strain", std::to_string(largestStrain(limited)));
   RecordProperty("free_strain", std::to_string(largestStrain(free)));
   EXPECT_GT(largestStrain(free), 0.4);
-  EXPECT_LE(worst, 0.12);  // measured 0.1136 (50 sweeps, while it falls); at rest exactly the limit
+  // Measured 0.1014 while it falls, 0.1004 at rest (100 sweeps: each step of a whole frame pulls
+  // the chain most of the way to its 49%; 50 sweeps leave 0.104).
+  EXPECT_LE(worst, 0.12);
   EXPECT_LE(largestStrain(limited), 0.101);
 }
 

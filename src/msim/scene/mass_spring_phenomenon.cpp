@@ -47,7 +47,16 @@ void declareMassSpringKeys(Schema& object, const char* what, double strainLimit)
                 "c of the wind's drag c A ((u - v) . n) n on each surface triangle, along its normal (linear, as Selle "
                 "ch. 6's leaves), from winds[]")
       .min(0.0);
-  object.boolean("implicit_springs", true, "springs implicit along themselves (Selle ch. 5.5)");
+  object.boolean("implicit_springs", true,
+                 "springs implicit along themselves (Selle ch. 5.5) and, when stretched, across (their tension): stable "
+                 "at one step per frame");
+  object.integer("newton_iterations", 4,
+                 "most linearisations of the springs per half step (the seed: 1); more keep a large step from "
+                 "gaining energy")
+      .min(1);
+  object.number("newton_tolerance", "", 0.03,
+                "the linearisations stop once one moves no particle by this fraction of the shortest spring")
+      .min(0.0, Bound::Exclusive);
   object.number("strain_limit", "", strainLimit,
                 "springs stretched further are shortened to this strain after every step (Provot 1995, Bridson et al. "
                 "2003); 0 = off")
@@ -184,6 +193,8 @@ class MassSpringPhenomenon final : public Phenomenon {
     solids::NewmarkSettings settings;
     settings.implicitSprings = c.at("implicit_springs").get<bool>();
     settings.cgTolerance = c.at("cg_tolerance").get<double>();
+    settings.newtonIterations = static_cast<int>(c.at("newton_iterations").get<long long>());
+    settings.newtonTolerance = c.at("newton_tolerance").get<double>();
     stepper_ = solids::NewmarkStepper(settings);
     strainLimit_ = c.at("strain_limit").get<double>();
     if (kind_ == "cloth" && c.at("self_collisions").get<bool>()) buildCollisionLoop(c, settings);
@@ -195,6 +206,15 @@ class MassSpringPhenomenon final : public Phenomenon {
       const double mb = system_.pinned[static_cast<std::size_t>(s.b)] ? 0.0 : system_.mass[static_cast<std::size_t>(s.b)];
       springMass_[i] = ma > 0.0 && mb > 0.0 ? ma * mb / (ma + mb) : std::max(ma, mb);
     }
+    // The drag's rate c A / m on each free particle, A a third of its triangles' area at rest.
+    std::vector<double> dragArea(system_.size(), 0.0);
+    for (const auto& t : mesh_.triangles) {
+      const double area = 0.5 * (system_.x[t[1]] - system_.x[t[0]]).cross(system_.x[t[2]] - system_.x[t[0]]).norm();
+      for (const int k : t) dragArea[static_cast<std::size_t>(k)] += area / 3.0;
+    }
+    massPerDragArea_ = std::numeric_limits<double>::infinity();
+    for (std::size_t p = 0; p < system_.size(); ++p)
+      if (!system_.pinned[p] && dragArea[p] > 0.0) massPerDragArea_ = std::min(massPerDragArea_, system_.mass[p] / dragArea[p]);
     preview_ = previewSettings(scene);
     preview_.colour = {0.85f, 0.45f, 0.30f};
     coverage_ = Grid<float, 3>(spec_, 0.0f);
@@ -204,20 +224,18 @@ class MassSpringPhenomenon final : public Phenomenon {
   // With the collision loop a step is an outer step of up to k_i inner steps.
   double stableTimestep() const override { return innerStableTimestep() * (loop_ ? loop_->settings().innerSteps : 1); }
 
-  // The explicit part's limit 2 / omega over the springs. Explicit springs: omega^2 = k / (l0 mu)
-  // along each. Implicit springs (ch. 5.5) are stable along themselves; what stays explicit is
-  // the sideways stiffness of their tension T = k |strain|, omega^2 = T / (L mu), taken at a
-  // strain of at least 1% (a slack cloth tightens within a step).
+  // The explicit part's limit 2 / omega. Explicit springs: omega^2 = k / (l0 mu) along each.
+  // Implicit springs (ch. 5.5, with their tension across them) have no limit, and a frame can be
+  // one step; what stays explicit is the wind's drag, c A / m per particle (windForces).
   double innerStableTimestep() const {
     double step = std::numeric_limits<double>::infinity();
-    for (std::size_t i = 0; i < system_.springs.size(); ++i) {
-      const solids::Spring& s = system_.springs[i];
-      if (!(springMass_[i] > 0.0) || !(s.stiffness > 0.0)) continue;
-      const double stiffness = implicitSprings_ ? s.stiffness * std::max(std::abs(system_.strain(i)), 0.01) /
-                                                      (s.restLength * (1.0 + system_.strain(i)))
-                                                : s.stiffness / s.restLength;
-      step = std::min(step, 2.0 * std::sqrt(springMass_[i] / stiffness));
-    }
+    if (!implicitSprings_)
+      for (std::size_t i = 0; i < system_.springs.size(); ++i) {
+        const solids::Spring& s = system_.springs[i];
+        if (!(springMass_[i] > 0.0) || !(s.stiffness > 0.0)) continue;
+        step = std::min(step, 2.0 * std::sqrt(springMass_[i] * s.restLength / s.stiffness));
+      }
+    if (!winds_.empty() && windDrag_ > 0.0) step = std::min(step, 2.0 * massPerDragArea_ / windDrag_);
     return cfl_ * step;
   }
 
@@ -441,7 +459,10 @@ class MassSpringPhenomenon final : public Phenomenon {
   // One outer step of the collision loop (Selle ch. 6.2), its stages timed as Table 6.3's A, B, C.
   solids::NewmarkStats collisionStep(double dt) {
     const double start = time_;
-    last_ = loop_->step(system_, dt, [this] { return innerStableTimestep(); }, contact_.empty() ? nullptr : &contact_,
+    // k_i inner steps (ch. 6.3), more where the explicit part's limit asks for them.
+    const double innerSteps = loop_->settings().innerSteps;
+    last_ = loop_->step(system_, dt, [this, dt, innerSteps] { return std::min(innerStableTimestep(), dt / innerSteps); },
+                        contact_.empty() ? nullptr : &contact_,
                         [this, start](double t) { moveBodies(start + t); });
     timers_.add("cloth: pairs (A)", last_.secondsPairs);
     timers_.add("cloth: inner steps (B)", last_.secondsInner);
@@ -581,6 +602,7 @@ class MassSpringPhenomenon final : public Phenomenon {
   mutable Grid<float, 3> solid_;
   std::vector<turbulence::TurbulentWind<3>> winds_;
   double windDrag_ = 0.0;
+  double massPerDragArea_ = 0.0;  // the smallest m / A over the free particles [kg/m^2]
   double time_ = 0.0;  // simulated [s]
   long steps_ = 0, iterations_ = 0, unconverged_ = 0;
   int contacts_ = 0;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 
@@ -9,19 +10,25 @@
 
 namespace msim::solids {
 
-// The step's matrix is A = M + h sum_s c_s (d d^T) on each spring's particles (weights -1 and 1,
-// the altitude springs' by their weights), c_s = b_s and, with implicit springs, + h k_s / l0_s;
-// rhs = M v + h F_e. It is applied without being assembled (conjugate gradients with a diagonal
-// preconditioner): the terms are gathered once per solve, and nothing is allocated once the
+// Half step i of the scheme solves M v' = M v + h F(x + c v') - h D v' for v', where x is the
+// solve's base (x(n), then x(n+1/2)), c = dt the reach of the position update x(n+1) = x(n) +
+// dt v(n+1/2) and D the damping along the springs. Elasticity linearised at x_k = x + c v_k
+// (v_0 = 0: at the base, as the seed) gives the matrix A = M + h sum_s (c_s d d^T + c'_s (I - d d^T))
+// on each spring's particles (weights -1 and 1, the altitude springs' by their weights), with
+// c_s = b_s and, with implicit springs, + c k_s / l0_s (the seed's "Delta t k / l0", ch. 5.5);
+// c'_s = c T_s / L_s for a stretched edge spring with implicit springs, else 0; and
+// rhs = M v + h F(x_k) + h c K_k v_k, K_k the elastic part. Further Newton iterations
+// (`newtonIterations`) take the springs' directions and tensions where the last solve moves the
+// particles to. A is applied without being assembled (conjugate gradients with a diagonal
+// preconditioner): the terms are gathered once per iteration, and nothing is allocated once the
 // buffers have grown. Pinned particles keep `from`: their unknowns stay fixed, so their columns act
 // through the start residual and their rows drop out.
-NewmarkStats NewmarkStepper::solveHalfStep(const MassSpringSystem& system, const std::vector<Vec3>& at,
-                                           const std::vector<Vec3>& from, double h, std::vector<Vec3>& out) {
-  const std::size_t n = system.size();
-  system.explicitForces(at, forces_);
+void NewmarkStepper::gatherTerms(const MassSpringSystem& system, const std::vector<Vec3>& at, double h, double reach) {
   terms_.clear();
-  const auto addTerm = [&](const int* nodes, const double* weights, int count, const Vec3& direction, double c) {
-    if (c == 0.0) return;
+  shortestSpring_ = std::numeric_limits<double>::infinity();
+  const auto addTerm = [&](const int* nodes, const double* weights, int count, const Vec3& direction, double damping,
+                           double along, double across) {
+    if (damping == 0.0 && along == 0.0 && across == 0.0) return;
     Term t;
     t.count = count;
     for (int i = 0; i < count; ++i) {
@@ -29,62 +36,113 @@ NewmarkStats NewmarkStepper::solveHalfStep(const MassSpringSystem& system, const
       t.weight[i] = weights[i];
     }
     t.direction = direction;
-    t.coefficient = c;
+    t.coefficient = h * (damping + along);
+    t.stiffness = h * along;
+    t.sideways = h * across;
     terms_.push_back(t);
   };
-  // Damping along each spring, and with implicit springs the stiffness k / l0 along it (ch. 5.5).
+  // Damping along each spring, and with implicit springs the stiffness k / l0 along it (ch. 5.5)
+  // and, for a stretched spring, the stiffness T / L = (k / l0)(1 - l0 / L) across it that its
+  // tension gives when it turns (the rest of the force's Jacobian; the seed freezes the direction
+  // and leaves it explicit, which bounds the step of a swinging cloth by 2 sqrt(L mu / T)).
+  // A compressed spring's sideways stiffness is negative (buckling) and stays explicit, which keeps
+  // A positive definite.
   for (const Spring& s : system.springs) {
     const Vec3 delta = at[s.b] - at[s.a];
     const double length = delta.norm();
     if (!(length > 0.0)) continue;
     const int nodes[2] = {s.a, s.b};
     const double weights[2] = {-1.0, 1.0};
-    addTerm(nodes, weights, 2, delta / length,
-            h * (s.damping + (settings_.implicitSprings ? h * s.stiffness / s.restLength : 0.0)));
+    shortestSpring_ = std::min(shortestSpring_, s.restLength);
+    const double along = reach * s.stiffness / s.restLength;
+    const double across = settings_.tensionAcross ? along * std::max(0.0, 1.0 - s.restLength / length) : 0.0;
+    addTerm(nodes, weights, 2, delta / length, s.damping, along, across);
   }
   for (const TetrahedronSpring& t : system.tetrahedra) {
     const AltitudeChoice choice = chooseAltitude({at[t.v[0]], at[t.v[1]], at[t.v[2]], at[t.v[3]]});
     if (choice.candidate < 0) continue;
     const double l0 = t.restAltitude[static_cast<std::size_t>(choice.candidate)];
-    addTerm(t.v.data(), choice.weights.data(), 4, choice.normal,
-            h * (t.damping + (settings_.implicitSprings ? h * t.stiffness / l0 : 0.0)));
+    shortestSpring_ = std::min(shortestSpring_, l0);
+    addTerm(t.v.data(), choice.weights.data(), 4, choice.normal, t.damping, reach * t.stiffness / l0, 0.0);
   }
-  // y = A u on the free particles (pinned rows zero).
-  const auto apply = [&](const std::vector<Vec3>& u, std::vector<Vec3>& y) {
-    for (std::size_t p = 0; p < n; ++p) y[p] = system.mass[p] * u[p];
-    for (const Term& t : terms_) {
-      double along = 0.0;
-      for (int i = 0; i < t.count; ++i) along += t.weight[i] * u[static_cast<std::size_t>(t.node[i])].dot(t.direction);
-      const Vec3 f = t.coefficient * along * t.direction;
-      for (int i = 0; i < t.count; ++i) y[static_cast<std::size_t>(t.node[i])] += t.weight[i] * f;
-    }
-    for (std::size_t p = 0; p < n; ++p)
-      if (system.pinned[p]) y[p].setZero();
-  };
-  inverseDiagonal_.assign(n, Vec3::Zero());
-  for (std::size_t p = 0; p < n; ++p) inverseDiagonal_[p] = Vec3::Constant(system.mass[p]);
+  inverseDiagonal_.assign(system.size(), Vec3::Zero());
+  for (std::size_t p = 0; p < system.size(); ++p) inverseDiagonal_[p] = Vec3::Constant(system.mass[p]);
   for (const Term& t : terms_)
     for (int i = 0; i < t.count; ++i)
       inverseDiagonal_[static_cast<std::size_t>(t.node[i])] +=
-          t.coefficient * t.weight[i] * t.weight[i] * t.direction.cwiseProduct(t.direction);
+          t.weight[i] * t.weight[i] *
+          (t.coefficient * t.direction.cwiseProduct(t.direction) +
+           t.sideways * (Vec3::Ones() - t.direction.cwiseProduct(t.direction)));
   for (Vec3& d : inverseDiagonal_) d = d.cwiseInverse();
+}
 
+// y = (elasticOnly ? h c K : A - M) u, accumulated onto y.
+void NewmarkStepper::applyTerms(const std::vector<Vec3>& u, std::vector<Vec3>& y, bool elasticOnly) const {
+  for (const Term& t : terms_) {
+    Vec3 relative = Vec3::Zero();
+    for (int i = 0; i < t.count; ++i) relative += t.weight[i] * u[static_cast<std::size_t>(t.node[i])];
+    const double along = relative.dot(t.direction);
+    const Vec3 f = (elasticOnly ? t.stiffness : t.coefficient) * along * t.direction +
+                   t.sideways * (relative - along * t.direction);
+    for (int i = 0; i < t.count; ++i) y[static_cast<std::size_t>(t.node[i])] += t.weight[i] * f;
+  }
+}
+
+NewmarkStats NewmarkStepper::solveHalfStep(const MassSpringSystem& system, const std::vector<Vec3>& base,
+                                           const std::vector<Vec3>& from, double h, std::vector<Vec3>& out) {
+  const std::size_t n = system.size();
+  const double reach = settings_.implicitSprings ? 2.0 * h : 0.0;
+  const int iterations = settings_.implicitSprings ? std::max(1, settings_.newtonIterations) : 1;
+  NewmarkStats stats;
   out = from;
   residual_.resize(n);
   product_.resize(n);
   search_.resize(n);
   precond_.resize(n);
-  apply(out, product_);
-  double rhsNorm2 = 0.0;
-  for (std::size_t p = 0; p < n; ++p) {
-    if (system.pinned[p]) {
-      residual_[p].setZero();
-      continue;
+  linearisedAt_.resize(n);
+  for (int k = 0; k < iterations; ++k) {
+    // x_k = base + c v_k, with v_0 = 0 and v_k the last solve's answer.
+    for (std::size_t p = 0; p < n; ++p) linearisedAt_[p] = k == 0 ? base[p] : base[p] + reach * out[p];
+    system.explicitForces(linearisedAt_, forces_);
+    gatherTerms(system, linearisedAt_, h, reach);
+    // rhs = M v + h F(x_k) + h c K_k v_k (product_ holds h c K_k v_k), residual = rhs - A out.
+    for (Vec3& y : product_) y.setZero();
+    if (k > 0) applyTerms(out, product_, true);
+    double rhsNorm2 = 0.0;
+    for (std::size_t p = 0; p < n; ++p) {
+      if (system.pinned[p]) continue;
+      residual_[p] = system.mass[p] * from[p] + h * forces_[p] + product_[p];
+      rhsNorm2 += residual_[p].squaredNorm();
     }
-    const Vec3 rhs = system.mass[p] * from[p] + h * forces_[p];
-    rhsNorm2 += rhs.squaredNorm();
-    residual_[p] = rhs - product_[p];
+    for (std::size_t p = 0; p < n; ++p) product_[p] = system.mass[p] * out[p];
+    applyTerms(out, product_, false);
+    for (std::size_t p = 0; p < n; ++p) residual_[p] = system.pinned[p] ? Vec3::Zero() : Vec3(residual_[p] - product_[p]);
+    if (k + 1 < iterations) previous_ = out;
+    const NewmarkStats solve = conjugateGradients(system, rhsNorm2, out);
+    stats.iterations += solve.iterations;
+    stats.converged = stats.converged && solve.converged;
+    ++stats.linearisations;
+    if (k + 1 < iterations) {
+      // Converged once the answer moves the linearisation point by less than newtonTolerance of the
+      // shortest spring.
+      double change = 0.0;
+      for (std::size_t p = 0; p < n; ++p) change = std::max(change, (out[p] - previous_[p]).squaredNorm());
+      if (reach * std::sqrt(change) <= settings_.newtonTolerance * shortestSpring_) break;
+    }
   }
+  return stats;
+}
+
+// Solves A out = rhs from the residual rhs - A out already in residual_.
+NewmarkStats NewmarkStepper::conjugateGradients(const MassSpringSystem& system, double rhsNorm2, std::vector<Vec3>& out) {
+  const std::size_t n = system.size();
+  // y = A u on the free particles (pinned rows zero).
+  const auto apply = [&](const std::vector<Vec3>& u, std::vector<Vec3>& y) {
+    for (std::size_t p = 0; p < n; ++p) y[p] = system.mass[p] * u[p];
+    applyTerms(u, y, false);
+    for (std::size_t p = 0; p < n; ++p)
+      if (system.pinned[p]) y[p].setZero();
+  };
   const auto dot = [&](const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
     double sum = 0.0;
     for (std::size_t p = 0; p < n; ++p) sum += a[p].dot(b[p]);
@@ -146,6 +204,7 @@ NewmarkStats NewmarkStepper::step(MassSpringSystem& system, double dt, const Bod
   }
   if (repulsion) repulsion->repelEndVelocity(system.x, system.v, inverseMass_);
   first.iterations += second.iterations;
+  first.linearisations += second.linearisations;
   first.converged = first.converged && second.converged;
   first.contacts = static_cast<int>(std::count_if(touched_.begin(), touched_.end(), [](int b) { return b >= 0; }));
   return first;
