@@ -12,6 +12,7 @@
 
 #include "cli_harness.hpp"
 #include "msim/io/ply.hpp"
+#include "msim/io/png.hpp"
 #include "msim/io/vdb.hpp"
 
 namespace {
@@ -57,6 +58,50 @@ TEST(ClothCli, PatchFallsOntoTheBallAndWritesMeshesAndResumes) {
   const json frames = readJson(out / "run.json").at("frames");
   ASSERT_EQ(frames.size(), 4u);
   EXPECT_GT(frames.back().at("contacts").get<int>(), 0) << "by 0.4 s the cloth lies on the ball";
+  // msim render draws the frame's surface mesh in mesh_albedo (red here) and the bodies (grey)
+  // from the frame's obstacle_distance: both must show.
+  const Result rendered = runMsim("render " + out.string() +
+                                  " --last --set render.camera.width=160 --set render.camera.height=120 "
+                                  "--set render.multiple_scattering=false --set 'render.mesh_albedo=[0.9,0.05,0.05]'");
+  ASSERT_EQ(rendered.exitCode, 0) << rendered.output;
+  const io::Image image = io::readPng(out / "render" / "tiny_0004.png");
+  int red = 0, grey = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const std::uint8_t* p = image.pixel(x, y);
+      if (p[0] > 60 && p[0] > 3 * p[1]) ++red;
+      if (p[0] > 60 && std::abs(p[0] - p[1]) < 12 && std::abs(p[1] - p[2]) < 12) ++grey;
+    }
+  EXPECT_GT(red, 100) << "the cloth";
+  EXPECT_GT(grey, 100) << "the ball and the floor";
+}
+
+TEST(ClothCli, InitialVelocityCarriesAFreeClothAndBothContactMethodsRun) {
+  // Without bodies a free cloth thrown at 1 m/s along x falls exactly (the trapezoidal rule is
+  // exact for a constant acceleration): from frame 1 (0.1 s) to frame 2 (0.2 s) its centroid moves
+  // 0.1 m along x and g (0.2^2 - 0.1^2) / 2 = 0.147 m down. The earlier contact method
+  // (projection) runs on the ball too.
+  const std::string thrown = replaced(tinyCloth(R"(, "initial_velocity": [1, 0, 0])"),
+                                      R"(  "bodies": [{"shape": {"type": "sphere", "center": [0, 0.3, 0], "radius": 0.2}, "friction": 0.5},
+             {"shape": {"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0]}}]
+)",
+                                      R"(  "bodies": []
+)");
+  const fs::path dir = scratch("cloth_thrown");
+  writeText(dir / "s.json", replaced(thrown, R"("min": [-0.5, 0, -0.5])", R"("min": [-0.5, -0.5, -0.5])"));
+  const Result r = runMsim("run " + (dir / "s.json").string() + " -q --out " + (dir / "out").string());
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  const auto start = io::readPlyMesh(dir / "out" / "mesh" / "tiny_0001.ply").mesh;
+  const auto end = io::readPlyMesh(dir / "out" / "mesh" / "tiny_0002.ply").mesh;
+  Vec3 moved = Vec3::Zero();
+  for (std::size_t v = 0; v < end.vertices.size(); ++v) moved += (end.vertices[v] - start.vertices[v]) / double(end.vertices.size());
+  EXPECT_NEAR(moved.x(), 0.1, 1e-6);
+  EXPECT_NEAR(moved.y(), -0.5 * 9.8 * (0.2 * 0.2 - 0.1 * 0.1), 1e-6);
+  const fs::path projected = scratch("cloth_projection");
+  writeText(projected / "s.json", tinyCloth(R"(, "contact_method": "projection")"));
+  const Result p = runMsim("run " + (projected / "s.json").string() + " -q --out " + (projected / "out").string());
+  ASSERT_EQ(p.exitCode, 0) << p.output;
+  EXPECT_GT(readJson(projected / "out" / "run.json").at("frames").back().at("contacts").get<int>(), 0);
 }
 
 TEST(ClothCli, WindPushesTheClothAlongItsNormal) {

@@ -81,6 +81,7 @@ VolumeRenderSettings surfaceSettings() {
   s.background = Vec3::Zero();
   s.ambient = kSky;
   s.surfaceAlbedo = kAlbedo;
+  s.meshAlbedo = kAlbedo;
   return s;
 }
 
@@ -308,4 +309,7 @@ TEST(Surfaces, BadInputsAreRefused) {
   VolumeRenderSettings s;
   s.surfaceAlbedo = Vec3(1.2, 0.5, 0.5);
   expectInvalidArgument([&] { s.validate(); }, "surfaceAlbedo");
+  s.surfaceAlbedo = Vec3::Constant(0.5);
+  s.meshAlbedo = Vec3(0.5, -0.1, 0.5);
+  expectInvalidArgument([&] { s.validate(); }, "meshAlbedo");
 }

@@ -11,6 +11,7 @@
 #include <numbers>
 
 #include "msim/geometry/analytic_shapes.hpp"
+#include "msim/geometry/shape_adapters.hpp"
 #include "msim/solids/body_contact.hpp"
 #include "msim/solids/mass_spring.hpp"
 #include "msim/solids/newmark.hpp"
@@ -112,4 +113,39 @@ TEST(BodyContact, ProjectionMethodSlidesTooFar) {
   const Slide projected = slide(particle(0.0), incline(0.6, ContactMethod::Projection), 1.0 / 30.0, 1.0, false);
   RecordProperty("projection_distance_over_exact", std::to_string(projected.distance / 0.5016));
   EXPECT_GT(projected.distance / 0.5016, 1.05);
+}
+
+// A turntable (a box turning about the vertical at 2 rad/s, geometry::RigidlyMoved) carries a
+// particle resting on it 0.3 m from the axis once friction has spun it up (mu g = 9.8 m/s^2 takes
+// 0.06 s to reach omega r = 0.6 m/s, and holds the centripetal omega^2 r = 1.2 m/s^2): after 1 s it
+// turns with the table at the same radius. Without friction the table turns under it and it stays.
+TEST(BodyContact, TurningBodyCarriesAParticleByFriction) {
+  const geometry::RigidMotion turn{Vec3::Zero(), Vec3(0.0, 2.0, 0.0), Vec3::Zero()};
+  const auto table = std::make_shared<geometry::Box<3>>(Vec3(-0.5, -0.1, -0.5), Vec3(0.5, 0.0, 0.5));
+  auto run = [&](double mu) {
+    MassSpringSystem system;
+    system.addParticle(Vec3(0.3, 1e-6, 0.0), 0.01);
+    ContactBody body{table, Vec3::Zero(), mu, turn.angularVelocity, Vec3::Zero()};
+    BodyContact contact;
+    contact.addBody(body);
+    NewmarkStepper stepper;
+    const double dt = 1e-3;
+    for (int s = 1; s <= 1000; ++s) {
+      body.shape = std::make_shared<geometry::RigidlyMoved>(table, turn, s * dt);  // where the step ends
+      contact.setBody(0, body);
+      stepper.step(system, dt, &contact);
+      EXPECT_GT(system.x[0].y(), -1e-9) << "step " << s;
+    }
+    return system;
+  };
+  const MassSpringSystem carried = run(1.0);
+  const Vec3 x = carried.x[0], v = carried.v[0];
+  EXPECT_NEAR(std::hypot(x.x(), x.z()), 0.3, 0.003);
+  EXPECT_NEAR(std::hypot(v.x(), v.z()), 0.6, 0.006);
+  // Turning the same way as the table: the angular momentum's y component is positive (omega_y > 0
+  // turns +x towards -z).
+  EXPECT_GT(x.z() * v.x() - x.x() * v.z(), 0.0);
+  const MassSpringSystem slipping = run(0.0);
+  EXPECT_LT((slipping.x[0] - Vec3(0.3, 0.0, 0.0)).norm(), 1e-3);
+  EXPECT_LT(slipping.v[0].norm(), 1e-6);
 }

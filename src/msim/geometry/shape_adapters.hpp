@@ -1,10 +1,13 @@
 #pragma once
 // Shapes made from other shapes: the complement (a container is everything outside its cavity),
-// a translated copy (a body moving without turning) and a grid-sampled copy (a mesh queried per particle and step is O(triangles) per call; a
+// a translated copy (a body moving without turning), a rigidly moved copy (a body that turns) and
+// a grid-sampled copy (a mesh queried per particle and step is O(triangles) per call; a
 // sampled distance is O(1), exact enough within the sampling cell near the surface).
+#include <limits>
 #include <memory>
 
 #include "msim/core/interpolation.hpp"
+#include "msim/geometry/rigid_motion.hpp"
 #include "msim/geometry/shape.hpp"
 
 namespace msim::geometry {
@@ -35,6 +38,35 @@ class Translated final : public Shape<D> {
  private:
   std::shared_ptr<const Shape<D>> inner_;
   Vec<D> offset_;
+};
+
+// `inner` (standing as at t = 0) moved by `motion` to time t: distance inner(motion^-1(x)), exact
+// since a rigid motion keeps distances.
+class RigidlyMoved final : public Shape<3> {
+ public:
+  RigidlyMoved(std::shared_ptr<const Shape<3>> inner, const RigidMotion& motion, double t)
+      : inner_(std::move(inner)), motion_(motion), t_(t) {}
+  double distance(const Vec3& x) const override { return inner_->distance(motion_.inverse(x, t_)); }
+  // The box around the moved corners of the inner box.
+  Bounds<3> bounds() const override {
+    const Bounds<3> b = inner_->bounds();
+    if (!b.min.allFinite() || !b.max.allFinite()) return Bounds<3>::infinite();
+    Bounds<3> out{Vec3::Constant(std::numeric_limits<double>::infinity()),
+                  Vec3::Constant(-std::numeric_limits<double>::infinity())};
+    for (int corner = 0; corner < 8; ++corner) {
+      const Vec3 c((corner & 1) ? b.max.x() : b.min.x(), (corner & 2) ? b.max.y() : b.min.y(),
+                   (corner & 4) ? b.max.z() : b.min.z());
+      const Vec3 moved = motion_.apply(c, t_);
+      out.min = out.min.cwiseMin(moved);
+      out.max = out.max.cwiseMax(moved);
+    }
+    return out;
+  }
+
+ private:
+  std::shared_ptr<const Shape<3>> inner_;
+  RigidMotion motion_;
+  double t_;
 };
 
 // `exact` sampled at the cell centres of `spec` and interpolated D-linearly inside it; outside

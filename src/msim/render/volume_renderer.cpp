@@ -487,6 +487,8 @@ void VolumeRenderSettings::validate() const {
     throw std::invalid_argument("volume render settings: ambient must be finite and non-negative");
   if (!finiteNonNegative(surfaceAlbedo) || (surfaceAlbedo.array() > 1.0).any())
     throw std::invalid_argument("volume render settings: surfaceAlbedo must be in [0, 1]");
+  if (!finiteNonNegative(meshAlbedo) || (meshAlbedo.array() > 1.0).any())
+    throw std::invalid_argument("volume render settings: meshAlbedo must be in [0, 1]");
   sky.validate();
   floor.validate();
   liquid.validate();
@@ -760,7 +762,7 @@ RenderResult renderVolume(const VolumeInput& input, const Camera& camera, const 
   settings.validate();
   checkLights(lights);
   const CameraRays rays(camera);
-  const SurfaceScene surfaces(input.meshes, input.points, settings.surfaceAlbedo);
+  const SurfaceScene surfaces(input.meshes, input.points, settings.meshAlbedo);
   checkCameraOutsideSolids(camera.position, input.surfaceDistance, input.meshes);
   const Grid<float, 3>& density = *input.density;
   RenderResult result;

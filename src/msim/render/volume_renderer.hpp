@@ -78,13 +78,14 @@ struct VolumeRenderSettings {
   double exposure = 1.0;                       // radiance multiplier before tone mapping
   double gamma = 2.2;                          // display gamma of the 8-bit image
   bool toneMap = true;                         // x / (1 + x) per channel; otherwise clamp to [0, 1]
-  Vec3 surfaceAlbedo = Vec3::Constant(0.6);    // Lambert albedo of obstacles (surfaceDistance) and meshes
+  Vec3 surfaceAlbedo = Vec3::Constant(0.6);    // Lambert albedo of obstacles (surfaceDistance)
+  Vec3 meshAlbedo = Vec3::Constant(0.6);       // and of meshes
   Sky sky;                                     // when enabled, what rays leaving the scene see instead of background
   Floor floor;                                 // a floor under the box, when enabled
   LiquidOptics liquid;                         // of VolumeInput::liquid
 
   // std::invalid_argument for stepCells, exposure or gamma not positive, negative or non-finite
-  // background or ambient, a surfaceAlbedo outside [0, 1], or an invalid sky, floor or liquid.
+  // background or ambient, a surfaceAlbedo or meshAlbedo outside [0, 1], or an invalid sky, floor or liquid.
   void validate() const;
 };
 

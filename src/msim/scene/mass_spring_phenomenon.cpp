@@ -6,14 +6,14 @@
 #include <memory>
 #include <utility>
 
-#include <Eigen/Geometry>
 #include <fmt/format.h>
 
 #include "msim/core/error.hpp"
 #include "msim/core/log.hpp"
+#include "msim/geometry/rigid_motion.hpp"
+#include "msim/geometry/shape_adapters.hpp"
 #include "msim/io/obj.hpp"
 #include "msim/io/ply.hpp"
-#include "msim/geometry/shape_adapters.hpp"
 #include "msim/io/vdb.hpp"
 #include "msim/render/density_preview.hpp"
 #include "msim/scene/json_vectors.hpp"
@@ -61,6 +61,12 @@ void declareMassSpringKeys(Schema& object, const char* what, double strainLimit)
                 "springs stretched further are shortened to this strain after every step (Provot 1995, Bridson et al. "
                 "2003); 0 = off")
       .min(0.0);
+  object.vector("initial_velocity", "m/s", {0.0, 0.0, 0.0}, "every free vertex starts with this velocity").lengths({3});
+  object.string("contact_method", "crossing_fraction",
+                "crossing_fraction: a step that meets a body is cut where it meets it and ends with Gamma of its "
+                "velocity (Selle ch. 6.5); projection: the earlier method, moved out along the normal after the whole "
+                "step (friction a step late)")
+      .choices({"crossing_fraction", "projection"});
   object.number("cg_tolerance", "", 1e-3, "relative residual of the step's solves (Table 6.1)").min(0.0, Bound::Exclusive).max(1.0);
   object.string("mesh_format", "ply", fmt::format("the {} surface mesh written per frame (mesh/<name>_NNNN.*): ply, obj, both or none", what))
       .choices({"ply", "obj", "both", "none"});
@@ -79,6 +85,10 @@ void declareBodiesAndWinds(Schema& root) {
   body.field("shape", shapeSchema());
   body.number("friction", "", 0.3, "mu of Coulomb friction (Selle ch. 6.5)").min(0.0);
   body.vector("velocity", "m/s", {0.0, 0.0, 0.0}, "the body translates at this velocity from its place at t = 0").lengths({3});
+  body.vector("angular_velocity", "rad/s", {0.0, 0.0, 0.0},
+              "and turns at this angular velocity (world frame) about `center`, which moves with it")
+      .lengths({3});
+  body.vector("center", "m", {0.0, 0.0, 0.0}, "the point the body turns about, at t = 0").lengths({3});
   root.array("bodies", body, "solids in contact");
   declareTurbulentWinds(root);
 }
@@ -152,6 +162,9 @@ class MassSpringPhenomenon final : public Phenomenon {
       throw InputError(fmt::format("{}: 'domain': a {} scene is 3D (give domain.min and domain.max 3 numbers)", source_, kind_));
     const json& c = scene.resolved.at(kind_);
     meshFormat_ = c.at("mesh_format").get<std::string>();
+    contact_ = solids::BodyContact(c.at("contact_method").get<std::string>() == "projection"
+                                       ? solids::ContactMethod::Projection
+                                       : solids::ContactMethod::CrossingFraction);
     if (kind_ == "cloth")
       buildCloth(scene, c);
     else
@@ -164,8 +177,7 @@ class MassSpringPhenomenon final : public Phenomenon {
       const std::string key = fmt::format("{}.pins[{}].shape", kind_, i);
       const auto shape = sceneShape<3>(scene, pins[i].at("shape"), key);
       int pinned = 0;
-      Script script{sceneVector<3>(pins[i].at("velocity")), sceneVector<3>(pins[i].at("angular_velocity")),
-                    sceneVector<3>(pins[i].at("center")), {}, {}};
+      Script script{rigidMotion(pins[i]), {}, {}};
       for (std::size_t v = 0; v < system_.size(); ++v)
         if (shape->distance(system_.x[v]) <= 0.0 && !system_.pinned[v]) {
           system_.pinned[v] = 1;
@@ -173,9 +185,12 @@ class MassSpringPhenomenon final : public Phenomenon {
           script.rest.push_back(system_.x[v]);
           ++pinned;
         }
-      if (script.velocity.norm() > 0.0 || script.angularVelocity.norm() > 0.0) scripts_.push_back(std::move(script));
+      if (script.motion.moves()) scripts_.push_back(std::move(script));
       if (pinned == 0) throw InputError(fmt::format("{}: '{}' holds no vertex of the {}: nothing to pin", source_, key, kind_));
     }
+    const Vec3 initialVelocity = sceneVector<3>(c.at("initial_velocity"));
+    for (std::size_t p = 0; p < system_.size(); ++p)
+      if (!system_.pinned[p]) system_.v[p] = initialVelocity;
     const json& bodies = scene.resolved.at("bodies");
     for (std::size_t i = 0; i < bodies.size(); ++i) {
       std::shared_ptr<const geometry::Shape3> shape = sceneShape<3>(scene, bodies[i].at("shape"), fmt::format("bodies[{}].shape", i));
@@ -184,11 +199,14 @@ class MassSpringPhenomenon final : public Phenomenon {
           throw InputError(fmt::format("{}: 'bodies[{}].shape' holds {} vertex {} at the start: the {} must begin "
                                        "outside the bodies",
                                        source_, i, kind_, v, kind_));
-      const Vec3 velocity = sceneVector<3>(bodies[i].at("velocity"));
-      const solids::ContactBody body{std::move(shape), velocity, bodies[i].at("friction").get<double>()};
+      const geometry::RigidMotion motion = rigidMotion(bodies[i]);
+      solids::ContactBody body{std::move(shape), motion.velocity, bodies[i].at("friction").get<double>()};
+      body.angularVelocity = motion.angularVelocity;
+      body.center = motion.center;
       contact_.addBody(body);
       bodyShapes_.push_back(body.shape);
       bodyRest_.push_back(body);
+      bodyMotion_.push_back(motion);
     }
     solids::NewmarkSettings settings;
     settings.implicitSprings = c.at("implicit_springs").get<bool>();
@@ -279,8 +297,17 @@ class MassSpringPhenomenon final : public Phenomenon {
                                         kind_, strain + 1.0, stepIndex, time, kind_));
   }
 
-  // The vertices (positions, velocities) for --resume and tools.
+  // The vertices (positions, velocities) for --resume and tools, and the bodies where they stand as
+  // "obstacle_distance" (signed, negative inside) for renderers.
   void writeVolume(io::VdbWriter& writer) const override {
+    if (!bodyShapes_.empty()) {
+      Grid<float, 3> distance(spec_, std::numeric_limits<float>::infinity());
+      for (const auto& shape : bodyShapes_) {
+        const Grid<float, 3> d = shape->distanceField(spec_);
+        for (std::size_t i = 0; i < distance.count(); ++i) distance[i] = std::min(distance[i], d[i]);
+      }
+      writer.addLevelSet("obstacle_distance", distance);
+    }
     io::PointCloud cloud;
     std::vector<io::PointAttribute> v = {{"vx", {}}, {"vy", {}}, {"vz", {}}};
     for (std::size_t p = 0; p < system_.size(); ++p) {
@@ -330,7 +357,7 @@ class MassSpringPhenomenon final : public Phenomenon {
       for (const auto& t : system_.tetrahedra)
         sampleSimplex({system_.x[t.v[0]], system_.x[t.v[1]], system_.x[t.v[2]], system_.x[t.v[3]]}, 4);
     }
-    if (std::any_of(bodyRest_.begin(), bodyRest_.end(), [](const solids::ContactBody& b) { return b.velocity.norm() > 0.0; }))
+    if (std::any_of(bodyMotion_.begin(), bodyMotion_.end(), [](const geometry::RigidMotion& m) { return m.moves(); }))
       markBodies();
     return render::renderDensityPreview(coverage_, preview_, bodyShapes_.empty() ? nullptr : &solid_);
   }
@@ -409,8 +436,14 @@ class MassSpringPhenomenon final : public Phenomenon {
     }
   }
 
-  struct Script {  // pinned vertices that move (pins[].velocity, angular_velocity, center)
-    Vec3 velocity, angularVelocity, center;
+  // pins[] and bodies[]: velocity, angular_velocity, center.
+  static geometry::RigidMotion rigidMotion(const json& entry) {
+    return {sceneVector<3>(entry.at("velocity")), sceneVector<3>(entry.at("angular_velocity")),
+            sceneVector<3>(entry.at("center"))};
+  }
+
+  struct Script {  // pinned vertices that move
+    geometry::RigidMotion motion;
     std::vector<int> vertices;
     std::vector<Vec3> rest;  // their positions at t = 0
   };
@@ -425,35 +458,36 @@ class MassSpringPhenomenon final : public Phenomenon {
     }
   }
 
-  // Moving bodies (bodies[].velocity) as they stand at time t: the contact step evaluates them at
-  // the step's end (Selle ch. 6.5).
+  // Moving bodies (bodies[].velocity, angular_velocity) as they stand at time t: the contact step
+  // evaluates them at the step's end (Selle ch. 6.5).
   void moveBodies(double t) {
     for (std::size_t b = 0; b < bodyRest_.size(); ++b) {
-      if (bodyRest_[b].velocity.norm() == 0.0) continue;
-      bodyShapes_[b] = std::make_shared<geometry::Translated<3>>(bodyRest_[b].shape, bodyRest_[b].velocity * t);
-      contact_.setBody(b, {bodyShapes_[b], bodyRest_[b].velocity, bodyRest_[b].friction});
+      const geometry::RigidMotion& motion = bodyMotion_[b];
+      if (!motion.moves()) continue;
+      if (motion.turns())
+        bodyShapes_[b] = std::make_shared<geometry::RigidlyMoved>(bodyRest_[b].shape, motion, t);
+      else
+        bodyShapes_[b] = std::make_shared<geometry::Translated<3>>(bodyRest_[b].shape, motion.velocity * t);
+      solids::ContactBody body = bodyRest_[b];
+      body.shape = bodyShapes_[b];
+      body.center = motion.centerAt(t);
+      contact_.setBody(b, body);
     }
   }
 
-  // A scripted pin moves rigidly: x(t) = c + v t + R(omega t) (x(0) - c). Over a step its
-  // vertices move at the chord's velocity (x(t + dt) - x(t)) / dt, so the step's linear motion
-  // lands on the exact positions, which placePins then sets (no drift of the radius).
-  Vec3 scriptedPosition(const Script& script, const Vec3& rest, double t) const {
-    const double angle = script.angularVelocity.norm() * t;
-    const Vec3 arm = rest - script.center;
-    const Vec3 turned = angle > 0.0 ? Vec3(Eigen::AngleAxisd(angle, script.angularVelocity.normalized()) * arm) : arm;
-    return script.center + script.velocity * t + turned;
-  }
+  // A scripted pin moves rigidly (geometry::RigidMotion). Over a step its vertices move at the
+  // chord's velocity (x(t + dt) - x(t)) / dt, so the step's linear motion lands on the exact
+  // positions, which placePins then sets (no drift of the radius).
   void scriptPins(double t, double dt) {
     for (const Script& script : scripts_)
       for (std::size_t k = 0; k < script.vertices.size(); ++k)
         system_.v[static_cast<std::size_t>(script.vertices[k])] =
-            (scriptedPosition(script, script.rest[k], t + dt) - scriptedPosition(script, script.rest[k], t)) / dt;
+            (script.motion.apply(script.rest[k], t + dt) - script.motion.apply(script.rest[k], t)) / dt;
   }
   void placePins(double t) {
     for (const Script& script : scripts_)
       for (std::size_t k = 0; k < script.vertices.size(); ++k)
-        system_.x[static_cast<std::size_t>(script.vertices[k])] = scriptedPosition(script, script.rest[k], t);
+        system_.x[static_cast<std::size_t>(script.vertices[k])] = script.motion.apply(script.rest[k], t);
   }
 
   // One outer step of the collision loop (Selle ch. 6.2), its stages timed as Table 6.3's A, B, C.
@@ -589,6 +623,7 @@ class MassSpringPhenomenon final : public Phenomenon {
   solids::BodyContact contact_;
   std::vector<std::shared_ptr<const geometry::Shape3>> bodyShapes_;  // as they stand now
   std::vector<solids::ContactBody> bodyRest_;  // as they stand at t = 0
+  std::vector<geometry::RigidMotion> bodyMotion_;
   solids::NewmarkStepper stepper_;
   std::vector<Script> scripts_;
   std::unique_ptr<solids::ClothCollisionLoop> loop_;  // cloth with self-collisions

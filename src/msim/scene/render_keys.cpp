@@ -162,11 +162,15 @@ Schema renderSchema() {
   r.vector("background", "", {0.02, 0.02, 0.03}, "radiance behind the medium, linear RGB").lengths({3}).min(0.0);
   r.vector("ambient", "", {0.1, 0.1, 0.12}, "sky radiance scattered by the medium, linear RGB").lengths({3}).min(0.0);
   r.vector("surface_albedo", "", {0.6, 0.6, 0.6}, "diffuse colour of obstacles, linear RGB").lengths({3}).min(0.0).max(1.0);
+  r.vector("mesh_albedo", "", {0.6, 0.6, 0.6}, "diffuse colour of meshes (render.meshes, a cloth or solid run's surface), linear RGB")
+      .lengths({3})
+      .min(0.0)
+      .max(1.0);
   r.number("exposure", "", 1.0, "radiance multiplier before tone mapping").min(0.0, Bound::Exclusive);
   r.boolean("multiple_scattering", true, "add multiple scattering by the diffusion approximation (ch. 5.5)");
   r.number("step", "cells", 0.5, "ray-march step").min(0.05).max(4.0);
   r.integer("slab_cells", 8, "2D scenes render as a slab this many cells thick, seen face-on").min(1).max(256);
-  r.array("meshes", meshSchema(), "triangle meshes drawn with every frame, shaded with surface_albedo");
+  r.array("meshes", meshSchema(), "triangle meshes drawn with every frame, shaded with mesh_albedo");
   r.field("points", pointsSchema());
   r.field("liquid", liquidSchema());
   r.field("sky", skySchema());
@@ -230,6 +234,7 @@ RenderKeys renderKeys(const json& r, const std::string& source, const std::files
   c.settings.background = paddedVec3(r.at("background"));
   c.settings.ambient = paddedVec3(r.at("ambient"));
   c.settings.surfaceAlbedo = paddedVec3(r.at("surface_albedo"));
+  c.settings.meshAlbedo = paddedVec3(r.at("mesh_albedo"));
   c.settings.exposure = r.at("exposure").get<double>();
   c.settings.stepCells = r.at("step").get<double>();
   k.slabCells = r.at("slab_cells").get<int>();

@@ -5,6 +5,7 @@
 // renders saved frames with the keys stored in their run.json.
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,8 @@ struct RenderKeys {
   render::FrameRenderConfig config;
   std::string densityGrid, temperatureGrid, emitterGrid, obstacleGrid, liquidGrid;  // "" = not used
   std::shared_ptr<const RenderGeometry> geometry;  // never null; may be empty
+  // The run's grid: the empty medium of a frame that holds only a surface mesh (cloth, solid).
+  std::optional<GridSpec<3>> domain;
 };
 
 // From the resolved "render" object; InputError naming `source` and the key for values the

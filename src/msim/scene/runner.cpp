@@ -53,6 +53,7 @@ Layout layoutFor(const Scene& scene, const fs::path& outDir) {
   l.name = scene.name();
   l.renderDir = outDir / "render";
   l.render = renderKeys(scene.resolved.at("render"), scene.file.string(), scene.directory());
+  if (scene.dimensions == 3) l.render.domain = scene.gridSpec<3>();
   if (l.render.enabled && scene.dimensions != 3)
     throw InputError(scene.file.string() + ": 'render.enabled' needs a 3D scene (2D scenes have their preview)");
   if (l.render.enabled && !l.vdb)

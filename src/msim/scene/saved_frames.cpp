@@ -12,6 +12,8 @@
 #include "msim/core/resample.hpp"
 #include "msim/io/atomic_file.hpp"
 #include "msim/io/exr.hpp"
+#include "msim/io/obj.hpp"
+#include "msim/io/ply.hpp"
 #include "msim/io/vdb.hpp"
 #include "msim/io/video.hpp"
 #include "msim/scene/progress_bar.hpp"
@@ -62,6 +64,31 @@ RenderKeys jobKeys(const nlohmann::json& storedRender, const std::vector<std::st
   return renderKeys(resolve(root, doc, source).at("render"), source, baseDirectory);
 }
 
+// The grid of a 3D run from its run.json (domain.min, the cell size and resolution), if it says.
+std::optional<GridSpec<3>> runDomain(const nlohmann::json& run) {
+  const nlohmann::json grid = run.value("grid", nlohmann::json::object());
+  const nlohmann::json domain = run.value("parameters", nlohmann::json::object()).value("domain", nlohmann::json::object());
+  if (grid.value("dimensions", 0) != 3 || !grid.contains("resolution") || !grid.contains("dx_m") || !domain.contains("min"))
+    return std::nullopt;
+  GridSpec<3> spec;
+  spec.dx = grid.at("dx_m").get<double>();
+  for (int a = 0; a < 3; ++a) {
+    spec.origin[a] = domain.at("min").at(a).get<double>();
+    spec.res[a] = grid.at("resolution").at(a).get<int>();
+  }
+  return spec;
+}
+
+// The surface mesh a cloth or solid run wrote beside a frame: <run>/mesh/<stem>.ply (or .obj) for
+// <run>/vdb/<stem>.vdb.
+std::optional<TriangleMesh> frameMesh(const fs::path& vdbFile) {
+  const fs::path dir = vdbFile.parent_path().parent_path() / "mesh";
+  const std::string stem = vdbFile.stem().string();
+  if (fs::exists(dir / (stem + ".ply"))) return io::readPlyMesh(dir / (stem + ".ply")).mesh;
+  if (fs::exists(dir / (stem + ".obj"))) return io::readObj(dir / (stem + ".obj"));
+  return std::nullopt;
+}
+
 }  // namespace
 
 void renderSavedFrame(const io::VdbFile& frame, const RenderKeys& keys, const fs::path& png,
@@ -70,14 +97,17 @@ void renderSavedFrame(const io::VdbFile& frame, const RenderKeys& keys, const fs
   const std::string vdbFile = frame.path().string();
   std::optional<Grid<float, 3>> liquid;
   if (hasGrid(grids, keys.liquidGrid)) liquid = readForRender(frame, keys.liquidGrid, keys.slabCells);
-  if (!hasGrid(grids, keys.densityGrid) && !liquid)
-    throw InputError(fmt::format("{}: no grid '{}' or '{}' to render (the file has: {}); set render.grids.density or "
-                                 "render.grids.liquid",
+  // A cloth or solid run: its surface mesh in the run's grid.
+  std::optional<TriangleMesh> surface;
+  if (!hasGrid(grids, keys.densityGrid) && !liquid && keys.domain) surface = frameMesh(frame.path());
+  if (!hasGrid(grids, keys.densityGrid) && !liquid && !surface)
+    throw InputError(fmt::format("{}: no grid '{}' or '{}' to render (the file has: {}) and no surface mesh in the "
+                                 "run's mesh/ folder; set render.grids.density or render.grids.liquid",
                                  vdbFile, keys.densityGrid, keys.liquidGrid, fmt::join(grids, ", ")));
-  // A liquid run has no smoke: an empty medium of the liquid's layout.
-  const Grid<float, 3> density = hasGrid(grids, keys.densityGrid)
-                                     ? readForRender(frame, keys.densityGrid, keys.slabCells)
-                                     : Grid<float, 3>(liquid->spec(), liquid->size(), liquid->offset());
+  // A liquid run has no smoke: an empty medium of the liquid's layout; a cloth's, of the run's grid.
+  const Grid<float, 3> density = hasGrid(grids, keys.densityGrid) ? readForRender(frame, keys.densityGrid, keys.slabCells)
+                                 : liquid ? Grid<float, 3>(liquid->spec(), liquid->size(), liquid->offset())
+                                          : Grid<float, 3>(*keys.domain, 0.0f);
   std::optional<Grid<float, 3>> temperature, emitter;
   if (hasGrid(grids, keys.temperatureGrid)) temperature = readForRender(frame, keys.temperatureGrid, keys.slabCells);
   if (temperature && hasGrid(grids, keys.emitterGrid)) emitter = readForRender(frame, keys.emitterGrid, keys.slabCells);
@@ -94,6 +124,7 @@ void renderSavedFrame(const io::VdbFile& frame, const RenderKeys& keys, const fs
   surfaces.distance = obstacles ? &*obstacles : nullptr;
   surfaces.liquid = liquid ? &*liquid : nullptr;
   for (const TriangleMesh& mesh : keys.geometry->meshes) surfaces.meshes.push_back(&mesh);
+  if (surface) surfaces.meshes.push_back(&*surface);
   if (!keys.geometry->points.empty()) {
     render::PointSet points;
     points.positions = &keys.geometry->points;
@@ -134,6 +165,7 @@ std::vector<fs::path> renderSavedFrames(const RenderJob& job) {
     const fs::path sceneFile = run.value("scene_file", std::string());
     keys = jobKeys(params.value("render", nlohmann::json::object()), job.overrides, runFile.string(),
                    sceneFile.parent_path());
+    keys.domain = runDomain(run);
     if (fs::is_directory(job.input / "vdb"))
       for (const auto& e : fs::directory_iterator(job.input / "vdb"))
         if (e.path().extension() == ".vdb") frames.push_back(e.path());

@@ -22,9 +22,10 @@ Vec3 BodyContact::normal(std::size_t b, const Vec3& x) const {
 Vec3 BodyContact::gamma(std::size_t b, const Vec3& x, const Vec3& v) const {
   const ContactBody& body = bodies_[b];
   const Vec3 n = normal(b, x);
-  const double vN = v.dot(n), bodyN = body.velocity.dot(n);
+  const Vec3 bodyV = body.velocityAt(x);
+  const double vN = v.dot(n), bodyN = bodyV.dot(n);
   const double starN = std::max(vN, bodyN);
-  const Vec3 bodyT = body.velocity - bodyN * n;
+  const Vec3 bodyT = bodyV - bodyN * n;
   const Vec3 relT = (v - vN * n) - bodyT;
   const double slip = relT.norm();
   const double keep = slip > 0.0 ? std::max(0.0, 1.0 - body.friction * (starN - vN) / slip) : 0.0;
@@ -40,7 +41,7 @@ Vec3 BodyContact::move(const Vec3& x, const Vec3& v, double dt, int& body) const
     body = static_cast<int>(b);
     const Vec3 n = normal(b, end);
     if (method_ == ContactMethod::Projection) return end - after * n;
-    const double before = std::max(0.0, distance(b, x) + dt * bodies_[b].velocity.dot(n));
+    const double before = std::max(0.0, distance(b, x) + dt * bodies_[b].velocityAt(end).dot(n));
     const double theta = before / (before - after);
     const Vec3 meet = x + theta * dt * v;
     return meet + (1.0 - theta) * dt * gamma(b, meet, v);

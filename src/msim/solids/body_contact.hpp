@@ -1,6 +1,6 @@
 #pragma once
 // Contact and friction of particles with bodies (Selle ch. 6.5): bodies are signed distances,
-// negative inside, moving with a velocity. The map
+// negative inside, moving rigidly (a velocity, and an angular velocity about a centre). The map
 //   Gamma(v):  v*_N = max(v_N, v_BN),
 //              v*_T = v_BT + max(0, 1 - mu (v*_N - v_N) / |v_T,rel|) v_T,rel,
 //              Gamma(v) = v*_N N + v*_T
@@ -14,6 +14,8 @@
 #include <memory>
 #include <vector>
 
+#include <Eigen/Geometry>
+
 #include "msim/core/vec.hpp"
 #include "msim/geometry/shape.hpp"
 
@@ -23,8 +25,13 @@ enum class ContactMethod { CrossingFraction, Projection };
 
 struct ContactBody {
   std::shared_ptr<const geometry::Shape3> shape;  // the body at the end of the step (signed distance)
-  Vec3 velocity = Vec3::Zero();                   // [m/s], translating
+  Vec3 velocity = Vec3::Zero();                   // [m/s] of its centre
   double friction = 0.0;                          // mu
+  Vec3 angularVelocity = Vec3::Zero();            // [rad/s], turning about
+  Vec3 center = Vec3::Zero();                     // this point, where it stands at the step's end
+
+  // The body's velocity at x: v + omega x (x - c).
+  Vec3 velocityAt(const Vec3& x) const { return velocity + angularVelocity.cross(x - center); }
 };
 
 class BodyContact {
