@@ -244,7 +244,12 @@ class MassSpringPhenomenon final : public Phenomenon {
 
   // The explicit part's limit 2 / omega. Explicit springs: omega^2 = k / (l0 mu) along each.
   // Implicit springs (ch. 5.5, with their tension across them) have no limit, and a frame can be
-  // one step; what stays explicit is the wind's drag, c A / m per particle (windForces).
+  // one step; what stays explicit is the wind's drag, c A / m per particle (windForces). With
+  // self-collisions an inner step also moves no vertex further than the thickness relative to
+  // the cloth's mean motion: repulsion (step B) acts only on pairs closer than it, and a pair that
+  // crossed the band within one inner step is left to step C, whose impulse takes back the
+  // pair's whole approach over the outer step (an outer step of a frame would tear the cloth
+  // where pieces meet fast).
   double innerStableTimestep() const {
     double step = std::numeric_limits<double>::infinity();
     if (!implicitSprings_)
@@ -254,6 +259,19 @@ class MassSpringPhenomenon final : public Phenomenon {
         step = std::min(step, 2.0 * std::sqrt(springMass_[i] * s.restLength / s.stiffness));
       }
     if (!winds_.empty() && windDrag_ > 0.0) step = std::min(step, 2.0 * massPerDragArea_ / windDrag_);
+    if (loop_) {
+      Vec3 momentum = Vec3::Zero();
+      double mass = 0.0;
+      for (std::size_t p = 0; p < system_.size(); ++p) {
+        momentum += system_.mass[p] * system_.v[p];
+        mass += system_.mass[p];
+      }
+      const Vec3 mean = momentum / mass;
+      double fastest = 0.0;
+      for (std::size_t p = 0; p < system_.size(); ++p)
+        if (!system_.pinned[p]) fastest = std::max(fastest, (system_.v[p] - mean).norm());
+      if (fastest > 0.0) step = std::min(step, loop_->settings().repulsion.thickness / fastest);
+    }
     return cfl_ * step;
   }
 
