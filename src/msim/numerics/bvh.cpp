@@ -14,7 +14,7 @@ constexpr double kCostTraversal = 1.0, kCostPrimitive = 1.0;
 
 }  // namespace
 
-Bvh::Bvh(const std::vector<Aabb>& boxes) {
+Bvh::Bvh(const std::vector<Aabb>& boxes) : boxes_(boxes) {
   if (boxes.empty()) return;
   const int n = static_cast<int>(boxes.size());
   primitives_.resize(boxes.size());
@@ -107,6 +107,7 @@ void Bvh::build(int node, int begin, int end, int depth, const std::vector<Aabb>
 
 void Bvh::refit(const std::vector<Aabb>& boxes) {
   if (boxes.size() != primitives_.size()) throw std::invalid_argument("Bvh::refit: the box count differs from the tree's");
+  boxes_ = boxes;
   if (!nodes_.empty()) refitNode(0, boxes);
 }
 

@@ -58,7 +58,10 @@ class Bvh {
       const Node& node = nodes_[static_cast<std::size_t>(stack[--top])];
       if (!node.box.overlaps(query)) continue;
       if (node.count > 0) {
-        for (int k = node.first; k < node.first + node.count; ++k) f(primitives_[static_cast<std::size_t>(k)]);
+        for (int k = node.first; k < node.first + node.count; ++k) {
+          const int p = primitives_[static_cast<std::size_t>(k)];
+          if (boxes_[static_cast<std::size_t>(p)].overlaps(query)) f(p);
+        }
         continue;
       }
       stack[top++] = node.first + 1;
@@ -79,7 +82,9 @@ class Bvh {
     bool found = false;
     while (top > 0) {
       const Node& node = nodes_[static_cast<std::size_t>(stack[--top])];
-      if (!(entry(node.box, origin, inv, tMax) <= tMax)) continue;
+      // A miss is +infinity, which an unbounded tMax would not cull: boxes are finite, so a box
+      // the ray enters has a finite entry.
+      if (entry(node.box, origin, inv, tMax) == kMiss) continue;
       if (node.count > 0) {
         for (int k = node.first; k < node.first + node.count; ++k)
           if (hit(primitives_[static_cast<std::size_t>(k)], tMax)) {
@@ -100,6 +105,7 @@ class Bvh {
 
  private:
   static constexpr int kMaxDepth = 60;  // deeper nodes become leaves, which bounds the stack
+  static constexpr double kMiss = std::numeric_limits<double>::infinity();
 
   struct Node {
     Aabb box;
@@ -116,7 +122,7 @@ class Bvh {
       t0 = ta > t0 ? ta : t0;  // NaN (0 * inf on a box face) leaves the bound unchanged
       t1 = tb < t1 ? tb : t1;
     }
-    return t0 <= t1 ? t0 : std::numeric_limits<double>::infinity();
+    return t0 <= t1 ? t0 : kMiss;
   }
 
   void build(int node, int begin, int end, int depth, const std::vector<Aabb>& boxes, std::vector<Vec3>& centres);
@@ -124,6 +130,7 @@ class Bvh {
 
   std::vector<Node> nodes_;
   std::vector<int> primitives_;
+  std::vector<Aabb> boxes_;  // per primitive, as built or last refitted
 };
 
 }  // namespace msim::numerics

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <utility>
 
 #include <fmt/format.h>
@@ -15,9 +16,10 @@
 #include "msim/io/obj.hpp"
 #include "msim/io/ply.hpp"
 #include "msim/io/vdb.hpp"
-#include "msim/render/density_preview.hpp"
+#include "msim/render/frame_renderer.hpp"
 #include "msim/scene/json_vectors.hpp"
 #include "msim/scene/phenomenon_support.hpp"
+#include "msim/scene/render_keys.hpp"
 #include "msim/scene/scene_file.hpp"
 #include "msim/scene/schema/shape_schema.hpp"
 #include "msim/scene/turbulent_wind_keys.hpp"
@@ -233,10 +235,9 @@ class MassSpringPhenomenon final : public Phenomenon {
     massPerDragArea_ = std::numeric_limits<double>::infinity();
     for (std::size_t p = 0; p < system_.size(); ++p)
       if (!system_.pinned[p] && dragArea[p] > 0.0) massPerDragArea_ = std::min(massPerDragArea_, system_.mass[p] / dragArea[p]);
-    preview_ = previewSettings(scene);
-    preview_.colour = {0.85f, 0.45f, 0.30f};
-    coverage_ = Grid<float, 3>(spec_, 0.0f);
-    markBodies();
+    previewRender_ = renderKeys(scene.resolved.at("render"), source_, scene.directory()).config;
+    previewRender_.multipleScattering = false;
+    emptyMedium_ = Grid<float, 3>(spec_, 0.0f);
   }
 
   // With the collision loop a step is an outer step of up to k_i inner steps.
@@ -318,14 +319,7 @@ class MassSpringPhenomenon final : public Phenomenon {
   // The vertices (positions, velocities) for --resume and tools, and the bodies where they stand as
   // "obstacle_distance" (signed, negative inside) for renderers.
   void writeVolume(io::VdbWriter& writer) const override {
-    if (!bodyShapes_.empty()) {
-      Grid<float, 3> distance(spec_, std::numeric_limits<float>::infinity());
-      for (const auto& shape : bodyShapes_) {
-        const Grid<float, 3> d = shape->distanceField(spec_);
-        for (std::size_t i = 0; i < distance.count(); ++i) distance[i] = std::min(distance[i], d[i]);
-      }
-      writer.addLevelSet("obstacle_distance", distance);
-    }
+    if (!bodyShapes_.empty()) writer.addLevelSet("obstacle_distance", bodyDistance());
     io::PointCloud cloud;
     std::vector<io::PointAttribute> v = {{"vx", {}}, {"vy", {}}, {"vz", {}}};
     for (std::size_t p = 0; p < system_.size(); ++p) {
@@ -349,35 +343,23 @@ class MassSpringPhenomenon final : public Phenomenon {
     if (meshFormat_ == "obj" || meshFormat_ == "both") io::writeObj(dir / (stem + ".obj"), now);
   }
 
+  // The surface mesh with the bodies, by the renderer of `msim render` (the scene's render.*
+  // camera, lights and mesh_albedo; single scattering is all an empty medium needs).
   io::Image preview() const override {
-    // The cells the cloth's triangles, or the solid's tetrahedra, pass through, seen as a dense
-    // medium (a solid filled, not only its surface).
-    coverage_.fill(0.0f);
-    auto mark = [&](const Vec3& x) {
-      const IVec3 cell = ((x - spec_.origin) / spec_.dx).array().floor().cast<int>();
-      if ((cell.array() >= 0).all() && (cell.array() < spec_.res.array()).all()) coverage_(cell) = 1.0f;
-    };
-    // Samples of the simplex spanned by corners[0..count) at about half a cell apart.
-    auto sampleSimplex = [&](const std::array<Vec3, 4>& corners, int count) {
-      double longest = 0.0;
-      for (int i = 0; i < count; ++i)
-        for (int j = i + 1; j < count; ++j) longest = std::max(longest, (corners[j] - corners[i]).norm());
-      const int n = std::max(1, static_cast<int>(std::ceil(2.0 * longest / spec_.dx)));
-      for (int i = 0; i <= n; ++i)
-        for (int j = 0; i + j <= n; ++j)
-          for (int k = 0; i + j + k <= (count == 4 ? n : 0); ++k)
-            mark(corners[0] + (double(i) / n) * (corners[1] - corners[0]) + (double(j) / n) * (corners[2] - corners[0]) +
-                 (count == 4 ? (double(k) / n) * (corners[3] - corners[0]) : Vec3(Vec3::Zero())));
-    };
-    if (system_.tetrahedra.empty()) {
-      for (const auto& t : mesh_.triangles) sampleSimplex({system_.x[t[0]], system_.x[t[1]], system_.x[t[2]], Vec3::Zero()}, 3);
-    } else {
-      for (const auto& t : system_.tetrahedra)
-        sampleSimplex({system_.x[t.v[0]], system_.x[t.v[1]], system_.x[t.v[2]], system_.x[t.v[3]]}, 4);
+    TriangleMesh now = mesh_;
+    now.vertices = system_.x;
+    render::FrameSurfaces surfaces;
+    surfaces.meshes = {&now};
+    std::optional<Grid<float, 3>> bodies;
+    if (!bodyShapes_.empty()) {
+      bodies = bodyDistance();
+      surfaces.distance = &*bodies;
     }
-    if (std::any_of(bodyMotion_.begin(), bodyMotion_.end(), [](const geometry::RigidMotion& m) { return m.moves(); }))
-      markBodies();
-    return render::renderDensityPreview(coverage_, preview_, bodyShapes_.empty() ? nullptr : &solid_);
+    try {
+      return render::renderFrame(previewRender_, emptyMedium_, nullptr, nullptr, surfaces).render.image;
+    } catch (const std::invalid_argument& e) {
+      throw InputError(fmt::format("{}: the preview cannot be drawn: {}", source_, e.what()));
+    }
   }
 
   void restore(const fs::path& vdbFile, double time) override {
@@ -466,14 +448,14 @@ class MassSpringPhenomenon final : public Phenomenon {
     std::vector<Vec3> rest;  // their positions at t = 0
   };
 
-  // The cells inside the bodies as they stand, grey in the previews.
-  void markBodies() const {
-    solid_ = Grid<float, 3>(spec_, 0.0f);
+  // The bodies as they stand: signed distance at the cell centres, negative inside.
+  Grid<float, 3> bodyDistance() const {
+    Grid<float, 3> distance(spec_, std::numeric_limits<float>::infinity());
     for (const auto& shape : bodyShapes_) {
       const Grid<float, 3> d = shape->distanceField(spec_);
-      for (std::size_t i = 0; i < solid_.count(); ++i)
-        if (d[i] < 0.0f) solid_[i] = 1.0f;
+      for (std::size_t i = 0; i < distance.count(); ++i) distance[i] = std::min(distance[i], d[i]);
     }
+    return distance;
   }
 
   // Moving bodies (bodies[].velocity, angular_velocity) as they stand at time t: the contact step
@@ -650,9 +632,8 @@ class MassSpringPhenomenon final : public Phenomenon {
   bool implicitSprings_ = true;
   double strainLimit_ = 0.0;
   std::vector<double> springMass_;  // each spring's reduced mass (the free end's with one end pinned)
-  render::PreviewSettings preview_;
-  mutable Grid<float, 3> coverage_;
-  mutable Grid<float, 3> solid_;
+  render::FrameRenderConfig previewRender_;
+  Grid<float, 3> emptyMedium_;
   std::vector<turbulence::TurbulentWind<3>> winds_;
   double windDrag_ = 0.0;
   double massPerDragArea_ = 0.0;  // the smallest m / A over the free particles [kg/m^2]
