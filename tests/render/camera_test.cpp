@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <stdexcept>
 
 #include "expect_invalid.hpp"
 #include "msim/render/camera.hpp"
@@ -68,12 +69,16 @@ TEST(Camera, VerticalFieldOfViewSpansTheImageHeight) {
 TEST(Camera, FrameBoxSeesAllEightCornersAndFillsTheImage) {
   struct Case {
     Vec3 lo, hi;
-    int width, height, upAxis;
+    int width, height, upAxis, viewAxis = -1;
   };
   for (const Case& k : {Case{Vec3::Zero(), Vec3::Ones(), 640, 480, 1}, Case{Vec3(-1, 0, 2), Vec3(3, 1, 2.5), 640, 480, 1},
                         Case{Vec3::Zero(), Vec3(0.5, 2, 1), 200, 400, 1}, Case{Vec3::Zero(), Vec3(1, 2, 3), 320, 240, 2},
-                        Case{Vec3(-2, -2, -2), Vec3(2, 0, 1), 100, 100, 0}}) {
-    const Camera c = frameBox(k.lo, k.hi, k.width, k.height, k.upAxis);
+                        Case{Vec3(-2, -2, -2), Vec3(2, 0, 1), 100, 100, 0}, Case{Vec3::Zero(), Vec3(2, 1, 1.5), 640, 480, 2, 1},
+                        Case{Vec3(-1, 0, -1), Vec3(1, 1, 1), 320, 240, 1, 0}}) {
+    const Camera c = frameBox(k.lo, k.hi, k.width, k.height, k.upAxis, k.viewAxis);
+    if (k.viewAxis >= 0) {  // looking along -viewAxis
+      EXPECT_LT((CameraRays(c).forward() + Vec3::Unit(k.viewAxis)).norm(), 1e-12);
+    }
     EXPECT_EQ(c.width, k.width);
     EXPECT_EQ(c.up, Vec3::Unit(k.upAxis));
     const CameraRays rays(c);
@@ -93,6 +98,11 @@ TEST(Camera, FrameBoxSeesAllEightCornersAndFillsTheImage) {
   }
   const Camera c = frameBox(Vec3::Zero(), Vec3::Ones(), 640, 480);
   EXPECT_LT((CameraRays(c).forward() - Vec3(0, 0, -1)).norm(), 1e-12);  // looking along -z
+}
+
+TEST(Camera, FrameBoxRefusesAViewAlongTheUpAxis) {
+  EXPECT_THROW(frameBox(Vec3::Zero(), Vec3::Ones(), 64, 64, 1, 1), std::invalid_argument);
+  EXPECT_THROW(frameBox(Vec3::Zero(), Vec3::Ones(), 64, 64, 1, 3), std::invalid_argument);
 }
 
 TEST(Camera, InvalidCamerasThrowWithAMessage) {

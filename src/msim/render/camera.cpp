@@ -56,15 +56,18 @@ std::optional<Vec2> CameraRays::project(const Vec3& x) const {
   return Vec2(halfWidth_ + d.dot(right_) / (depth * pixelScale_), halfHeight_ - d.dot(up_) / (depth * pixelScale_));
 }
 
-Camera frameBox(const Vec3& lo, const Vec3& hi, int width, int height, int upAxis) {
+Camera frameBox(const Vec3& lo, const Vec3& hi, int width, int height, int upAxis, int viewAxis) {
   if (upAxis < 0 || upAxis > 2) throw std::invalid_argument("frameBox: upAxis must be 0, 1 or 2, got " + std::to_string(upAxis));
+  if (viewAxis < 0) viewAxis = (upAxis + 1) % 3;
+  if (viewAxis > 2 || viewAxis == upAxis)
+    throw std::invalid_argument("frameBox: viewAxis must be 0, 1 or 2 and differ from upAxis, got " +
+                                std::to_string(viewAxis));
   if (!lo.allFinite() || !hi.allFinite() || !(lo.array() < hi.array()).all())
     throw std::invalid_argument("frameBox: empty or non-finite box " + str(lo) + " .. " + str(hi));
   if (width <= 0 || height <= 0)
     throw std::invalid_argument("frameBox: image size must be positive, got " + std::to_string(width) + " x " +
                                 std::to_string(height));
-  const int viewAxis = (upAxis + 1) % 3;
-  const int rightAxis = (upAxis + 2) % 3;  // forward x up = -viewAxis x upAxis = rightAxis (cyclic)
+  const int rightAxis = 3 - upAxis - viewAxis;  // the image's horizontal
   Camera c;
   c.width = width;
   c.height = height;

@@ -54,10 +54,10 @@ class CameraRays {
 };
 
 // A camera that frames the box [lo, hi] (a grid's domain): it looks at the box centre along
-// -viewAxis with viewAxis = (upAxis + 1) % 3 (along -z for the default y-up), image up along
-// +upAxis, from the distance at which the near face of the box fills the image less a 10% border
-// in the tighter of the two directions (so all 8 corners are in view). std::invalid_argument for
-// upAxis outside 0..2, an empty box or a size that is not positive.
-Camera frameBox(const Vec3& lo, const Vec3& hi, int width, int height, int upAxis = 1);
+// -viewAxis (by default (upAxis + 1) % 3: along -z for the default y-up), image up along +upAxis,
+// from the distance at which the near face of the box fills the image less a 10% border in the
+// tighter of the two directions (so all 8 corners are in view). std::invalid_argument for an axis
+// outside 0..2, a view axis equal to the up axis, an empty box or a size that is not positive.
+Camera frameBox(const Vec3& lo, const Vec3& hi, int width, int height, int upAxis = 1, int viewAxis = -1);
 
 }  // namespace msim::render

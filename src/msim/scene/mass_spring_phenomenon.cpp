@@ -16,6 +16,8 @@
 #include "msim/io/obj.hpp"
 #include "msim/io/ply.hpp"
 #include "msim/io/vdb.hpp"
+#include "msim/render/camera.hpp"
+#include "msim/render/density_preview.hpp"
 #include "msim/render/frame_renderer.hpp"
 #include "msim/scene/json_vectors.hpp"
 #include "msim/scene/phenomenon_support.hpp"
@@ -237,6 +239,11 @@ class MassSpringPhenomenon final : public Phenomenon {
       if (!system_.pinned[p] && dragArea[p] > 0.0) massPerDragArea_ = std::min(massPerDragArea_, system_.mass[p] / dragArea[p]);
     previewRender_ = renderKeys(scene.resolved.at("render"), source_, scene.directory()).config;
     previewRender_.multipleScattering = false;
+    if (!previewRender_.camera) {  // render.camera.auto: the domain seen along outputs.preview's axes
+      const render::PreviewSettings axes = previewSettings(scene);
+      previewRender_.camera = render::frameBox(spec_.origin, spec_.origin + spec_.extent(), previewRender_.width,
+                                               previewRender_.height, axes.upAxis, axes.viewAxis);
+    }
     emptyMedium_ = Grid<float, 3>(spec_, 0.0f);
   }
 
