@@ -5,9 +5,10 @@
 #   scripts/make_gallery.sh [SCENE ...]     (default: every scene in the table below)
 #
 # Each scene runs into out/gallery/<scene> with the settings of its gallery row (frame count and
-# --set overrides, listed below); the preview of its last frame becomes docs/images/<scene>.png and,
-# for gases, smoke and liquids, `msim render --last` of the run (its own render keys: camera, lights, medium)
-# docs/images/render_<scene>.png (2D scenes render as slabs). Needs the release build (make app).
+# --set overrides, listed below); the preview of its last frame becomes docs/images/<scene>.png
+# and, for gases, smoke, liquids and cloth, `msim render --last` of the run (its own render keys:
+# camera, lights, medium) docs/images/render_<scene>.png (2D scenes render as slabs). Needs the
+# release build (make app).
 # The whole table takes about 30 minutes on 2 cores, most of it the large crowds, the turbulent
 # smoke and the hourglasses.
 set -euo pipefail
@@ -51,7 +52,10 @@ drop_into_pool      | render  | --frames 15
 wave_maker_2d       | preview | --frames 96
 pour_glass          | render  | --frames 30
 river_rapids        | render  | --frames 72
-cloth_drape         | preview | --frames 24
+cloth_drape         | render  |
+cloth_twist         | render  |
+cloth_spinning_ball | render  |
+cloth_leaves        | render  |
 cloth_flag          | preview | --frames 40
 solid_torus         | preview |
 "
