@@ -183,6 +183,37 @@ TEST(Surfaces, MeshAndPointSphereMatchTheDistanceSphere) {
   EXPECT_LT(pointError.farWorst, 1e-5);
 }
 
+TEST(Surfaces, MeshLyingOnASampledSolidIsDrawnInFrontOfIt) {
+  // A mesh on the sphere's surface (its vertices on it, as a cloth resting on a body) and the
+  // same sphere as a distance grid, in different colours: the mesh is exact, the grid's trilinear
+  // surface is good to a fraction of a cell, so wherever the two meet the mesh shows, not the
+  // grid's solid poking through it (only at grazing angles near the outline, where the mesh's
+  // chords lie more than a quarter cell behind the sampled surface along the ray: 1.0% of the
+  // ball; 98% without the mesh's precedence).
+  const Grid<float, 3> rho(unitBox());
+  const Grid<float, 3> sdf = sphereDistance();
+  const TriangleMesh mesh = uvSphere(48, 24);
+  VolumeInput input{&rho};
+  input.surfaceDistance = &sdf;
+  input.meshes = {&mesh};
+  VolumeRenderSettings settings = surfaceSettings();
+  settings.surfaceAlbedo = Vec3(0.1, 0.1, 0.9);
+  settings.meshAlbedo = Vec3(0.9, 0.1, 0.1);
+  const Camera camera = frontCamera();
+  const RenderResult r = renderVolume(input, camera, {sun(kToLight, kIrradiance)}, Medium(), settings);
+  int ball = 0, solidShowing = 0;
+  for (int y = 0; y < camera.height; ++y)
+    for (int x = 0; x < camera.width; ++x) {
+      const Vec3 v = pixel(r.radiance, x, y);
+      if (v.maxCoeff() <= 0.0) continue;  // background
+      ++ball;
+      if (v.z() > v.x()) ++solidShowing;
+    }
+  EXPECT_GT(ball, 500);
+  EXPECT_LT(solidShowing, 0.02 * ball);
+  RecordProperty("solid_showing_fraction", std::to_string(double(solidShowing) / ball));
+}
+
 TEST(Surfaces, BallBehindSmokeIsDimmedByBeerLambert) {
   Grid<float, 3> rho(unitBox());
   constexpr double rho0 = 0.2;

@@ -608,10 +608,10 @@ class VolumeScene final : public TracedScene {
   // The distance grid's solids, the floor, then anything nearer in the BVH.
   bool opaqueHit(const Ray& ray, double tMax, SurfaceHit& hit) const override {
     double tSurface = tMax, t0, t1;
-    bool found = false;
+    bool found = false, sampled = false;  // sampled: the nearest so far is the distance grid's
     if (distance_ && intersectBox(ray, lo_, hi_, t0, t1) && t0 < tMax &&
         traceDistance(sampler_, distance_, ray, t0, std::min(t1, tMax), ds_, tSurface)) {
-      found = true;
+      found = sampled = true;
       const Vec3 p = ray.origin + tSurface * ray.direction;
       Vec3 g = Vec3::Zero();  // gradient of the trilinear distance, central differences over a cell
       for (int a = 0; a < 3; ++a) {
@@ -629,9 +629,16 @@ class VolumeScene final : public TracedScene {
     }
     if (settings_.floor.intersect(ray, tSurface, hit)) {
       found = true;
+      sampled = false;
       tSurface = hit.t;
     }
-    if (!surfaces_.empty() && surfaces_.intersect(ray, tSurface, hit)) found = true;
+    // A mesh up to a quarter cell behind a sampled solid's surface is drawn in front of it: the
+    // distance is trilinear between cell centres, good to a fraction of a cell, while a mesh is
+    // exact (a cloth resting on a body would otherwise show the body through it in dots).
+    if (!surfaces_.empty()) {
+      const double reach = sampled ? std::min(tMax, tSurface + 0.25 * dx_) : tSurface;
+      if (surfaces_.intersect(ray, reach, hit)) found = true;
+    }
     return found;
   }
 
