@@ -90,12 +90,8 @@ struct Drop {
 // floor with friction 0.5, outer steps of 1/100 s in 8 inner steps, for `seconds`.
 Drop dropOntoFloor(bool collisions, double seconds) {
   TriangleMesh mesh = clothPatch(Vec3(-0.3, 0.7, 0.0), Vec3(0.6, 0.0, 0.0), Vec3(0.0, -0.6, 0.05), 24, 24);
-  ClothMaterial material;
-  material.edgeStiffness = 20.0;
-  material.edgeDamping = 0.002;
-  material.bendStiffness = 0.05;
-  material.bendDamping = 0.0001;
-  MassSpringSystem system = clothSystem(mesh, material);
+  MassSpringSystem system = clothSystem(
+      mesh, {.edgeStiffness = 20.0, .edgeDamping = 0.002, .bendStiffness = 0.05, .bendDamping = 0.0001});
   BodyContact floor;
   floor.addBody({std::make_shared<geometry::Plane<3>>(Vec3::Zero(), Vec3(0.0, 1.0, 0.0)), Vec3::Zero(), 0.5});
   NewmarkSettings newmark;

@@ -106,6 +106,12 @@ void expectConsistent(const EdgeEdgeProximity& r, const Vec3& p0, const Vec3& p1
   }
 }
 
+// A closest distance against the least of dense samples: never above it, and within 1e-6 of it.
+void expectMatchesSampling(double distance, double sampled, const std::string& what) {
+  EXPECT_LE(distance, sampled * (1.0 + 1e-12)) << what << ": no sample is closer";
+  EXPECT_NEAR(distance, sampled, 1e-6 * sampled) << what;
+}
+
 }  // namespace
 
 TEST(CollisionGeometry, PointTriangleMatchesDenseSamplingOnRandomCases) {
@@ -117,9 +123,7 @@ TEST(CollisionGeometry, PointTriangleMatchesDenseSamplingOnRandomCases) {
     const PointTriangleProximity r = pointTriangleProximity(p, a, b, c);
     const std::string what = "case " + std::to_string(k);
     expectConsistent(r, p, a, b, c, what);
-    const double sampled = sampledPointTriangleDistance(p, a, b, c);
-    EXPECT_LE(r.distance, sampled * (1.0 + 1e-12)) << what << ": no sample is closer";
-    EXPECT_NEAR(r.distance, sampled, 1e-6 * sampled) << what;
+    expectMatchesSampling(r.distance, sampledPointTriangleDistance(p, a, b, c), what);
   }
 }
 
@@ -180,9 +184,7 @@ TEST(CollisionGeometry, EdgeEdgeMatchesDenseSamplingOnRandomCases) {
     const EdgeEdgeProximity r = edgeEdgeProximity(p0, p1, q0, q1);
     const std::string what = "case " + std::to_string(k);
     expectConsistent(r, p0, p1, q0, q1, what);
-    const double sampled = sampledEdgeEdgeDistance(p0, p1, q0, q1);
-    EXPECT_LE(r.distance, sampled * (1.0 + 1e-12)) << what << ": no sample is closer";
-    EXPECT_NEAR(r.distance, sampled, 1e-6 * sampled) << what;
+    expectMatchesSampling(r.distance, sampledEdgeEdgeDistance(p0, p1, q0, q1), what);
   }
 }
 

@@ -128,12 +128,8 @@ TEST(MassSpring, HangingClothRowsCarryTheWeightBelowThem) {
   // leave it upwards pull with the weight of the cloth below (static equilibrium, eq. 5.1), 2%.
   const int nu = 12, nv = 12;
   const TriangleMesh mesh = clothPatch(Vec3(0.0, -1.0, 0.0), Vec3(1.0, 0.0, 0.0), Vec3(0.0, 1.0, 0.0), nu, nv);
-  ClothMaterial material;
-  material.arealDensity = 0.2;
-  material.edgeStiffness = 40.0;
-  material.edgeDamping = 0.05;
-  material.bendStiffness = 4.0;
-  MassSpringSystem cloth = clothSystem(mesh, material);
+  MassSpringSystem cloth = clothSystem(
+      mesh, {.arealDensity = 0.2, .edgeStiffness = 40.0, .edgeDamping = 0.05, .bendStiffness = 4.0});
   for (int i = 0; i <= nu; ++i) cloth.pinned[static_cast<std::size_t>(nv * (nu + 1) + i)] = 1;
   NewmarkStepper stepper(tight(true));
   for (int s = 0; s < 24 * 60; ++s) stepper.step(cloth, 1.0 / 24.0);
@@ -172,12 +168,8 @@ struct SwingingCloth {
 SwingingCloth swingAtOneStepPerFrame(bool tensionAcross, int newtonIterations) {
   const int n = 16;
   const TriangleMesh mesh = clothPatch(Vec3::Zero(), Vec3(1.0, 0.0, 0.0), Vec3(0.0, 0.0, 1.0), n, n);
-  ClothMaterial material;
-  material.arealDensity = 0.1;
-  material.edgeStiffness = 400.0;
-  material.edgeDamping = 0.01;
-  material.bendStiffness = 4.0;
-  MassSpringSystem cloth = clothSystem(mesh, material);
+  MassSpringSystem cloth = clothSystem(
+      mesh, {.arealDensity = 0.1, .edgeStiffness = 400.0, .edgeDamping = 0.01, .bendStiffness = 4.0});
   cloth.pinned[0] = cloth.pinned[static_cast<std::size_t>(n)] = 1;
   NewmarkSettings settings = tight(true);
   settings.cgTolerance = 1e-6;

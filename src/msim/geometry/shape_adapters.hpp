@@ -41,12 +41,12 @@ class Translated final : public Shape<D> {
 };
 
 // `inner` (standing as at t = 0) moved by `motion` to time t: distance inner(motion^-1(x)), exact
-// since a rigid motion keeps distances.
+// since a rigid motion keeps distances. The rotation is taken once, not per query.
 class RigidlyMoved final : public Shape<3> {
  public:
   RigidlyMoved(std::shared_ptr<const Shape<3>> inner, const RigidMotion& motion, double t)
-      : inner_(std::move(inner)), motion_(motion), t_(t) {}
-  double distance(const Vec3& x) const override { return inner_->distance(motion_.inverse(x, t_)); }
+      : inner_(std::move(inner)), rotation_(motion.rotation(t)), from_(motion.center), to_(motion.centerAt(t)) {}
+  double distance(const Vec3& x) const override { return inner_->distance(from_ + rotation_.transpose() * (x - to_)); }
   // The box around the moved corners of the inner box.
   Bounds<3> bounds() const override {
     const Bounds<3> b = inner_->bounds();
@@ -56,7 +56,7 @@ class RigidlyMoved final : public Shape<3> {
     for (int corner = 0; corner < 8; ++corner) {
       const Vec3 c((corner & 1) ? b.max.x() : b.min.x(), (corner & 2) ? b.max.y() : b.min.y(),
                    (corner & 4) ? b.max.z() : b.min.z());
-      const Vec3 moved = motion_.apply(c, t_);
+      const Vec3 moved = to_ + rotation_ * (c - from_);
       out.min = out.min.cwiseMin(moved);
       out.max = out.max.cwiseMax(moved);
     }
@@ -65,8 +65,8 @@ class RigidlyMoved final : public Shape<3> {
 
  private:
   std::shared_ptr<const Shape<3>> inner_;
-  RigidMotion motion_;
-  double t_;
+  Eigen::Matrix3d rotation_;
+  Vec3 from_, to_;  // the centre at t = 0 and at t
 };
 
 // `exact` sampled at the cell centres of `spec` and interpolated D-linearly inside it; outside

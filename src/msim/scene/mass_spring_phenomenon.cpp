@@ -268,13 +268,7 @@ class MassSpringPhenomenon final : public Phenomenon {
       }
     if (!winds_.empty() && windDrag_ > 0.0) step = std::min(step, 2.0 * massPerDragArea_ / windDrag_);
     if (loop_) {
-      Vec3 momentum = Vec3::Zero();
-      double mass = 0.0;
-      for (std::size_t p = 0; p < system_.size(); ++p) {
-        momentum += system_.mass[p] * system_.v[p];
-        mass += system_.mass[p];
-      }
-      const Vec3 mean = momentum / mass;
+      const Vec3 mean = system_.meanVelocity();
       double fastest = 0.0;
       for (std::size_t p = 0; p < system_.size(); ++p)
         if (!system_.pinned[p]) fastest = std::max(fastest, (system_.v[p] - mean).norm());
@@ -343,8 +337,7 @@ class MassSpringPhenomenon final : public Phenomenon {
     if (meshFormat_ == "none") return;
     const fs::path dir = runDir / "mesh";
     fs::create_directories(dir);
-    TriangleMesh now = mesh_;
-    now.vertices = system_.x;
+    const TriangleMesh now = surfaceNow();
     const std::string stem = fmt::format("{}_{:04d}", name_, frame);
     if (meshFormat_ != "obj") io::writePlyMesh(dir / (stem + ".ply"), now);
     if (meshFormat_ == "obj" || meshFormat_ == "both") io::writeObj(dir / (stem + ".obj"), now);
@@ -353,15 +346,10 @@ class MassSpringPhenomenon final : public Phenomenon {
   // The surface mesh with the bodies, by the renderer of `msim render` (the scene's render.*
   // camera, lights and mesh_albedo; single scattering is all an empty medium needs).
   io::Image preview() const override {
-    TriangleMesh now = mesh_;
-    now.vertices = system_.x;
+    const TriangleMesh now = surfaceNow();
     render::FrameSurfaces surfaces;
     surfaces.meshes = {&now};
-    std::optional<Grid<float, 3>> bodies;
-    if (!bodyShapes_.empty()) {
-      bodies = bodyDistance();
-      surfaces.distance = &*bodies;
-    }
+    if (!bodyShapes_.empty()) surfaces.distance = &bodyDistance();
     try {
       return render::renderFrame(previewRender_, emptyMedium_, nullptr, nullptr, surfaces).render.image;
     } catch (const std::invalid_argument& e) {
@@ -455,14 +443,27 @@ class MassSpringPhenomenon final : public Phenomenon {
     std::vector<Vec3> rest;  // their positions at t = 0
   };
 
-  // The bodies as they stand: signed distance at the cell centres, negative inside.
-  Grid<float, 3> bodyDistance() const {
+  // The mesh's triangles over the vertices where they stand (a solid's interior vertices too).
+  TriangleMesh surfaceNow() const {
+    TriangleMesh now = mesh_;
+    now.vertices = system_.x;
+    return now;
+  }
+
+  // The bodies as they stand: signed distance at the cell centres, negative inside. Sampled once
+  // for bodies at rest, once per time for moving ones (the VDB frame and the preview share it).
+  const Grid<float, 3>& bodyDistance() const {
+    const bool moving =
+        std::any_of(bodyMotion_.begin(), bodyMotion_.end(), [](const geometry::RigidMotion& m) { return m.moves(); });
+    if (bodyDistance_ && (!moving || bodyDistanceTime_ == time_)) return *bodyDistance_;
     Grid<float, 3> distance(spec_, std::numeric_limits<float>::infinity());
     for (const auto& shape : bodyShapes_) {
       const Grid<float, 3> d = shape->distanceField(spec_);
       for (std::size_t i = 0; i < distance.count(); ++i) distance[i] = std::min(distance[i], d[i]);
     }
-    return distance;
+    bodyDistance_ = std::move(distance);
+    bodyDistanceTime_ = time_;
+    return *bodyDistance_;
   }
 
   // Moving bodies (bodies[].velocity, angular_velocity) as they stand at time t: the contact step
@@ -631,6 +632,8 @@ class MassSpringPhenomenon final : public Phenomenon {
   std::vector<std::shared_ptr<const geometry::Shape3>> bodyShapes_;  // as they stand now
   std::vector<solids::ContactBody> bodyRest_;  // as they stand at t = 0
   std::vector<geometry::RigidMotion> bodyMotion_;
+  mutable std::optional<Grid<float, 3>> bodyDistance_;  // bodyDistance()'s, sampled at bodyDistanceTime_
+  mutable double bodyDistanceTime_ = 0.0;
   solids::NewmarkStepper stepper_;
   std::vector<Script> scripts_;
   std::unique_ptr<solids::ClothCollisionLoop> loop_;  // cloth with self-collisions

@@ -38,13 +38,7 @@ ClothCollisionStats ClothCollisionLoop::step(MassSpringSystem& system, double T,
   // A. Pairs within the thickness of each other somewhere between the positions and where the
   // velocities take them relative to the cloth's mean motion.
   auto clock = std::chrono::steady_clock::now();
-  Vec3 momentum = Vec3::Zero();
-  double mass = 0.0;
-  for (std::size_t p = 0; p < n; ++p) {
-    momentum += system.mass[p] * system.v[p];
-    mass += system.mass[p];
-  }
-  const Vec3 mean = momentum / mass;
+  const Vec3 mean = system.meanVelocity();
   predicted_.resize(n);
   for (std::size_t p = 0; p < n; ++p) predicted_[p] = system.x[p] + T * (system.v[p] - mean);
   repulsion_.findPairs(pairs_, system.x, predicted_);

@@ -69,6 +69,16 @@ void MassSpringSystem::explicitForces(const std::vector<Vec3>& at, std::vector<V
   }
 }
 
+Vec3 MassSpringSystem::meanVelocity() const {
+  Vec3 momentum = Vec3::Zero();
+  double total = 0.0;
+  for (std::size_t p = 0; p < size(); ++p) {
+    momentum += mass[p] * v[p];
+    total += mass[p];
+  }
+  return total > 0.0 ? Vec3(momentum / total) : Vec3(Vec3::Zero());
+}
+
 double MassSpringSystem::kineticEnergy() const {
   double e = 0.0;
   for (std::size_t p = 0; p < x.size(); ++p) e += 0.5 * mass[p] * v[p].squaredNorm();

@@ -62,6 +62,8 @@ struct MassSpringSystem {
   void explicitForces(const std::vector<Vec3>& at, std::vector<Vec3>& force) const;
   // 1/2 m |v|^2 summed [J].
   double kineticEnergy() const;
+  // The mass-weighted mean velocity (the centre of mass's) [m/s].
+  Vec3 meanVelocity() const;
   // Elastic energy: for eq. 5.1, k l0 (s^2 / 2) per spring with strain s = |x2 - x1| / l0 - 1, plus
   // the gravitational energy -m g . x [J].
   double potentialEnergy() const;
