@@ -64,6 +64,7 @@ ClothCollisionStats ClothCollisionLoop::step(MassSpringSystem& system, double T,
       if (bodies) bodies->pushOut(system.x, system.v, system.pinned);
     }
     stats.newmark.iterations += s.iterations;
+    stats.newmark.preconditionerSetups += s.preconditionerSetups;
     stats.newmark.converged = stats.newmark.converged && s.converged;
     stats.newmark.contacts = s.contacts;
     stats.repulsions += s.repulsions;

@@ -10,6 +10,18 @@
 
 namespace msim::solids {
 
+namespace {
+
+// Iterations a solve needs before its convergence rate tells whether the multigrid hierarchy has aged.
+constexpr int kRateSample = 8;
+
+struct JacobiPreconditioner {
+  const Eigen::VectorXd& inverseDiagonal;
+  void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const { z = inverseDiagonal.cwiseProduct(r); }
+};
+
+}  // namespace
+
 // Half step i of the scheme solves M v' = M v + h F(x + c v') - h D v' for v', where x is the
 // solve's base (x(n), then x(n+1/2)), c = dt the reach of the position update x(n+1) = x(n) +
 // dt v(n+1/2) and D the damping along the springs. Elasticity linearised at x_k = x + c v_k
@@ -19,17 +31,18 @@ namespace msim::solids {
 // c'_s = c T_s / L_s for a stretched edge spring with implicit springs, else 0; and
 // rhs = M v + h F(x_k) + h c K_k v_k, K_k the elastic part. Further Newton iterations
 // (`newtonIterations`) take the springs' directions and tensions where the last solve moves the
-// particles to. A is applied without being assembled (conjugate gradients with a diagonal
-// preconditioner): the terms are gathered once per iteration, and nothing is allocated once the
-// buffers have grown. Pinned particles keep `from`: their unknowns stay fixed, so their columns act
-// through the start residual and their rows drop out.
+// particles to. The terms are gathered once per iteration; with Jacobi preconditioning A is applied
+// term by term without being assembled, with multigrid it is assembled in 3 x 3 blocks
+// (newmark_matrix.hpp); nothing is allocated once the buffers have grown.
+// Pinned particles keep `from`: their unknowns stay fixed, so their columns act through the start
+// residual and their rows drop out.
 void NewmarkStepper::gatherTerms(const MassSpringSystem& system, const std::vector<Vec3>& at, double h, double reach) {
   terms_.clear();
   shortestSpring_ = std::numeric_limits<double>::infinity();
   const auto addTerm = [&](const int* nodes, const double* weights, int count, const Vec3& direction, double damping,
                            double along, double across) {
     if (damping == 0.0 && along == 0.0 && across == 0.0) return;
-    Term t;
+    SpringTerm t;
     t.count = count;
     for (int i = 0; i < count; ++i) {
       t.node[i] = nodes[i];
@@ -65,26 +78,26 @@ void NewmarkStepper::gatherTerms(const MassSpringSystem& system, const std::vect
     shortestSpring_ = std::min(shortestSpring_, l0);
     addTerm(t.v.data(), choice.weights.data(), 4, choice.normal, t.damping, reach * t.stiffness / l0, 0.0);
   }
-  inverseDiagonal_.assign(system.size(), Vec3::Zero());
-  for (std::size_t p = 0; p < system.size(); ++p) inverseDiagonal_[p] = Vec3::Constant(system.mass[p]);
-  for (const Term& t : terms_)
+  if (settings_.preconditioner != SolvePreconditioner::Jacobi) return;
+  inverseDiagonal_.resize(static_cast<Eigen::Index>(3 * system.size()));
+  for (std::size_t p = 0; p < system.size(); ++p) inverseDiagonal_.segment<3>(static_cast<Eigen::Index>(3 * p)).setConstant(system.mass[p]);
+  for (const SpringTerm& t : terms_)
     for (int i = 0; i < t.count; ++i)
-      inverseDiagonal_[static_cast<std::size_t>(t.node[i])] +=
+      inverseDiagonal_.segment<3>(3 * static_cast<Eigen::Index>(t.node[i])) +=
           t.weight[i] * t.weight[i] *
           (t.coefficient * t.direction.cwiseProduct(t.direction) +
            t.sideways * (Vec3::Ones() - t.direction.cwiseProduct(t.direction)));
-  for (Vec3& d : inverseDiagonal_) d = d.cwiseInverse();
+  inverseDiagonal_ = inverseDiagonal_.cwiseInverse();
 }
 
-// y = (elasticOnly ? h c K : A - M) u, accumulated onto y.
-void NewmarkStepper::applyTerms(const std::vector<Vec3>& u, std::vector<Vec3>& y, bool elasticOnly) const {
-  for (const Term& t : terms_) {
+void NewmarkStepper::applyTerms(const double* u, double* y, bool elasticOnly) const {
+  for (const SpringTerm& t : terms_) {
     Vec3 relative = Vec3::Zero();
-    for (int i = 0; i < t.count; ++i) relative += t.weight[i] * u[static_cast<std::size_t>(t.node[i])];
+    for (int i = 0; i < t.count; ++i) relative += t.weight[i] * Eigen::Map<const Vec3>(u + 3 * t.node[i]);
     const double along = relative.dot(t.direction);
     const Vec3 f = (elasticOnly ? t.stiffness : t.coefficient) * along * t.direction +
                    t.sideways * (relative - along * t.direction);
-    for (int i = 0; i < t.count; ++i) y[static_cast<std::size_t>(t.node[i])] += t.weight[i] * f;
+    for (int i = 0; i < t.count; ++i) Eigen::Map<Vec3>(y + 3 * t.node[i]) += t.weight[i] * f;
   }
 }
 
@@ -97,8 +110,6 @@ NewmarkStats NewmarkStepper::solveHalfStep(const MassSpringSystem& system, const
   out = from;
   residual_.resize(n);
   product_.resize(n);
-  search_.resize(n);
-  precond_.resize(n);
   linearisedAt_.resize(n);
   for (int k = 0; k < iterations; ++k) {
     // x_k = base + c v_k, with v_0 = 0 and v_k the last solve's answer.
@@ -107,7 +118,7 @@ NewmarkStats NewmarkStepper::solveHalfStep(const MassSpringSystem& system, const
     gatherTerms(system, linearisedAt_, h, reach);
     // rhs = M v + h F(x_k) + h c K_k v_k (product_ holds h c K_k v_k), residual = rhs - A out.
     for (Vec3& y : product_) y.setZero();
-    if (k > 0) applyTerms(out, product_, true);
+    if (k > 0) applyTerms(out.data()->data(), product_.data()->data(), true);
     double rhsNorm2 = 0.0;
     for (std::size_t p = 0; p < n; ++p) {
       if (system.pinned[p]) continue;
@@ -115,12 +126,13 @@ NewmarkStats NewmarkStepper::solveHalfStep(const MassSpringSystem& system, const
       rhsNorm2 += residual_[p].squaredNorm();
     }
     for (std::size_t p = 0; p < n; ++p) product_[p] = system.mass[p] * out[p];
-    applyTerms(out, product_, false);
+    applyTerms(out.data()->data(), product_.data()->data(), false);
     for (std::size_t p = 0; p < n; ++p) residual_[p] = system.pinned[p] ? Vec3::Zero() : Vec3(residual_[p] - product_[p]);
     if (k + 1 < iterations) previous_ = out;
-    const NewmarkStats solve = conjugateGradients(system, rhsNorm2, out);
+    const NewmarkStats solve = conjugateGradients(system, h, rhsNorm2, out);
     stats.iterations += solve.iterations;
     stats.converged = stats.converged && solve.converged;
+    stats.preconditionerSetups += solve.preconditionerSetups;
     ++stats.linearisations;
     if (k + 1 < iterations) {
       // Converged once the answer moves the linearisation point by less than newtonTolerance of the
@@ -134,49 +146,63 @@ NewmarkStats NewmarkStepper::solveHalfStep(const MassSpringSystem& system, const
 }
 
 // Solves A out = rhs from the residual rhs - A out already in residual_.
-NewmarkStats NewmarkStepper::conjugateGradients(const MassSpringSystem& system, double rhsNorm2, std::vector<Vec3>& out) {
-  const std::size_t n = system.size();
-  // y = A u on the free particles (pinned rows zero).
-  const auto apply = [&](const std::vector<Vec3>& u, std::vector<Vec3>& y) {
-    for (std::size_t p = 0; p < n; ++p) y[p] = system.mass[p] * u[p];
-    applyTerms(u, y, false);
-    for (std::size_t p = 0; p < n; ++p)
-      if (system.pinned[p]) y[p].setZero();
-  };
-  const auto dot = [&](const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
-    double sum = 0.0;
-    for (std::size_t p = 0; p < n; ++p) sum += a[p].dot(b[p]);
-    return sum;
-  };
+NewmarkStats NewmarkStepper::conjugateGradients(const MassSpringSystem& system, double h, double rhsNorm2,
+                                                 std::vector<Vec3>& out) {
+  const auto unknowns = static_cast<Eigen::Index>(3 * system.size());
+  unknowns_ = Eigen::Map<const Eigen::VectorXd>(out.data()->data(), unknowns);
+  residualVector_ = Eigen::Map<const Eigen::VectorXd>(residual_.data()->data(), unknowns);
   const double target2 = settings_.cgTolerance * settings_.cgTolerance * rhsNorm2;
   NewmarkStats stats;
-  double residualNorm2 = dot(residual_, residual_);
-  for (std::size_t p = 0; p < n; ++p) precond_[p] = inverseDiagonal_[p].cwiseProduct(residual_[p]);
-  search_ = precond_;
-  double rz = dot(residual_, precond_);
-  while (residualNorm2 > target2 && stats.iterations < settings_.cgMaxIterations) {
-    apply(search_, product_);
-    const double curvature = dot(search_, product_);
-    if (!(curvature > 0.0)) break;
-    const double alpha = rz / curvature;
-    for (std::size_t p = 0; p < n; ++p) {
-      out[p] += alpha * search_[p];
-      residual_[p] -= alpha * product_[p];
-      precond_[p] = inverseDiagonal_[p].cwiseProduct(residual_[p]);
+  numerics::SparseCgStats solve;
+  if (settings_.preconditioner == SolvePreconditioner::Multigrid) {
+    matrix_.assemble(system, terms_);
+    const numerics::SparseRowMatrix& A = matrix_.matrix();
+    const auto product = [&A](const Eigen::VectorXd& u, Eigen::VectorXd& y) { numerics::parallelMultiply(A, u, y); };
+    const bool setup = stale_ || multigridParticles_ != system.size() || std::abs(h - multigridH_) > 0.25 * multigridH_;
+    if (setup) {
+      // The coarse levels carry each aggregate's rigid motions: translations, and rotations, which
+      // springs that are not stretched barely resist (a slack or folded cloth).
+      Vec3 center = Vec3::Zero();
+      for (const Vec3& p : linearisedAt_) center += p;
+      center /= static_cast<double>(std::max<std::size_t>(1, linearisedAt_.size()));
+      multigrid_.setup(A, numerics::rigidModes(linearisedAt_, center));
+      multigridParticles_ = system.size();
+      multigridH_ = h;
+      stale_ = false;
+      ++stats.preconditionerSetups;
     }
-    const double rzNext = dot(residual_, precond_);
-    const double beta = rzNext / rz;
-    rz = rzNext;
-    for (std::size_t p = 0; p < n; ++p) search_[p] = precond_[p] + beta * search_[p];
-    residualNorm2 = dot(residual_, residual_);
-    ++stats.iterations;
+    solve = numerics::preconditionedCg(product, multigrid_, unknowns_, residualVector_, target2, settings_.cgMaxIterations, workspace_);
+    // The first solve of at least kRateSample iterations after the setup measures the hierarchy's
+    // rate (fewer, as when a Newton iteration starts near its answer, say little).
+    if (setup) multigridRate_ = 0.0;
+    if (solve.iterations >= kRateSample) {
+      const double rate = solve.digitsPerIteration();
+      if (multigridRate_ == 0.0) multigridRate_ = rate;
+      else if (rate > 0.25 * multigridRate_) stale_ = true;
+    }
+  } else {
+    // y = A u on the free particles (pinned rows zero), term by term.
+    const auto product = [&](const Eigen::VectorXd& u, Eigen::VectorXd& y) {
+      y.resize(u.size());
+      for (std::size_t p = 0; p < system.size(); ++p) {
+        const auto row = static_cast<Eigen::Index>(3 * p);
+        y.segment<3>(row) = system.mass[p] * u.segment<3>(row);
+      }
+      applyTerms(u.data(), y.data(), false);
+      for (std::size_t p = 0; p < system.size(); ++p)
+        if (system.pinned[p]) y.segment<3>(static_cast<Eigen::Index>(3 * p)).setZero();
+    };
+    const JacobiPreconditioner jacobi{inverseDiagonal_};
+    solve = numerics::preconditionedCg(product, jacobi, unknowns_, residualVector_, target2, settings_.cgMaxIterations, workspace_);
   }
-  stats.converged = residualNorm2 <= target2;
+  Eigen::Map<Eigen::VectorXd>(out.data()->data(), unknowns) = unknowns_;
+  stats.iterations = solve.iterations;
+  stats.converged = solve.converged;
   return stats;
 }
 
 NewmarkStats NewmarkStepper::step(MassSpringSystem& system, double dt, const BodyContact* bodies,
-                                   const SelfRepulsion* repulsion) {
+                                   SelfRepulsion* repulsion) {
   if (!(dt > 0.0) || !std::isfinite(dt)) throw std::invalid_argument("Newmark step: dt must be > 0");
   const double h = 0.5 * dt;
   const std::size_t n = system.size();
@@ -205,6 +231,7 @@ NewmarkStats NewmarkStepper::step(MassSpringSystem& system, double dt, const Bod
   if (repulsion) repulsion->repelEndVelocity(system.x, system.v, inverseMass_);
   first.iterations += second.iterations;
   first.linearisations += second.linearisations;
+  first.preconditionerSetups += second.preconditionerSetups;
   first.converged = first.converged && second.converged;
   first.contacts = static_cast<int>(std::count_if(touched_.begin(), touched_.end(), [](int b) { return b >= 0; }));
   return first;

@@ -24,11 +24,22 @@
 #include <vector>
 
 #include "msim/core/vec.hpp"
+#include "msim/numerics/smoothed_aggregation.hpp"
+#include "msim/numerics/sparse_cg.hpp"
 #include "msim/solids/body_contact.hpp"
 #include "msim/solids/mass_spring.hpp"
+#include "msim/solids/newmark_matrix.hpp"
 #include "msim/solids/self_repulsion.hpp"
 
 namespace msim::solids {
+
+// How the solves are preconditioned: the inverse of the matrix's diagonal (Jacobi), the matrix
+// applied spring by spring, or a smoothed-aggregation multigrid V-cycle on the assembled matrix
+// (numerics/smoothed_aggregation.hpp, with the rigid motions as near-null space). Multigrid's
+// iteration counts stay nearly flat as a taut cloth at a large step is refined, where Jacobi's grow
+// with its width; at the small steps of colliding cloth the matrix is well conditioned and the
+// cheaper Jacobi iterations win (docs/solids.md).
+enum class SolvePreconditioner { Jacobi, Multigrid };
 
 struct NewmarkSettings {
   bool implicitSprings = false;  // ch. 5.5
@@ -37,6 +48,7 @@ struct NewmarkSettings {
   double newtonTolerance = 1e-3;  // stop once an iteration moves no particle's x_k by this of the shortest spring
   double cgTolerance = 1e-6;     // relative residual of each solve (the seed's Table 6.1: 1e-3)
   int cgMaxIterations = 1000;
+  SolvePreconditioner preconditioner = SolvePreconditioner::Jacobi;
 };
 
 struct NewmarkStats {
@@ -45,6 +57,7 @@ struct NewmarkStats {
   int contacts = 0;          // particles that met a body
   int repulsions = 0;        // self-repulsion pairs closer than the thickness (step B.2)
   int linearisations = 0;    // solves of the step's two half steps (Newton iterations)
+  int preconditionerSetups = 0;  // multigrid hierarchies built (one serves solves until it ages)
 };
 
 class NewmarkStepper {
@@ -53,7 +66,7 @@ class NewmarkStepper {
   // Advances the system by dt, against `bodies` and with `repulsion` when given;
   // std::invalid_argument for dt <= 0.
   NewmarkStats step(MassSpringSystem& system, double dt, const BodyContact* bodies = nullptr,
-                    const SelfRepulsion* repulsion = nullptr);
+                    SelfRepulsion* repulsion = nullptr);
   const NewmarkSettings& settings() const { return settings_; }
 
  private:
@@ -64,27 +77,30 @@ class NewmarkStepper {
   // The matrix's spring terms linearised at `at` (reach c = dt with implicit springs, else 0), and
   // the inverse of its diagonal.
   void gatherTerms(const MassSpringSystem& system, const std::vector<Vec3>& at, double h, double reach);
-  void applyTerms(const std::vector<Vec3>& u, std::vector<Vec3>& y, bool elasticOnly) const;
-  NewmarkStats conjugateGradients(const MassSpringSystem& system, double rhsNorm2, std::vector<Vec3>& out);
+  // y += (elasticOnly ? h c K : A - M) u, u and y 3 values per particle.
+  void applyTerms(const double* u, double* y, bool elasticOnly) const;
+  NewmarkStats conjugateGradients(const MassSpringSystem& system, double h, double rhsNorm2, std::vector<Vec3>& out);
 
   NewmarkSettings settings_;
   std::vector<Vec3> forces_, start_, half_, mid_;
   std::vector<int> touched_;  // the body each particle met in the step, or -1
   std::vector<double> inverseMass_;
-  // A term of the step's matrix: with r = sum_i w_i v_i, c (r . d) d + c' (r - (r . d) d) on each
-  // node i, weighted w_i.
-  struct Term {
-    std::array<int, 4> node{};
-    std::array<double, 4> weight{};
-    int count = 0;
-    Vec3 direction = Vec3::Zero();
-    double coefficient = 0.0;  // h (b + c k / l0) along d
-    double stiffness = 0.0;    // its elastic part, h c k / l0
-    double sideways = 0.0;     // h c T / L across d
-  };
-  std::vector<Term> terms_;
-  std::vector<Vec3> inverseDiagonal_, residual_, product_, search_, precond_, linearisedAt_, previous_;
+  std::vector<SpringTerm> terms_;
+  std::vector<Vec3> residual_, product_, linearisedAt_, previous_;
   double shortestSpring_ = 0.0;  // rest length, or altitude, over the last gathered terms
+  NewmarkMatrix matrix_;
+  Eigen::VectorXd inverseDiagonal_;  // of the matrix, for Jacobi
+  // The multigrid hierarchy is built from one solve's matrix and kept while it serves: the matrices
+  // of later solves differ little (springs turn slowly from step to step). A new one is built when
+  // the half step h changes by more than a quarter (the stiffness terms scale with h^2), or when a
+  // solve gains less than a quarter of the digits per iteration that the first one after the setup did.
+  numerics::SmoothedAggregation multigrid_{numerics::AggregationSettings{.blockSize = 3}};  // rigid modes
+  bool stale_ = true;
+  double multigridH_ = 0.0;     // the half step it was built for
+  double multigridRate_ = 0.0;  // its log10 residual reduction per iteration when new (0: not yet measured)
+  std::size_t multigridParticles_ = 0;
+  Eigen::VectorXd unknowns_, residualVector_;
+  numerics::SparseCgWorkspace workspace_;
 };
 
 }  // namespace msim::solids

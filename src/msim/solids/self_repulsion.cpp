@@ -2,25 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include <Eigen/Geometry>
 
+#include "msim/core/parallel.hpp"
 #include "msim/solids/collision/proximity.hpp"
-#include "msim/solids/contact_stencil.hpp"
 
 namespace msim::solids {
-
-namespace {
-
-// A pair's state at the current positions: the stencil of its relative position, the remembered
-// normal and the gap along it (negative once crossed).
-struct Contact {
-  ContactStencil stencil;
-  Vec3 normal;
-  double gap = 0.0;
-};
-
-}  // namespace
 
 void SelfRepulsion::findPairs(CollisionPairs& pairs, const std::vector<Vec3>& x, const std::vector<Vec3>& predicted) {
   mesh_ = &pairs;
@@ -43,26 +32,78 @@ void SelfRepulsion::findPairs(CollisionPairs& pairs, const std::vector<Vec3>& x,
 }
 
 int SelfRepulsion::repelPositionVelocity(const std::vector<Vec3>& x, std::vector<Vec3>& v,
-                                         const std::vector<double>& inverseMass, double dt) const {
-  apply(Pass::Inelastic, x, v, inverseMass, dt);
-  return apply(Pass::Elastic, x, v, inverseMass, dt);
+                                         const std::vector<double>& inverseMass, double dt) {
+  gatherContacts(x);
+  respond(Pass::Inelastic, v, inverseMass, dt);
+  return respond(Pass::Elastic, v, inverseMass, dt);
 }
 
 int SelfRepulsion::repelEndVelocity(const std::vector<Vec3>& x, std::vector<Vec3>& v,
-                                    const std::vector<double>& inverseMass) const {
-  return apply(Pass::EndOfStep, x, v, inverseMass, 0.0);
+                                    const std::vector<double>& inverseMass) {
+  gatherContacts(x);
+  return respond(Pass::EndOfStep, v, inverseMass, 0.0);
 }
 
-int SelfRepulsion::apply(Pass pass, const std::vector<Vec3>& x, std::vector<Vec3>& v,
-                         const std::vector<double>& inverseMass, double dt) const {
-  if (mesh_ == nullptr) return 0;
+// The geometry depends on the positions alone, which a pass leaves alone, so it is found for all
+// pairs at once on all cores, block by block, and the blocks joined in the pairs' order (the
+// Gauss-Seidel passes then see the contacts in the same order whatever the thread count).
+void SelfRepulsion::gatherContacts(const std::vector<Vec3>& x) {
+  contacts_.clear();
+  if (mesh_ == nullptr) return;
   const double h = settings_.thickness;
-  int active = 0;
-  const auto respond = [&](const Contact& c) {
-    if (!(c.gap < h) || !(c.gap > -2.0 * h)) return;  // apart, or crossed deeper than repulsion can mend
-    ++active;
+  // Closer than h, and crossed by less than 2h (deeper than repulsion can mend: collisions act).
+  const auto within = [h](double gap) { return gap < h && gap > -2.0 * h; };
+  constexpr std::size_t kBlock = 2048;
+  const std::size_t pointBlocks = (pointTriangle_.size() + kBlock - 1) / kBlock;
+  const std::size_t edgeBlocks = (edgeEdge_.size() + kBlock - 1) / kBlock;
+  blockContacts_.resize(std::max(blockContacts_.size(), pointBlocks + edgeBlocks));
+  parallelFor(0, pointBlocks + edgeBlocks, [&](std::size_t block) {
+    std::vector<Contact>& found = blockContacts_[block];
+    found.clear();
+    if (block < pointBlocks) {
+      const std::size_t end = std::min(pointTriangle_.size(), (block + 1) * kBlock);
+      for (std::size_t i = block * kBlock; i < end; ++i) {
+        const PointTriangleHistory& p = pointTriangle_[i];
+        const auto& t = mesh_->triangles()[static_cast<std::size_t>(p.pair.triangle)];
+        const Vec3& xp = x[static_cast<std::size_t>(p.pair.point)];
+        const Vec3 &a = x[static_cast<std::size_t>(t[0])], &b = x[static_cast<std::size_t>(t[1])], &c = x[static_cast<std::size_t>(t[2])];
+        Vec3 normal = (b - a).cross(c - a);
+        const double length = normal.norm();
+        if (!(length > 0.0)) continue;
+        normal /= p.flipped ? -length : length;
+        const double gap = (xp - a).dot(normal);  // the distance from the face along the remembered side
+        if (!within(gap)) continue;
+        // Only where the point lies over the face: near an edge or a corner the edge pairs act.
+        const std::optional<Vec3> weights = faceProjectionWeights(xp, a, b, c);
+        if (!weights || !(weights->minCoeff() > 0.0)) continue;
+        found.push_back({ContactStencil::pointTriangle(p.pair.point, t, *weights), normal, gap});
+      }
+    } else {
+      const std::size_t first = (block - pointBlocks) * kBlock;
+      const std::size_t end = std::min(edgeEdge_.size(), first + kBlock);
+      for (std::size_t i = first; i < end; ++i) {
+        const EdgeEdgeHistory& p = edgeEdge_[i];
+        const auto& e = mesh_->edges()[static_cast<std::size_t>(p.pair.first)];
+        const auto& f = mesh_->edges()[static_cast<std::size_t>(p.pair.second)];
+        const EdgeEdgeProximity prox = edgeEdgeProximity(x[static_cast<std::size_t>(e[0])], x[static_cast<std::size_t>(e[1])],
+                                                         x[static_cast<std::size_t>(f[0])], x[static_cast<std::size_t>(f[1])]);
+        if (!(prox.s > 0.0 && prox.s < 1.0 && prox.t > 0.0 && prox.t < 1.0)) continue;  // end points: the point pairs act
+        const bool crossed = p.side.dot(prox.normal) < settings_.edgeFlipEpsilon;
+        const double gap = crossed ? -prox.distance : prox.distance;
+        if (!within(gap)) continue;
+        found.push_back({ContactStencil::edgeEdge(e, f, prox.s, prox.t), crossed ? Vec3(-prox.normal) : prox.normal, gap});
+      }
+    }
+  }, 1);
+  for (std::size_t block = 0; block < pointBlocks + edgeBlocks; ++block)
+    contacts_.insert(contacts_.end(), blockContacts_[block].begin(), blockContacts_[block].end());
+}
+
+int SelfRepulsion::respond(Pass pass, std::vector<Vec3>& v, const std::vector<double>& inverseMass, double dt) const {
+  const double h = settings_.thickness;
+  for (const Contact& c : contacts_) {
     const double im = c.stencil.inverseMass(inverseMass);
-    if (!(im > 0.0)) return;
+    if (!(im > 0.0)) continue;
     const Vec3 rel = c.stencil.relative(v);
     const double vN = rel.dot(c.normal);
     switch (pass) {
@@ -85,32 +126,8 @@ int SelfRepulsion::apply(Pass pass, const std::vector<Vec3>& x, std::vector<Vec3
         break;
       }
     }
-  };
-  for (const PointTriangleHistory& p : pointTriangle_) {
-    const auto& t = mesh_->triangles()[static_cast<std::size_t>(p.pair.triangle)];
-    const Vec3& xp = x[static_cast<std::size_t>(p.pair.point)];
-    const Vec3 &a = x[static_cast<std::size_t>(t[0])], &b = x[static_cast<std::size_t>(t[1])], &c = x[static_cast<std::size_t>(t[2])];
-    const PointTriangleProximity prox = pointTriangleProximity(xp, a, b, c);
-    // Only where the point lies over the face: near an edge or a corner the edge pairs act.
-    if (!(prox.weights.minCoeff() > 0.0)) continue;
-    Vec3 normal = (b - a).cross(c - a);
-    const double length = normal.norm();
-    if (!(length > 0.0)) continue;
-    normal /= p.flipped ? -length : length;
-    const ContactStencil stencil = ContactStencil::pointTriangle(p.pair.point, t, prox.weights);
-    respond({stencil, normal, stencil.relative(x).dot(normal)});
   }
-  for (const EdgeEdgeHistory& p : edgeEdge_) {
-    const auto& e = mesh_->edges()[static_cast<std::size_t>(p.pair.first)];
-    const auto& f = mesh_->edges()[static_cast<std::size_t>(p.pair.second)];
-    const EdgeEdgeProximity prox = edgeEdgeProximity(x[static_cast<std::size_t>(e[0])], x[static_cast<std::size_t>(e[1])],
-                                                     x[static_cast<std::size_t>(f[0])], x[static_cast<std::size_t>(f[1])]);
-    if (!(prox.s > 0.0 && prox.s < 1.0 && prox.t > 0.0 && prox.t < 1.0)) continue;  // end points: the point pairs act
-    const bool crossed = p.side.dot(prox.normal) < settings_.edgeFlipEpsilon;
-    respond({ContactStencil::edgeEdge(e, f, prox.s, prox.t), crossed ? Vec3(-prox.normal) : prox.normal,
-             crossed ? -prox.distance : prox.distance});
-  }
-  return active;
+  return static_cast<int>(contacts_.size());
 }
 
 }  // namespace msim::solids

@@ -20,6 +20,7 @@
 
 #include "msim/core/vec.hpp"
 #include "msim/solids/collision_pairs.hpp"
+#include "msim/solids/contact_stencil.hpp"
 
 namespace msim::solids {
 
@@ -50,15 +51,25 @@ class SelfRepulsion {
   // or step B.8 on the end-of-step velocity (inelastic and friction). inverseMass: 1 / m per
   // particle, 0 for pinned ones. Returns the pairs that were closer than h.
   int repelPositionVelocity(const std::vector<Vec3>& x, std::vector<Vec3>& v, const std::vector<double>& inverseMass,
-                            double dt) const;
-  int repelEndVelocity(const std::vector<Vec3>& x, std::vector<Vec3>& v, const std::vector<double>& inverseMass) const;
+                            double dt);
+  int repelEndVelocity(const std::vector<Vec3>& x, std::vector<Vec3>& v, const std::vector<double>& inverseMass);
 
   RepulsionStats stats() const { return {static_cast<int>(pointTriangle_.size()), static_cast<int>(edgeEdge_.size()), 0}; }
 
  private:
   enum class Pass { Inelastic, Elastic, EndOfStep };
-  int apply(Pass pass, const std::vector<Vec3>& x, std::vector<Vec3>& v, const std::vector<double>& inverseMass,
-            double dt) const;
+  // A pair within reach at the current positions: the stencil of its relative position, the
+  // remembered normal and the gap along it (negative once crossed).
+  struct Contact {
+    ContactStencil stencil;
+    Vec3 normal;
+    double gap = 0.0;
+  };
+  // The pairs closer than h at x (and crossed by less than 2 h), over a face or between the edges'
+  // ends, in the pairs' order (points first).
+  void gatherContacts(const std::vector<Vec3>& x);
+  // One Gauss-Seidel pass over the gathered contacts; returns their count.
+  int respond(Pass pass, std::vector<Vec3>& v, const std::vector<double>& inverseMass, double dt) const;
 
   struct PointTriangleHistory {
     PointTrianglePair pair;
@@ -75,6 +86,8 @@ class SelfRepulsion {
   std::vector<EdgeEdgeHistory> edgeEdge_;
   std::vector<PointTrianglePair> foundPointTriangle_;
   std::vector<EdgeEdgePair> foundEdgeEdge_;
+  std::vector<std::vector<Contact>> blockContacts_;  // per block of pairs, joined into contacts_
+  std::vector<Contact> contacts_;
 };
 
 }  // namespace msim::solids

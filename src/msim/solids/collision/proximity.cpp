@@ -40,10 +40,22 @@ double largestCoordinate(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3
 
 }  // namespace
 
-PointTriangleProximity pointTriangleProximity(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+std::optional<Vec3> faceProjectionWeights(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  // The sub-triangle areas measured along n. A nearly degenerate triangle has ill-conditioned
+  // weights; pointTriangleProximity compares them with the edges' candidates.
   const Vec3 ab = b - a, ac = c - a, ap = p - a;
   const Vec3 n = ab.cross(ac);
   const double nn = n.squaredNorm();
+  if (!(nn > 0.0)) return std::nullopt;
+  const double wb = ap.cross(ac).dot(n) / nn, wc = ab.cross(ap).dot(n) / nn;
+  const double wa = 1.0 - wb - wc;
+  if (!(wa >= 0.0 && wb >= 0.0 && wc >= 0.0)) return std::nullopt;
+  return Vec3(wa, wb, wc);
+}
+
+PointTriangleProximity pointTriangleProximity(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a;
+  const Vec3 n = ab.cross(ac);
 
   double bestSquared = INFINITY;
   Vec3 weights(1.0, 0.0, 0.0);
@@ -54,14 +66,10 @@ PointTriangleProximity pointTriangleProximity(const Vec3& p, const Vec3& a, cons
       weights = w;
     }
   };
-  // The face: p's projection onto the plane, kept when it falls inside (the sub-triangle areas
-  // measured along n). A zero-area triangle has no face region (nn = 0); a nearly degenerate one
-  // has ill-conditioned weights, which the comparison with the edges below makes harmless.
-  if (nn > 0.0) {
-    const double wb = ap.cross(ac).dot(n) / nn, wc = ab.cross(ap).dot(n) / nn;
-    const double wa = 1.0 - wb - wc;
-    if (wa >= 0.0 && wb >= 0.0 && wc >= 0.0) consider(Vec3(wa, wb, wc));
-  }
+  // The face: p's projection onto the plane, kept when it falls inside (a zero-area triangle has
+  // no face region; a nearly degenerate one's ill-conditioned weights are made harmless by the
+  // comparison with the edges below).
+  if (const std::optional<Vec3> face = faceProjectionWeights(p, a, b, c)) consider(*face);
   // The edges, whose closest points include the vertices' regions.
   const double tab = closestSegmentParameter(p, a, b), tbc = closestSegmentParameter(p, b, c),
                tca = closestSegmentParameter(p, c, a);

@@ -7,6 +7,8 @@
 // (face, edges, vertices) and stay well defined for zero-area triangles and zero-length or parallel
 // edges: they compare the interior candidate, when it exists, with the closest points on the
 // boundary, so an ill-conditioned interior solve can never return a point farther than a boundary one.
+#include <optional>
+
 #include "msim/core/vec.hpp"
 
 namespace msim::solids {
@@ -18,6 +20,11 @@ struct PointTriangleProximity {
 };
 
 PointTriangleProximity pointTriangleProximity(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
+
+// The barycentric weights (of a, b, c) of p's projection onto the triangle's plane when it falls on
+// the face, each >= 0 (then it is the closest point); nullopt when it falls outside or the triangle
+// has no area. The cheap test of repulsions, which act only over faces.
+std::optional<Vec3> faceProjectionWeights(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
 
 struct EdgeEdgeProximity {
   double distance = 0.0;

@@ -1,0 +1,66 @@
+#pragma once
+// Preconditioned conjugate gradients on a symmetric positive definite system given by its product
+// (a callable apply(x, y): y = A x, e.g. parallelMultiply with an assembled matrix, or a product
+// applied term by term) with any preconditioner that offers apply(r, z) (block_jacobi.hpp,
+// smoothed_aggregation.hpp). Dot products run on all cores; the work vectors live in a workspace so
+// that repeated solves allocate nothing once it has grown.
+#include <cmath>
+
+#include <Eigen/Sparse>
+
+#include "msim/numerics/block_jacobi.hpp"
+
+namespace msim::numerics {
+
+struct SparseCgStats {
+  int iterations = 0;
+  bool converged = false;
+  double residualNorm2 = 0.0;
+  double initialResidualNorm2 = 0.0;
+  // log10 of the residual's reduction per iteration (negative; 0 without iterations): how well the
+  // preconditioner serves the matrix, whatever the start.
+  double digitsPerIteration() const {
+    return iterations > 0 && initialResidualNorm2 > 0.0 && residualNorm2 > 0.0
+               ? 0.5 * std::log10(residualNorm2 / initialResidualNorm2) / iterations
+               : 0.0;
+  }
+};
+
+struct SparseCgWorkspace {
+  Eigen::VectorXd z, search, product;
+};
+
+// Solves A x = b from x and its residual r = b - A x (both updated); stops once |r|^2 <= target2
+// or after maxIterations.
+template <typename Product, typename Preconditioner>
+SparseCgStats preconditionedCg(const Product& multiply, const Preconditioner& preconditioner, Eigen::VectorXd& x,
+                               Eigen::VectorXd& r, double target2, int maxIterations, SparseCgWorkspace& w) {
+  SparseCgStats stats;
+  stats.residualNorm2 = stats.initialResidualNorm2 = parallelDot(r, r);
+  if (stats.residualNorm2 <= target2) {
+    stats.converged = true;
+    return stats;
+  }
+  preconditioner.apply(r, w.z);
+  w.search = w.z;
+  double rz = parallelDot(r, w.z);
+  while (stats.iterations < maxIterations) {
+    multiply(w.search, w.product);
+    const double curvature = parallelDot(w.search, w.product);
+    if (!(curvature > 0.0)) break;
+    const double alpha = rz / curvature;
+    x += alpha * w.search;
+    r -= alpha * w.product;
+    ++stats.iterations;
+    stats.residualNorm2 = parallelDot(r, r);
+    if (stats.residualNorm2 <= target2) break;
+    preconditioner.apply(r, w.z);
+    const double rzNext = parallelDot(r, w.z);
+    w.search = w.z + (rzNext / rz) * w.search;
+    rz = rzNext;
+  }
+  stats.converged = stats.residualNorm2 <= target2;
+  return stats;
+}
+
+}  // namespace msim::numerics
