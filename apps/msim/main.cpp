@@ -23,7 +23,7 @@
 #include "msim/scene/saved_frames.hpp"
 #include "msim/scene/scene_file.hpp"
 #include "msim/scene/schema/describe.hpp"
-#include "msim/scene/velocity_spectrum.hpp"
+#include "msim/scene/reports/velocity_spectrum.hpp"
 #include "msim/version.hpp"
 
 namespace {

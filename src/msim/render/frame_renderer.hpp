@@ -3,7 +3,7 @@
 // every light through the medium (eq. 5.6), the first-scatter source (eq. 5.7), multiple
 // scattering by the diffusion approximation (ch. 5.5, multiple_scattering.hpp) and the ray march
 // of the transport equation's integral form (eq. 5.8, volume_renderer.hpp). The scene keys under
-// render.* map onto FrameRenderConfig (scene/render_keys.hpp); `msim render` and the runner use it.
+// render.* map onto FrameRenderConfig (scene/keys/render_keys.hpp); `msim render` and the runner use it.
 #include <optional>
 #include <vector>
 

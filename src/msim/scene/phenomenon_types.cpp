@@ -1,10 +1,10 @@
-#include "msim/scene/crowd_phenomenon.hpp"
-#include "msim/scene/gas_phenomenon.hpp"
-#include "msim/scene/granular_phenomenon.hpp"
-#include "msim/scene/liquid_phenomenon.hpp"
-#include "msim/scene/mass_spring_phenomenon.hpp"
+#include "msim/scene/crowd/crowd_phenomenon.hpp"
+#include "msim/scene/gas/gas_phenomenon.hpp"
+#include "msim/scene/granular/granular_phenomenon.hpp"
+#include "msim/scene/liquid/liquid_phenomenon.hpp"
+#include "msim/scene/solids/mass_spring_phenomenon.hpp"
 #include "msim/scene/phenomenon.hpp"
-#include "msim/scene/smoke_phenomenon.hpp"
+#include "msim/scene/smoke/smoke_phenomenon.hpp"
 
 namespace msim::scene {
 

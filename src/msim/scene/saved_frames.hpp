@@ -9,7 +9,7 @@
 #include "msim/io/png.hpp"
 #include "msim/io/vdb.hpp"
 #include "msim/render/frame_renderer.hpp"
-#include "msim/scene/render_keys.hpp"
+#include "msim/scene/keys/render_keys.hpp"
 
 namespace msim::scene {
 

@@ -5,8 +5,8 @@
 #include <fmt/format.h>
 
 #include "msim/core/error.hpp"
-#include "msim/scene/json_vectors.hpp"
-#include "msim/scene/render_keys.hpp"
+#include "msim/scene/keys/json_vectors.hpp"
+#include "msim/scene/keys/render_keys.hpp"
 #include "msim/core/system_memory.hpp"
 #include "msim/scene/schema/json_file.hpp"
 #include "msim/scene/schema/key_suggestion.hpp"

@@ -1,11 +1,11 @@
-#include "msim/scene/granular_outputs.hpp"
+#include "msim/scene/granular/granular_outputs.hpp"
 
 #include <fmt/format.h>
 
 #include "msim/core/error.hpp"
 #include "msim/io/ply.hpp"
 #include "msim/io/vdb.hpp"
-#include "msim/scene/granular_bodies.hpp"
+#include "msim/scene/granular/granular_bodies.hpp"
 #include "msim/scene/phenomenon_support.hpp"
 
 namespace msim::scene {

@@ -1,10 +1,10 @@
-#include "msim/scene/granular_preview.hpp"
+#include "msim/scene/granular/granular_preview.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "msim/scene/granular_bodies.hpp"
+#include "msim/scene/granular/granular_bodies.hpp"
 
 namespace msim::scene {
 namespace {

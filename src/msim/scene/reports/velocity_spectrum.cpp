@@ -1,4 +1,4 @@
-#include "msim/scene/velocity_spectrum.hpp"
+#include "msim/scene/reports/velocity_spectrum.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -13,7 +13,7 @@
 #include "msim/io/atomic_file.hpp"
 #include "msim/io/png.hpp"
 #include "msim/io/vdb.hpp"
-#include "msim/scene/spectrum_plot.hpp"
+#include "msim/scene/reports/spectrum_plot.hpp"
 #include "msim/turbulence/energy_spectrum.hpp"
 
 namespace msim::scene {

@@ -1,4 +1,4 @@
-#include "msim/scene/scene_obstacles.hpp"
+#include "msim/scene/keys/scene_obstacles.hpp"
 
 #include <cmath>
 #include <limits>
@@ -10,7 +10,7 @@
 #include "msim/core/log.hpp"
 #include "msim/core/parallel.hpp"
 #include "msim/numerics/pressure/face_fractions.hpp"
-#include "msim/scene/json_vectors.hpp"
+#include "msim/scene/keys/json_vectors.hpp"
 #include "msim/scene/phenomenon_support.hpp"
 #include "msim/scene/scene_file.hpp"
 #include "msim/scene/schema/shape_schema.hpp"

@@ -1,4 +1,4 @@
-#include "msim/scene/liquid_phenomenon.hpp"
+#include "msim/scene/liquid/liquid_phenomenon.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -17,13 +17,13 @@
 #include "msim/io/ply.hpp"
 #include "msim/io/vdb.hpp"
 #include "msim/numerics/level_set/level_set_measures.hpp"
-#include "msim/scene/json_vectors.hpp"
-#include "msim/scene/liquid_sources.hpp"
+#include "msim/scene/keys/json_vectors.hpp"
+#include "msim/scene/liquid/liquid_sources.hpp"
 #include "msim/scene/phenomenon_support.hpp"
 #include "msim/scene/scene_file.hpp"
-#include "msim/scene/scene_obstacles.hpp"
+#include "msim/scene/keys/scene_obstacles.hpp"
 #include "msim/scene/schema/shape_schema.hpp"
-#include "msim/scene/subgrid_turbulence_keys.hpp"
+#include "msim/scene/keys/subgrid_turbulence_keys.hpp"
 
 namespace msim::scene {
 

@@ -1,4 +1,4 @@
-#include "msim/scene/granular_bodies.hpp"
+#include "msim/scene/granular/granular_bodies.hpp"
 
 #include <cmath>
 #include <numbers>
@@ -9,7 +9,7 @@
 #include "msim/io/obj.hpp"
 #include "msim/rigid/mass_properties.hpp"
 #include "msim/rigid/polyhedron.hpp"
-#include "msim/scene/json_vectors.hpp"
+#include "msim/scene/keys/json_vectors.hpp"
 #include "msim/scene/scene_file.hpp"
 
 namespace msim::scene {

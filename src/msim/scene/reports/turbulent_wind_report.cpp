@@ -1,4 +1,4 @@
-#include "msim/scene/turbulent_wind_report.hpp"
+#include "msim/scene/reports/turbulent_wind_report.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +10,7 @@
 #include "msim/io/atomic_file.hpp"
 #include "msim/io/png.hpp"
 #include "msim/render/plot.hpp"
-#include "msim/scene/spectrum_plot.hpp"
+#include "msim/scene/reports/spectrum_plot.hpp"
 #include "msim/turbulence/energy_spectrum.hpp"
 
 namespace msim::scene {

@@ -1,17 +1,17 @@
-#include "msim/scene/smoke_scene_keys.hpp"
+#include "msim/scene/smoke/smoke_scene_keys.hpp"
 
 #include <cmath>
 
 #include <fmt/format.h>
 
 #include "msim/core/error.hpp"
-#include "msim/scene/json_vectors.hpp"
+#include "msim/scene/keys/json_vectors.hpp"
 #include "msim/scene/phenomenon_support.hpp"
 #include "msim/scene/scene_file.hpp"
-#include "msim/scene/scene_obstacles.hpp"
+#include "msim/scene/keys/scene_obstacles.hpp"
 #include "msim/scene/schema/shape_schema.hpp"
-#include "msim/scene/subgrid_turbulence_keys.hpp"
-#include "msim/scene/turbulent_wind_keys.hpp"
+#include "msim/scene/keys/subgrid_turbulence_keys.hpp"
+#include "msim/scene/keys/turbulent_wind_keys.hpp"
 
 namespace msim::scene {
 

@@ -1,4 +1,4 @@
-#include "msim/scene/crowd_scene_keys.hpp"
+#include "msim/scene/crowd/crowd_scene_keys.hpp"
 
 #include <cmath>
 
@@ -13,7 +13,7 @@
 #if MSIM_WITH_ROADMAP
 #include "msim/crowd/roadmap/roadmap.hpp"
 #endif
-#include "msim/scene/json_vectors.hpp"
+#include "msim/scene/keys/json_vectors.hpp"
 #include "msim/scene/scene_file.hpp"
 
 namespace msim::scene {

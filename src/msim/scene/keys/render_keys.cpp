@@ -1,4 +1,4 @@
-#include "msim/scene/render_keys.hpp"
+#include "msim/scene/keys/render_keys.hpp"
 
 #include <functional>
 #include <stdexcept>
@@ -9,7 +9,7 @@
 #include "msim/core/error.hpp"
 #include "msim/io/obj.hpp"
 #include "msim/io/ply.hpp"
-#include "msim/scene/json_vectors.hpp"
+#include "msim/scene/keys/json_vectors.hpp"
 
 namespace msim::scene {
 

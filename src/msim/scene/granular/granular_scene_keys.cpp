@@ -1,4 +1,4 @@
-#include "msim/scene/granular_scene_keys.hpp"
+#include "msim/scene/granular/granular_scene_keys.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,13 +7,13 @@
 
 #include "msim/core/error.hpp"
 #include "msim/geometry/shape_adapters.hpp"
-#include "msim/scene/granular_bodies.hpp"
-#include "msim/scene/json_vectors.hpp"
+#include "msim/scene/granular/granular_bodies.hpp"
+#include "msim/scene/keys/json_vectors.hpp"
 #include "msim/scene/phenomenon_support.hpp"
 #include "msim/scene/scene_file.hpp"
 #include "msim/scene/schema/shape_schema.hpp"
 #include "msim/scene/schema/key_suggestion.hpp"
-#include "msim/scene/turbulent_wind_keys.hpp"
+#include "msim/scene/keys/turbulent_wind_keys.hpp"
 
 namespace msim::scene {
 namespace {

@@ -1,4 +1,4 @@
-#include "msim/scene/liquid_sources.hpp"
+#include "msim/scene/liquid/liquid_sources.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 
 #include "msim/core/error.hpp"
 #include "msim/core/parallel.hpp"
-#include "msim/scene/json_vectors.hpp"
+#include "msim/scene/keys/json_vectors.hpp"
 #include "msim/scene/phenomenon_support.hpp"
 #include "msim/scene/scene_file.hpp"
 #include "msim/scene/schema/shape_schema.hpp"

@@ -1,4 +1,4 @@
-#include "msim/scene/gas_phenomenon.hpp"
+#include "msim/scene/gas/gas_phenomenon.hpp"
 
 #include <cmath>
 #include <limits>
@@ -7,7 +7,7 @@
 #include <fmt/format.h>
 
 #include "msim/core/error.hpp"
-#include "msim/scene/json_vectors.hpp"
+#include "msim/scene/keys/json_vectors.hpp"
 #include "msim/core/parallel.hpp"
 #include "msim/fluid/gas/gas_solver.hpp"
 #include "msim/geometry/occupancy.hpp"
@@ -15,8 +15,8 @@
 #include "msim/scene/phenomenon_support.hpp"
 #include "msim/scene/scene_file.hpp"
 #include "msim/scene/schema/shape_schema.hpp"
-#include "msim/scene/turbulent_wind_keys.hpp"
-#include "msim/scene/turbulent_wind_report.hpp"
+#include "msim/scene/keys/turbulent_wind_keys.hpp"
+#include "msim/scene/reports/turbulent_wind_report.hpp"
 
 namespace msim::scene {
 

@@ -1,4 +1,4 @@
-#include "msim/scene/subgrid_turbulence_keys.hpp"
+#include "msim/scene/keys/subgrid_turbulence_keys.hpp"
 
 namespace msim::scene {
 

@@ -1,4 +1,4 @@
-#include "msim/scene/crowd_phenomenon.hpp"
+#include "msim/scene/crowd/crowd_phenomenon.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -19,7 +19,7 @@
 #include "msim/io/vdb.hpp"
 #include "msim/render/floor_plan.hpp"
 #include "msim/render/plot.hpp"
-#include "msim/scene/crowd_scene_keys.hpp"
+#include "msim/scene/crowd/crowd_scene_keys.hpp"
 #include "msim/scene/phenomenon_support.hpp"
 #include "msim/scene/scene_file.hpp"
 

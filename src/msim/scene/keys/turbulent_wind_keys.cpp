@@ -1,8 +1,8 @@
-#include "msim/scene/turbulent_wind_keys.hpp"
+#include "msim/scene/keys/turbulent_wind_keys.hpp"
 
 #include <fmt/format.h>
 
-#include "msim/scene/json_vectors.hpp"
+#include "msim/scene/keys/json_vectors.hpp"
 #include "msim/scene/scene_file.hpp"
 
 namespace msim::scene {

@@ -1,4 +1,4 @@
-#include "msim/scene/granular_phenomenon.hpp"
+#include "msim/scene/granular/granular_phenomenon.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,13 +7,13 @@
 
 #include "msim/core/error.hpp"
 #include "msim/core/parallel.hpp"
-#include "msim/scene/granular_outputs.hpp"
-#include "msim/scene/granular_preview.hpp"
-#include "msim/scene/granular_scene_keys.hpp"
+#include "msim/scene/granular/granular_outputs.hpp"
+#include "msim/scene/granular/granular_preview.hpp"
+#include "msim/scene/granular/granular_scene_keys.hpp"
 #include "msim/scene/phenomenon_support.hpp"
 #include "msim/scene/runner.hpp"
 #include "msim/scene/scene_file.hpp"
-#include "msim/scene/turbulent_wind_report.hpp"
+#include "msim/scene/reports/turbulent_wind_report.hpp"
 
 namespace msim::scene {
 namespace {

@@ -1,4 +1,4 @@
-#include "msim/scene/mass_spring_phenomenon.hpp"
+#include "msim/scene/solids/mass_spring_phenomenon.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -19,12 +19,12 @@
 #include "msim/render/camera.hpp"
 #include "msim/render/density_preview.hpp"
 #include "msim/render/frame_renderer.hpp"
-#include "msim/scene/json_vectors.hpp"
+#include "msim/scene/keys/json_vectors.hpp"
 #include "msim/scene/phenomenon_support.hpp"
-#include "msim/scene/render_keys.hpp"
+#include "msim/scene/keys/render_keys.hpp"
 #include "msim/scene/scene_file.hpp"
 #include "msim/scene/schema/shape_schema.hpp"
-#include "msim/scene/turbulent_wind_keys.hpp"
+#include "msim/scene/keys/turbulent_wind_keys.hpp"
 #include "msim/solids/cloth_collision_loop.hpp"
 #include "msim/solids/cloth_mesh.hpp"
 #include "msim/solids/collision/triangle_intersection.hpp"

@@ -1,4 +1,4 @@
-#include "msim/scene/spectrum_plot.hpp"
+#include "msim/scene/reports/spectrum_plot.hpp"
 
 #include <algorithm>
 #include <cmath>

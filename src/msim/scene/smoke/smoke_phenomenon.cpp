@@ -1,4 +1,4 @@
-#include "msim/scene/smoke_phenomenon.hpp"
+#include "msim/scene/smoke/smoke_phenomenon.hpp"
 
 #include <cmath>
 #include <optional>
@@ -11,13 +11,13 @@
 #include "msim/fluid/smoke/smoke_solver.hpp"
 #include "msim/io/vdb.hpp"
 #include "msim/render/density_preview.hpp"
-#include "msim/scene/json_vectors.hpp"
+#include "msim/scene/keys/json_vectors.hpp"
 #include "msim/scene/phenomenon_support.hpp"
 #include "msim/scene/scene_file.hpp"
-#include "msim/scene/scene_obstacles.hpp"
-#include "msim/scene/smoke_scene_keys.hpp"
-#include "msim/scene/turbulent_wind_keys.hpp"
-#include "msim/scene/turbulent_wind_report.hpp"
+#include "msim/scene/keys/scene_obstacles.hpp"
+#include "msim/scene/smoke/smoke_scene_keys.hpp"
+#include "msim/scene/keys/turbulent_wind_keys.hpp"
+#include "msim/scene/reports/turbulent_wind_report.hpp"
 
 namespace msim::scene {
 
