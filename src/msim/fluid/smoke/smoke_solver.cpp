@@ -49,6 +49,21 @@ void SmokeSolver<D>::setObstacles(const Grid<float, D>& nodalSolidPhi) {
   if (conservative_) conservative_->transport.setSolid(sealed_);
   hasObstacles_ = true;
   border_ = numerics::SolidExtension<D>(solid_, 1);
+  if (vortex_) vortex_->setSolid(nodalSolidPhi);
+}
+
+template <int D>
+void SmokeSolver<D>::setVortexLayer(std::unique_ptr<VortexLayer<D>> layer) {
+  vortex_ = std::move(layer);
+  if (vortex_) vortex_->seedInitial(flowVorticity());
+}
+
+template <int D>
+const Vorticity<D>* SmokeSolver<D>::flowVorticity() {
+  if (!vortex_ || !vortex_->needsFlowVorticity()) return nullptr;
+  if (!flowVorticity_) flowVorticity_.emplace(spec_);
+  computeVorticity(velocity_, *flowVorticity_);
+  return &*flowVorticity_;
 }
 
 template <int D>
@@ -173,6 +188,8 @@ void SmokeSolver<D>::step(double dt) {
     if (b.alpha != 0.0 || b.beta != 0.0) addBuoyancy(velocity_, density_, temperature_, b, dt, solid);
     // Confinement re-injects the small-scale rotation (eq. 3.3) numerical dissipation removed.
     if (params_.vorticityEpsilon != 0.0) confinement_.apply(velocity_, params_.vorticityEpsilon, dt, solid);
+    // The vortex particles' force (Selle ch. 3.4.2), a body force that keeps the total vorticity.
+    if (vortex_) vortex_->addForce(velocity_, dt, solid);
     if (!winds_.empty()) applyWinds(dt);
   }
   if (params_.viscosity > 0.0) {
@@ -187,6 +204,11 @@ void SmokeSolver<D>::step(double dt) {
     applyInflow();
     pressureIterations_ = projection_.project(velocity_, dt, params_.fluidDensity).iterations;
     maxDivergence_ = measureDivergence();
+  }
+  if (vortex_) {
+    // The particles move with the divergence-free velocity (Selle ch. 3.3).
+    ScopedStage s(timers_, "vortex particles");
+    vortex_->advance(velocity_, dt, time_, flowVorticity());
   }
   {
     ScopedStage s(timers_, "advect scalars");
@@ -408,6 +430,10 @@ SmokeStatistics SmokeSolver<D>::statistics() const {
   s.totalDensity = dV * parallelSum(density_.count(), [&](std::size_t i) {
     return excluded[i] > 0.5f ? 0.0 : double(density_[i]);
   });
+  Vorticity<D> vorticity(spec_);
+  computeVorticity(velocity_, vorticity);
+  s.enstrophy = 0.5 * dV * parallelSum(vorticity.count(), [&](std::size_t i) { return double(vorticity[i].squaredNorm()); });
+  s.vortexParticles = vortex_ ? vortex_->particles().size() : 0;
   s.maxDivergence = maxDivergence_;
   s.pressureIterations = pressureIterations_;
   s.viscosityIterations = viscosityIterations_;

@@ -27,6 +27,7 @@
 #include "msim/fluid/smoke/buoyancy.hpp"
 #include "msim/fluid/smoke/viscosity.hpp"
 #include "msim/fluid/smoke/vorticity_confinement.hpp"
+#include "msim/fluid/vortex/vortex_layer.hpp"
 #include "msim/numerics/advection/advector.hpp"
 #include "msim/numerics/flux_transport.hpp"
 #include "msim/numerics/pressure/projection.hpp"
@@ -115,6 +116,8 @@ struct SmokeStatistics {
   int pressureIterations = 0;   // last projection
   int viscosityIterations = 0;  // last implicit viscosity solve
   long step = 0;                // steps taken
+  double enstrophy = 0.0;       // 1/2 sum_cells |curl u|^2 dV [m^3/s^2 (m^2/s^2 per unit depth in 2D)]
+  std::size_t vortexParticles = 0;
 };
 
 // Smoke decays as exp(-densityRate dt) per step and T - T_ambient as exp(-temperatureRate dt)
@@ -148,6 +151,12 @@ class SmokeSolver {
   // Procedural turbulence carries density and temperature on its own finer grid and sets the
   // solver's each step (their averages): the solver then neither advects nor dissipates them.
   void setScalarsCarriedElsewhere(bool elsewhere) { scalarsElsewhere_ = elsewhere; }
+  // Vortex particles (Selle ch. 3.3-3.5, fluid/vortex): their force joins the body forces and they
+  // move after the projection. Set before setObstacles, which hands them the obstacles; the
+  // initial particles are seeded here.
+  void setVortexLayer(std::unique_ptr<VortexLayer<D>> layer);
+  const VortexLayer<D>* vortexLayer() const { return vortex_.get(); }
+  VortexLayer<D>* vortexLayer() { return vortex_.get(); }
   // The clock the winds are sampled at [s]; step() advances it, a resumed run sets it.
   void setTime(double time) { time_ = time; }
   double time() const { return time_; }
@@ -186,7 +195,8 @@ class SmokeSolver {
   const GridSpec<D>& spec() const { return spec_; }
   const SmokeParams<D>& params() const { return params_; }
   SmokeParams<D>& params() { return params_; }
-  // Wall time per stage (sources, advect velocity, forces, viscosity, project, advect scalars).
+  // Wall time per stage (sources, advect velocity, forces, viscosity, project, vortex particles,
+  // advect scalars).
   const StageTimers& timers() const { return timers_; }
   void resetTimers() { timers_.reset(); }
 
@@ -213,6 +223,8 @@ class SmokeSolver {
   void applyWinds(double dt);
   void checkFinite() const;
   double measureDivergence();
+  // The grid's vorticity when the vortex particles seed from it, else null.
+  const Vorticity<D>* flowVorticity();
 
   GridSpec<D> spec_;
   SmokeParams<D> params_;
@@ -248,6 +260,8 @@ class SmokeSolver {
   bool scalarsElsewhere_ = false;
   std::optional<MacGrid<D>> advecting_;  // U + offset
   double time_ = 0.0;
+  std::unique_ptr<VortexLayer<D>> vortex_;
+  std::optional<Vorticity<D>> flowVorticity_;  // for vortex particles seeded with the flow's vorticity
 };
 
 }  // namespace msim::fluid

@@ -10,6 +10,7 @@
 #include "msim/scene/scene_file.hpp"
 #include "msim/scene/keys/scene_obstacles.hpp"
 #include "msim/scene/schema/shape_schema.hpp"
+#include "msim/scene/smoke/vortex_particle_keys.hpp"
 #include "msim/scene/keys/subgrid_turbulence_keys.hpp"
 #include "msim/scene/keys/turbulent_wind_keys.hpp"
 
@@ -72,6 +73,7 @@ Schema smokeKeys() {
   turbulence.boolean("write_velocity", false,
                      "write the fine velocity U + u' as 'vel' in the VDB frames (large: 12 bytes per fine cell)");
   smoke.field("turbulence", turbulence);
+  smoke.field("vortex_particles", vortexParticleKeys());
   smoke.vector("initial_velocity", "m/s", {0.0, 0.0, 0.0}, "velocity of the air at t = 0").lengths({2, 3});
   Schema walls = Schema::object("velocity of each closed side of the domain");
   for (const auto& axis : kDomainSideKeys)
