@@ -23,6 +23,7 @@ mushroom            | render  |
 swirl_2d            | render  |
 chimney_wind        | render  |
 plume_3d            | render  |
+plume_vortex_particles | preview | --frames 48
 smoke_sphere        | render  |
 burning_log         | render  |
 plume_2d            | render  |
