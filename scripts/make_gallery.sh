@@ -24,6 +24,7 @@ swirl_2d            | render  |
 chimney_wind        | render  |
 plume_3d            | render  |
 plume_vortex_particles | preview | --frames 48
+stream_vortex_particles | preview | --frames 48
 smoke_sphere        | render  |
 burning_log         | render  |
 plume_2d            | render  |
