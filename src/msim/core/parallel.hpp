@@ -55,21 +55,20 @@ void parallelForCells(const Grid<T, D>& g, F&& f) {
   parallelForCells<D>(g.size(), std::forward<F>(f));
 }
 
-// Deterministic parallel sum of f(i) over [0, n) in double precision.
+// Deterministic parallel sum of f(i) over [0, n) in double precision: the range is split by
+// halving down to blocks of at most 4096 and the partial sums are combined along that tree, which
+// depends on n alone, so a sum is the same whatever the thread count. Nothing is allocated (conjugate
+// gradients call it every iteration).
 template <typename F>
 double parallelSum(std::size_t n, F&& f) {
   constexpr std::size_t kBlock = 4096;
-  const std::size_t blocks = (n + kBlock - 1) / kBlock;
-  std::vector<double> partial(blocks, 0.0);
-  tbb::parallel_for(std::size_t(0), blocks, [&](std::size_t b) {
-    double s = 0.0;
-    const std::size_t end = std::min(n, (b + 1) * kBlock);
-    for (std::size_t i = b * kBlock; i < end; ++i) s += f(i);
-    partial[b] = s;
-  });
-  double total = 0.0;
-  for (double p : partial) total += p;
-  return total;
+  return tbb::parallel_deterministic_reduce(
+      tbb::blocked_range<std::size_t>(0, n, kBlock), 0.0,
+      [&](const tbb::blocked_range<std::size_t>& r, double s) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) s += f(i);
+        return s;
+      },
+      [](double a, double b) { return a + b; });
 }
 
 // Parallel max of f(i) over [0, n) (0 for an empty range; f is expected to be >= 0). The max does

@@ -6,93 +6,14 @@
 
 #include "msim/numerics/block_jacobi.hpp"
 
-#include <algorithm>
 #include <stdexcept>
-#include <utility>
 #include <vector>
 
 #include <Eigen/Dense>
-#include <tbb/enumerable_thread_specific.h>
 
 #include "msim/core/parallel.hpp"
 
 namespace msim::numerics {
-
-void parallelMultiply(const SparseRowMatrix& A, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
-  y.resize(A.rows());
-  const int* outer = A.outerIndexPtr();
-  const int* inner = A.innerIndexPtr();
-  const double* value = A.valuePtr();
-  parallelFor(0, static_cast<std::size_t>(A.rows()), [&](std::size_t row) {
-    double s = 0.0;
-    for (int e = outer[row]; e < outer[row + 1]; ++e) s += value[e] * x[inner[e]];
-    y[static_cast<Eigen::Index>(row)] = s;
-  }, 256);
-}
-
-SparseRowMatrix parallelProduct(const SparseRowMatrix& A, const SparseRowMatrix& B) {
-  if (A.cols() != B.rows()) throw std::invalid_argument("sparse product: the inner sizes differ");
-  const auto rows = static_cast<std::size_t>(A.rows());
-  const int* aOuter = A.outerIndexPtr();
-  const int* aInner = A.innerIndexPtr();
-  const double* aValue = A.valuePtr();
-  const int* bOuter = B.outerIndexPtr();
-  const int* bInner = B.innerIndexPtr();
-  const double* bValue = B.valuePtr();
-  // Per thread: the slot of each column in the row being formed (-1: none yet).
-  tbb::enumerable_thread_specific<std::vector<int>> slots([&] { return std::vector<int>(static_cast<std::size_t>(B.cols()), -1); });
-  // Pass 1: the nonzeros of each row.
-  std::vector<int> count(rows + 1, 0);
-  parallelFor(0, rows, [&](std::size_t row) {
-    std::vector<int>& slot = slots.local();
-    int n = 0;
-    for (int e = aOuter[row]; e < aOuter[row + 1]; ++e)
-      for (int f = bOuter[aInner[e]]; f < bOuter[aInner[e] + 1]; ++f)
-        if (slot[static_cast<std::size_t>(bInner[f])] != static_cast<int>(row)) {
-          slot[static_cast<std::size_t>(bInner[f])] = static_cast<int>(row);
-          ++n;
-        }
-    count[row + 1] = n;
-  }, 64);
-  for (std::size_t row = 0; row < rows; ++row) count[row + 1] += count[row];
-  SparseRowMatrix C(A.rows(), B.cols());
-  C.resizeNonZeros(count[rows]);
-  std::copy(count.begin(), count.end(), C.outerIndexPtr());
-  int* cInner = C.innerIndexPtr();
-  double* cValue = C.valuePtr();
-  // Pass 2: the values, accumulated in place, then each row's columns sorted.
-  for (std::vector<int>& slot : slots) std::fill(slot.begin(), slot.end(), -1);  // pass 1 left row numbers
-  tbb::enumerable_thread_specific<std::vector<std::pair<int, double>>> rowBuffers;
-  parallelFor(0, rows, [&](std::size_t row) {
-    std::vector<int>& slot = slots.local();
-    const int begin = count[row];
-    int end = begin;
-    for (int e = aOuter[row]; e < aOuter[row + 1]; ++e)
-      for (int f = bOuter[aInner[e]]; f < bOuter[aInner[e] + 1]; ++f) {
-        const auto column = static_cast<std::size_t>(bInner[f]);
-        if (slot[column] < begin || slot[column] >= end) {  // not yet in this row (rows' ranges are disjoint)
-          slot[column] = end;
-          cInner[end] = bInner[f];
-          cValue[end++] = 0.0;
-        }
-        cValue[slot[column]] += aValue[e] * bValue[f];
-      }
-    std::vector<std::pair<int, double>>& sorted = rowBuffers.local();
-    sorted.clear();
-    for (int e = begin; e < end; ++e) sorted.emplace_back(cInner[e], cValue[e]);
-    std::sort(sorted.begin(), sorted.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
-    for (int e = begin; e < end; ++e) {
-      cInner[e] = sorted[static_cast<std::size_t>(e - begin)].first;
-      cValue[e] = sorted[static_cast<std::size_t>(e - begin)].second;
-    }
-  }, 64);
-  return C;
-}
-
-double parallelDot(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
-  return parallelSum(static_cast<std::size_t>(a.size()),
-                     [&](std::size_t i) { return a[static_cast<Eigen::Index>(i)] * b[static_cast<Eigen::Index>(i)]; });
-}
 
 namespace {
 

@@ -5,18 +5,9 @@
 // own as the cheap preconditioner of small systems and as the smoother of smoothed_aggregation.hpp.
 #include <vector>
 
-#include <Eigen/Sparse>
+#include "msim/numerics/sparse_ops.hpp"
 
 namespace msim::numerics {
-
-using SparseRowMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
-
-// y = A x, the rows shared among threads (A compressed).
-void parallelMultiply(const SparseRowMatrix& A, const Eigen::VectorXd& x, Eigen::VectorXd& y);
-// C = A B by rows on all cores (Gustavson's row-by-row accumulation), columns sorted in each row.
-SparseRowMatrix parallelProduct(const SparseRowMatrix& A, const SparseRowMatrix& B);
-// Deterministic parallel dot product (fixed blocks, whatever the thread count).
-double parallelDot(const Eigen::VectorXd& a, const Eigen::VectorXd& b);
 
 class BlockJacobi {
  public:

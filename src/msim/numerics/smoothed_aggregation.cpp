@@ -267,12 +267,6 @@ void SmoothedAggregation::setup(const Matrix& A, const Eigen::MatrixXd& nearNull
   }
 }
 
-std::vector<int> SmoothedAggregation::levelNodes() const {
-  std::vector<int> nodes;
-  for (const Level& level : levels_) nodes.push_back(static_cast<int>(level.A.rows() / level.blockSize));
-  return nodes;
-}
-
 double SmoothedAggregation::operatorComplexity() const {
   if (levels_.empty()) return 0.0;
   double total = 0.0;

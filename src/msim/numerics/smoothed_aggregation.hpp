@@ -52,7 +52,6 @@ class SmoothedAggregation {
   void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
 
   int levels() const { return static_cast<int>(levels_.size()); }
-  std::vector<int> levelNodes() const;
   // Nonzeros of all levels over those of the finest: the work of a cycle relative to a product with A.
   double operatorComplexity() const;
 

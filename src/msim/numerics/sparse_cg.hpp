@@ -8,7 +8,7 @@
 
 #include <Eigen/Sparse>
 
-#include "msim/numerics/block_jacobi.hpp"
+#include "msim/numerics/sparse_ops.hpp"
 
 namespace msim::numerics {
 

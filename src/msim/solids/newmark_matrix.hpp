@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "msim/core/vec.hpp"
-#include "msim/numerics/block_jacobi.hpp"
+#include "msim/numerics/sparse_ops.hpp"
 #include "msim/solids/mass_spring.hpp"
 
 namespace msim::solids {

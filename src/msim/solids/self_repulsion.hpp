@@ -35,7 +35,6 @@ struct RepulsionSettings {
 
 struct RepulsionStats {
   int pointTrianglePairs = 0, edgeEdgePairs = 0;  // found in step A
-  int active = 0;                                 // pairs closer than h in the last pass
 };
 
 class SelfRepulsion {
@@ -54,7 +53,7 @@ class SelfRepulsion {
                             double dt);
   int repelEndVelocity(const std::vector<Vec3>& x, std::vector<Vec3>& v, const std::vector<double>& inverseMass);
 
-  RepulsionStats stats() const { return {static_cast<int>(pointTriangle_.size()), static_cast<int>(edgeEdge_.size()), 0}; }
+  RepulsionStats stats() const { return {static_cast<int>(pointTriangle_.size()), static_cast<int>(edgeEdge_.size())}; }
 
  private:
   enum class Pass { Inelastic, Elastic, EndOfStep };
