@@ -202,6 +202,7 @@ void SmokeSolver<D>::step(double dt) {
     // Eq. 3.2 through the pressure: inflow faces are set first so the projection balances them.
     ScopedStage s(timers_, "project");
     applyInflow();
+    updateExpansion();
     pressureIterations_ = projection_.project(velocity_, dt, params_.fluidDensity).iterations;
     maxDivergence_ = measureDivergence();
   }
@@ -369,6 +370,25 @@ void SmokeSolver<D>::applyInflow() {
 }
 
 template <int D>
+void SmokeSolver<D>::updateExpansion() {
+  const bool expanding = std::any_of(sources_.begin(), sources_.end(),
+                                     [](const SmokeSource<D>& s) { return s.active && s.expansion != 0.0; });
+  if (!expanding) {
+    if (expansion_.count() != 0) {
+      expansion_ = Grid<float, D>();
+      projection_.setCellTargetDivergence(nullptr);
+    }
+    return;
+  }
+  if (expansion_.count() == 0) expansion_ = Grid<float, D>(spec_);
+  std::fill(expansion_.data().begin(), expansion_.data().end(), 0.0f);
+  for (const auto& src : sources_)
+    if (src.active)
+      for (const auto& [cell, w] : src.cells) expansion_[cell] += static_cast<float>(w * src.expansion);
+  projection_.setCellTargetDivergence(&expansion_);
+}
+
+template <int D>
 void dissipateSmoke(Grid<float, D>& density, Grid<float, D>& temperature, double densityRate, double temperatureRate,
                     double ambientTemperature, double dt) {
   const float keepRho = static_cast<float>(std::exp(-densityRate * dt));
@@ -395,6 +415,9 @@ void SmokeSolver<D>::dissipate(double dt) {
 template <int D>
 double SmokeSolver<D>::measureDivergence() {
   projection_.divergence(velocity_, divergence_);
+  // Expanding sources keep their divergence on purpose; what is measured is the error.
+  if (expansion_.count() != 0)
+    return parallelMax(divergence_.count(), [&](std::size_t i) { return std::abs(divergence_[i] - expansion_[i]); });
   return parallelMax(divergence_.count(), [&](std::size_t i) { return std::abs(divergence_[i]); });
 }
 

@@ -78,6 +78,11 @@ struct SmokeSource {
   double density = 0.0;      // Set: value [kg/m^3]; Add: rate [kg/(m^3 s)]
   double temperature = 0.0;  // Set: value [K]; Add: rate [K/s]; ignored when <= 0 in Set mode
   std::optional<Vec<D>> velocity;  // inflow [m/s]
+  // Divergence [1/s] the projection leaves in covered cells, times their coverage: the gas an
+  // explosion or a flame releases pushes the air out (Selle Fig. 3.4's divergence-driven
+  // expansion). Where no side is open the box cannot grow, and the rest of the air is compressed
+  // uniformly to make room (the projection removes the target's mean there).
+  double expansion = 0.0;
   // Extra scalars (addScalar index, value or rate as for density), e.g. fuel for fire.
   std::vector<std::pair<std::size_t, double>> scalars;
   bool active = true;  // an inactive source does nothing (emitters switched on and off in time)
@@ -109,7 +114,7 @@ void applySourceScalars(const SmokeSource<D>& src, double dt, Grid<float, D>& de
 
 struct SmokeStatistics {
   double kineticEnergy = 0.0;   // 1/2 rho sum_faces w_f u_f^2 dV [J per unit depth in 2D]
-  double maxDivergence = 0.0;   // max |div u| after the last projection [1/s]
+  double maxDivergence = 0.0;   // max |div u - expansion| after the last projection [1/s]
   double totalDensity = 0.0;    // integral of density over the cells that carry scalars [kg]
                                 // (Advector: centre outside obstacles; Conservative: any open face)
   double maxSpeed = 0.0;        // max |u_f| over faces [m/s]
@@ -219,6 +224,8 @@ class SmokeSolver {
   void findCutFaces();
   void extrapolateIntoCutFaces();
   void applyInflow();
+  // Fills expansion_ from the active expanding sources and hands it to the projection.
+  void updateExpansion();
   void dissipate(double dt);
   void applyWinds(double dt);
   void checkFinite() const;
@@ -230,6 +237,7 @@ class SmokeSolver {
   SmokeParams<D> params_;
   MacGrid<D> velocity_;
   Grid<float, D> density_, temperature_, solid_, divergence_;
+  Grid<float, D> expansion_;  // the sources' target divergence [1/s]; empty while none expands
   // Cells with no open face (projection weight 0 on all 2D faces): no pressure, no flux; the
   // conservative transport's solid mask.
   Grid<float, D> sealed_;

@@ -223,11 +223,14 @@ PcgStats PressureProjection<D>::project(MacGrid<D>& velocity, double dt, double 
     throw std::invalid_argument("pressure projection: the step and the density must be positive");
   const float toScaled = static_cast<float>(dt / (density * spec_.dx));
   netOutflow(velocity, rhs_);
-  // A p^ = -dx (div u* - c): the cells keep the target divergence c (0 unless volume control).
-  const float targetOutflow = static_cast<float>(spec_.dx) * targetDivergence_;
+  // A p^ = -dx (div u* - c): the cells keep the target divergence c (0 unless volume control or
+  // an expanding source).
+  const float dx = static_cast<float>(spec_.dx), targetOutflow = dx * targetDivergence_;
+  const float* cellTarget = cellTargetDivergence_ ? cellTargetDivergence_->data().data() : nullptr;
   const std::vector<float>& diag = matrix_.diag();
   parallelFor(0, rhs_.size(), [&](std::size_t i) {
-    rhs_[i] = diag[i] > 0.0f ? targetOutflow - rhs_[i] : 0.0f;
+    const float outflow = cellTarget ? targetOutflow + dx * cellTarget[i] : targetOutflow;
+    rhs_[i] = diag[i] > 0.0f ? outflow - rhs_[i] : 0.0f;
     scaledPressure_[i] = pressure_[i] * toScaled;
   });
   Preconditioner& M = multigrid_ ? static_cast<Preconditioner&>(*multigrid_) : *mic0_;

@@ -93,6 +93,9 @@ class PressureProjection {
   // volume expand by div u = c > 0. A region with no Dirichlet cell cannot change its volume; its
   // mean target is removed with the rest of its right-hand side's mean (floatingRegions()).
   void setTargetDivergence(double perSecond) { targetDivergence_ = static_cast<float>(perSecond); }
+  // A divergence [1/s] per cell added to the uniform one (an explosion's or a flame's expansion
+  // where its gas is released); null: none. The grid must outlive its use.
+  void setCellTargetDivergence(const Grid<float, D>* perCell) { cellTargetDivergence_ = perCell; }
 
   // Makes `velocity` divergence free; the pressure [Pa] is kept (pressure()) and warm-starts
   // the next call.
@@ -133,6 +136,7 @@ class PressureProjection {
   std::vector<float> dirichlet_;  // with a free surface: PoissonMatrix's Dirichlet terms
   bool freeSurface_ = false;
   float targetDivergence_ = 0.0f;
+  const Grid<float, D>* cellTargetDivergence_ = nullptr;
   std::array<std::array<float, 2>, D> wallNormalVelocity_{};
   PoissonMatrix<D> matrix_;
   FloatingRegions<D> floating_;

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <numbers>
 #include <optional>
 
 #include <fmt/format.h>
@@ -315,6 +316,14 @@ class SmokePhenomenon final : public Phenomenon {
       src.mode = s.at("mode") == "set" ? fluid::SmokeSource<D>::Mode::Set : fluid::SmokeSource<D>::Mode::Add;
       src.density = s.at("density").get<double>();
       src.temperature = s.at("temperature").get<double>();
+      src.expansion = s.at("expansion").get<double>();
+      if (src.expansion != 0.0) {
+        // A ball of volume V expanding at div u = c pushes its surface out at c R / D.
+        double volume = 0.0;
+        for (const auto& cell : src.cells) volume += cell.second * solver_.spec().cellVolume();
+        const double radius = D == 3 ? std::cbrt(3.0 * volume / (4.0 * std::numbers::pi)) : std::sqrt(volume / std::numbers::pi);
+        boundarySpeed_ = std::max(boundarySpeed_, std::abs(src.expansion) * radius / D);
+      }
       const double fuel = s.at("fuel").get<double>();
       if (fuel > 0.0) {
         if (!combustion_)
@@ -352,7 +361,7 @@ class SmokePhenomenon final : public Phenomenon {
   fluid::SmokeSolver<D> solver_;
   double timeCfl_;
   double time_ = 0.0;
-  double boundarySpeed_ = 0.0;  // fastest wall or source inflow: the flow will reach it [m/s]
+  double boundarySpeed_ = 0.0;  // fastest wall, source inflow or expansion: the flow will reach it [m/s]
   std::vector<std::pair<double, double>> windows_;  // (start, stop) of each source [s]
   std::optional<fluid::CombustionParams> combustion_;
   std::size_t fuel_ = 0, flame_ = 0;

@@ -116,6 +116,9 @@ void declareSmokeKeys(Schema& root) {
   source.number("fuel", "kg/m^3 (set) or kg/(m^3 s) (add)", 0.0, "fuel for fire (needs fire.enabled)").min(0.0);
   source.boolean("inflow", false, "impose 'velocity' on the faces of covered cells before the projection");
   source.vector("velocity", "m/s", {0.0, 0.0, 0.0}, "inflow velocity").lengths({2, 3});
+  source.number("expansion", "1/s", 0.0,
+                "div u the covered cells keep while the source emits: the gas release of an explosion or a flame "
+                "pushing the air out (Selle Fig. 3.4)");
   source.number("start", "s", 0.0, "emits from this time").min(0.0);
   source.number("stop", "s", 0.0, "emits until this time; 0 = to the end").min(0.0);
   root.array("sources", source, "emitters");
