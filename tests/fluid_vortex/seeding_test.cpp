@@ -1,4 +1,4 @@
-// Seeding (Selle ch. 3.4.1, 3.5): counts and rates, the three vorticity choices, and bad input.
+// Seeding (Selle ch. 3.4.1, 3.5): counts and rates, the four vorticity choices, and bad input.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -80,8 +80,25 @@ TEST(VortexSeeding, AzimuthalVorticityIsTangentToTheVerticalCylinder) {
   }
 }
 
+TEST(VortexSeeding, VerticalVorticityPointsUpOrDownInEqualShares) {
+  auto s = boxSettings();
+  s.vorticity = SeedVorticity::Vertical;
+  VortexParticles<3> particles;
+  Rng rng(5);
+  seedVortexParticles<3>(particles, s, kDomain, 1000, rng);
+  int up = 0;
+  for (std::size_t p = 0; p < particles.size(); ++p) {
+    const Eigen::Vector3d w = particles.vorticities()[p];
+    ASSERT_EQ(w.x(), 0.0);
+    ASSERT_EQ(w.z(), 0.0);
+    ASSERT_NEAR(std::abs(w.y()), 2e-3, 1e-15);
+    up += w.y() > 0.0;
+  }
+  EXPECT_NEAR(up, 500, 60);  // binomial(1000, 1/2): 3.8 standard deviations
+}
+
 TEST(VortexSeeding, LocalFlowTakesTheGridVorticityAndSkipsCalmRegions) {
-  GridVorticity<3> flow(kDomain);
+  Vorticity<3> flow(kDomain);
   for (std::size_t i = 0; i < flow.count(); ++i)
     flow[i] = flow.position(flow.coord(i)).x() < 0.45 ? Eigen::Vector3f(0, 0, 3.0f) : Eigen::Vector3f::Zero();
   auto s = boxSettings();
@@ -124,6 +141,12 @@ TEST(VortexSeeding, BadInputIsRejectedNamingTheField) {
   EXPECT_NE(messageOf([&] { outside.validate(kDomain, "smoke.vortex_particles.seed"); })
                 .find("smoke.vortex_particles.seed.region"),
             std::string::npos);
+  // A box drawn to the domain's bounds as written passes, however dx rounds (4.8 / 96 * 32 < 1.6).
+  const GridSpec<3> river(Vec3::Zero(), 4.8 / 96, IVec3(96, 24, 32));
+  auto toTheWall = boxSettings();
+  toTheWall.regionMin = Vec3::Zero();
+  toTheWall.regionMax = Vec3(0.5, 0.4, 1.6);
+  EXPECT_NO_THROW(toTheWall.validate(river));
   auto inverted = boxSettings();
   inverted.regionMin.y() = 0.8;
   EXPECT_NE(messageOf([&] { inverted.validate(kDomain); }).find("exceeds"), std::string::npos);

@@ -8,7 +8,9 @@
 
 #include "msim/core/error.hpp"
 #include "msim/core/parallel.hpp"
+#include "msim/core/interpolation.hpp"
 #include "msim/core/resample.hpp"
+#include "msim/fluid/vortex/vortex_solids.hpp"
 #include "msim/numerics/level_set/extrapolation.hpp"
 #include "msim/numerics/level_set/fast_marching.hpp"
 #include "msim/numerics/level_set/level_set_measures.hpp"
@@ -56,6 +58,7 @@ void LiquidSolver<D>::setObstacles(const Grid<float, D>& nodalSolidPhi) {
   }
   projection_.setSolids(open);
   solidDistance_ = nodalSolidPhi;
+  if (vortex_) vortex_->setSolid(nodalSolidPhi);
   // phi continues three cells into the obstacles (a 90-degree contact, as the domain's clamped
   // sides give). Left with the air's sign, a wall would be a surface of the liquid, which the
   // level set then eroded along every obstacle (a pool in a box container lost half its water in a
@@ -369,6 +372,11 @@ void LiquidSolver<D>::step(double dt) {
       parallelFor(0, u.count(), [&](std::size_t i) { u[i] += dv; });
     }
   }
+  if (vortex_) {
+    // The particles' force (Selle ch. 3.4.2) joins gravity; none on faces next to obstacles.
+    ScopedStage s(timers_, "liquid: vortex particles");
+    vortex_->addForce(velocity_, dt, &solid_);
+  }
   {
     ScopedStage s(timers_, "liquid: pressure");
     parallelFor(0, phi_.count(), [&](std::size_t i) {  // solids hold no liquid (their faces are closed)
@@ -387,11 +395,38 @@ void LiquidSolver<D>::step(double dt) {
     ScopedStage s(timers_, "liquid: grid to particles");
     flip_.fromGrid(velocity_, gridVelocityBefore_, params_.flipRatio);
   }
+  if (vortex_) advanceVortexParticles(dt);
   if (inflowThisStep_) {  // the emitters mark their wall faces again before the next step
     for (int a = 0; a < D; ++a) wallInflow_->component(a).fill(0.0f);
     inflowThisStep_ = false;
   }
   ++steps_;
+  time_ += dt;
+}
+
+template <int D>
+void LiquidSolver<D>::setVortexLayer(std::unique_ptr<VortexLayer<D>> layer) {
+  vortex_ = std::move(layer);
+  if (!vortex_) return;
+  if (solidDistance_) vortex_->setSolid(*solidDistance_);
+  vortex_->seedInitial(flowVorticity());
+  removeVortexParticlesInSolid<D>(vortex_->particles(), [&](const Vec<D>& x) { return -double(sampleLinear<D>(phi_, x)); });
+}
+
+template <int D>
+void LiquidSolver<D>::advanceVortexParticles(double dt) {
+  ScopedStage s(timers_, "liquid: vortex particles");
+  vortex_->advance(velocity_, dt, time_, flowVorticity());
+  // Particles in the air (phi > 0, read D-linearly at the cell centres) carry nothing there.
+  removeVortexParticlesInSolid<D>(vortex_->particles(), [&](const Vec<D>& x) { return -double(sampleLinear<D>(phi_, x)); });
+}
+
+template <int D>
+const Vorticity<D>* LiquidSolver<D>::flowVorticity() {
+  if (!vortex_ || !vortex_->needsFlowVorticity()) return nullptr;
+  if (!flowVorticity_) flowVorticity_.emplace(spec_);
+  computeVorticity(velocity_, *flowVorticity_);
+  return &*flowVorticity_;
 }
 
 template <int D>
@@ -421,6 +456,10 @@ LiquidStatistics LiquidSolver<D>::statistics() const {
                     });
   s.pressureIterations = lastSolve_.iterations;
   s.pressureConverged = lastSolve_.converged;
+  Vorticity<D> vorticity(spec_);
+  computeVorticity(velocity_, vorticity);
+  s.enstrophy = enstrophy<D>(vorticity, [&](std::size_t cell) { return liquidCell(cell); });
+  s.vortexParticles = vortex_ ? vortex_->particles().size() : 0;
   s.particles = params_.tracker == InterfaceTracker::Flip ? flip_.size() : particles_.size();
   s.escaped = lastEscaped_;
   s.step = steps_;

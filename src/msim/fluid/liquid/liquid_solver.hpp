@@ -27,12 +27,16 @@
 // open sides less what sinks and open sides took (FLIP: the particles' volume, scaled as the
 // surface first measured it). The correction is spread over the whole liquid, not put back where
 // the volume was lost.
+// Vortex particles (setVortexLayer; Selle ch. 3.3-3.5, fluid/vortex) add their force with gravity
+// in step 3 and move with the velocity after step 5; those that leave the liquid are deleted (the
+// air carries no vorticity: Fig. 3.3's river eddies live in the water).
 // Obstacles are solids given by a signed distance at the grid nodes, as for smoke; moving ones are
 // placed again before every step with the velocity of the solid on every face, which the pressure
 // uses as the boundary condition (the solid pushes the liquid through its faces' closed parts). Storage
 // is float, reductions double; the work arrays live in the object.
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -40,6 +44,7 @@
 #include "msim/core/mac_grid.hpp"
 #include "msim/core/timer.hpp"
 #include "msim/fluid/liquid/flip_particles.hpp"
+#include "msim/fluid/vortex/vortex_layer.hpp"
 #include "msim/numerics/advection/advector.hpp"
 #include "msim/numerics/level_set/particle_level_set.hpp"
 #include "msim/numerics/pressure/projection.hpp"
@@ -102,6 +107,8 @@ struct LiquidStatistics {
   bool pressureConverged = true;
   std::size_t particles = 0;    // marker particles
   std::size_t escaped = 0;      // escaped particles the last correction used
+  double enstrophy = 0.0;       // 1/2 sum over liquid cells of |curl u|^2 dV [m^3/s^2 in 3D]
+  std::size_t vortexParticles = 0;
   long step = 0;
 };
 
@@ -141,6 +148,16 @@ class LiquidSolver {
   // Advances by dt in ceil(dt / cflTimestep()) equal substeps; SimulationError (naming the step
   // and the speed) when that would exceed params.maxSubsteps. Returns the number of substeps.
   int advance(double dt);
+
+  // Vortex particles in the liquid (null: none); the initial ones are seeded here, so call it
+  // after the obstacles and the initial liquid are in place.
+  void setVortexLayer(std::unique_ptr<VortexLayer<D>> layer);
+  const VortexLayer<D>* vortexLayer() const { return vortex_.get(); }
+  VortexLayer<D>* vortexLayer() { return vortex_.get(); }
+  // The clock the vortex particles' seeding window is read at [s]; step() advances it, a resumed
+  // run sets it.
+  void setTime(double time) { time_ = time; }
+  double time() const { return time_; }
 
   LiquidStatistics statistics() const;
   // The liquid's volume at the end of the last step [m^3] (measured once its surface had moved;
@@ -183,6 +200,10 @@ class LiquidSolver {
   template <typename Edit>
   double editLevelSet(const Grid<float, D>& region, Edit&& edit);
   bool liquidCell(std::size_t cell) const { return phi_[cell] < 0.0f && solid_[cell] <= 0.5f; }
+  // The vortex particles' move (VortexLayer::advance), then those outside the liquid go.
+  void advanceVortexParticles(double dt);
+  // The grid's vorticity when the vortex particles seed from it, else null.
+  const Vorticity<D>* flowVorticity();
   // Whether face f of `axis` has a cell on either side for which isLiquid(cell index) holds.
   template <typename IsLiquid>
   bool faceTouches(int axis, const IVec<D>& f, IsLiquid&& isLiquid) const;
@@ -214,6 +235,9 @@ class LiquidSolver {
   std::uint64_t emissions_ = 0;  // emit() calls so far (new random streams each)
   std::optional<MacGrid<D>> wallInflow_;  // emitters' wall faces (markWallInflow), this step
   bool inflowThisStep_ = false, inflowApplied_ = false;  // set by emit(); in the projection
+  std::unique_ptr<VortexLayer<D>> vortex_;
+  std::optional<Vorticity<D>> flowVorticity_;  // for vortex particles seeded with the flow's vorticity
+  double time_ = 0.0;
   StageTimers timers_;
 };
 

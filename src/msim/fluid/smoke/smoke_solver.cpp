@@ -455,7 +455,7 @@ SmokeStatistics SmokeSolver<D>::statistics() const {
   });
   Vorticity<D> vorticity(spec_);
   computeVorticity(velocity_, vorticity);
-  s.enstrophy = 0.5 * dV * parallelSum(vorticity.count(), [&](std::size_t i) { return double(vorticity[i].squaredNorm()); });
+  s.enstrophy = enstrophy<D>(vorticity, [](std::size_t) { return true; });
   s.vortexParticles = vortex_ ? vortex_->particles().size() : 0;
   s.maxDivergence = maxDivergence_;
   s.pressureIterations = pressureIterations_;

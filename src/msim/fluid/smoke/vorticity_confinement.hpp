@@ -6,18 +6,9 @@
 // refinement, where the dissipation it compensates vanishes too.
 #include "msim/core/grid.hpp"
 #include "msim/core/mac_grid.hpp"
+#include "msim/fluid/vortex/grid_vorticity.hpp"
 
 namespace msim::fluid {
-
-// Vorticity at cell centres from the staggered velocity by central differences of the
-// face velocities averaged to the centres: 3 components in 3D; in 2D the scalar w_z is stored in
-// component 0 of a 1-vector. Exact for linear velocity fields away from the border (one-sided
-// differences at the border).
-template <int D>
-using Vorticity = Grid<Eigen::Matrix<float, (D == 3 ? 3 : 1), 1>, D>;
-
-template <int D>
-void computeVorticity(const MacGrid<D>& velocity, Vorticity<D>& vorticity);
 
 // Adds dt * f to the face velocities, with f = epsilon dx (N x omega) at cell centres averaged to
 // the faces. The centre velocities, vorticity and force are scratch grids reused between calls

@@ -7,7 +7,7 @@
 //   diagonal      du_a/dx_a = (u_a(upper face) - u_a(lower face)) / dx, the staggered difference
 //                 (the one the pressure projection's divergence uses);
 //   off-diagonal  du_a/dx_b = central difference along b of the face-averaged centre velocity,
-//                 one-sided at the border (as computeVorticity in fluid/smoke does).
+//                 one-sided at the border (as computeVorticity in grid_vorticity.hpp does).
 // Exact for linear velocity fields, up to float rounding.
 //
 // Evaluated on demand from the faces around the point (2^D cells, about 30 face reads each in 3D)

@@ -18,7 +18,7 @@ VortexLayer<D>::VortexLayer(const VortexLayerSettings<D>& settings, const GridSp
 }
 
 template <int D>
-void VortexLayer<D>::seedInitial(const GridVorticity<D>* flowVorticity) {
+void VortexLayer<D>::seedInitial(const Vorticity<D>* flowVorticity) {
   if (settings_.initialCount == 0) return;
   Rng rng(settings_.randomSeed ^ 0x5eedULL);
   seedVortexParticles<D>(particles_, settings_.seed, domain_, settings_.initialCount, rng, flowVorticity);
@@ -30,7 +30,7 @@ void VortexLayer<D>::addForce(MacGrid<D>& velocity, double dt, const Grid<float,
 }
 
 template <int D>
-void VortexLayer<D>::advance(const MacGrid<D>& velocity, double dt, double time, const GridVorticity<D>* flowVorticity) {
+void VortexLayer<D>::advance(const MacGrid<D>& velocity, double dt, double time, const Vorticity<D>* flowVorticity) {
   advectVortexParticles<D>(particles_, velocity, dt);
   stretchVortexParticles<D>(particles_, velocity, dt);
   if (solidPhi_) {

@@ -41,11 +41,11 @@ class VortexLayer {
 
   void addForce(MacGrid<D>& velocity, double dt, const Grid<float, D>* solidMask) const;
   // flowVorticity: the grid's vorticity, needed when the seed takes the local flow's.
-  void advance(const MacGrid<D>& velocity, double dt, double time, const GridVorticity<D>* flowVorticity);
+  void advance(const MacGrid<D>& velocity, double dt, double time, const Vorticity<D>* flowVorticity);
   // The obstacles as a signed distance at the grid nodes (negative inside), copied; none before.
   void setSolid(const Grid<float, D>& nodalSolidPhi) { solidPhi_ = nodalSolidPhi; }
   // The particles seeded at the start (initialCount), once; flowVorticity as for advance.
-  void seedInitial(const GridVorticity<D>* flowVorticity);
+  void seedInitial(const Vorticity<D>* flowVorticity);
 
   const VortexParticles<D>& particles() const { return particles_; }
   VortexParticles<D>& particles() { return particles_; }

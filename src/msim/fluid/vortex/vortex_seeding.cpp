@@ -54,7 +54,7 @@ VortexVector<D> azimuthalDirection(const Vec<D>& x, const Vec<D>& centre, int up
 }
 
 template <int D>
-VortexVector<D> sampleFlowVorticity(const GridVorticity<D>& grid, const Vec<D>& x) {
+VortexVector<D> sampleFlowVorticity(const Vorticity<D>& grid, const Vec<D>& x) {
   const Vec<D> s = grid.toSampleSpace(x);
   std::array<LinearTap, D> taps;
   for (int a = 0; a < D; ++a) taps[a] = clampedTap(s[a], grid.size()[a], static_cast<std::size_t>(grid.stride(a)));
@@ -65,7 +65,9 @@ VortexVector<D> sampleFlowVorticity(const GridVorticity<D>& grid, const Vec<D>& 
 
 template <int D>
 void VortexSeedSettings<D>::validate(const GridSpec<D>& domain, const std::string& context) const {
-  const Vec<D> lo = domain.origin, hi = domain.upper();
+  // A box drawn to the domain's written bounds may exceed the grid's origin + res dx by rounding.
+  const double slack = 1e-9 * domain.dx;
+  const Vec<D> lo = domain.origin.array() - slack, hi = domain.upper().array() + slack;
   for (int a = 0; a < D; ++a) {
     if (!std::isfinite(regionMin[a]) || !std::isfinite(regionMax[a]))
       fail(context, "region", "the corners must be finite, got min " + format<D>(regionMin) + " max " + format<D>(regionMax));
@@ -88,7 +90,7 @@ void VortexSeedSettings<D>::validate(const GridSpec<D>& domain, const std::strin
 template <int D>
 std::size_t seedVortexParticles(VortexParticles<D>& particles, const VortexSeedSettings<D>& settings,
                                 const GridSpec<D>& domain, std::size_t count, Rng& rng,
-                                const GridVorticity<D>* flowVorticity) {
+                                const Vorticity<D>* flowVorticity) {
   settings.validate(domain);
   if (settings.vorticity == SeedVorticity::LocalFlow) {
     if (!flowVorticity) throw std::invalid_argument("seedVortexParticles: LocalFlow seeding needs the grid's vorticity");
@@ -113,6 +115,16 @@ std::size_t seedVortexParticles(VortexParticles<D>& particles, const VortexSeedS
         omega = settings.magnitude * t;
         break;
       }
+      case SeedVorticity::Vertical: {
+        const double sign = rng.uniform() < 0.5 ? -1.0 : 1.0;
+        if constexpr (D == 3) {
+          omega = VortexVector<D>::Zero();
+          omega[settings.upAxis] = sign * settings.magnitude;
+        } else {
+          omega = VortexVector<D>(sign * settings.magnitude);
+        }
+        break;
+      }
       case SeedVorticity::LocalFlow:
         omega = sampleFlowVorticity<D>(*flowVorticity, x);
         if (!(omega.norm() > settings.minimumFlowVorticity)) continue;
@@ -134,7 +146,7 @@ VortexEmitter<D>::VortexEmitter(const VortexSeedSettings<D>& settings, const Gri
 }
 
 template <int D>
-std::size_t VortexEmitter<D>::emit(VortexParticles<D>& particles, double dt, const GridVorticity<D>* flowVorticity) {
+std::size_t VortexEmitter<D>::emit(VortexParticles<D>& particles, double dt, const Vorticity<D>* flowVorticity) {
   requireValidVortexTimestep(dt, "VortexEmitter::emit");
   carry_ += rate_ * dt;
   const double whole = std::floor(carry_);
@@ -148,8 +160,8 @@ template struct VortexSeedSettings<3>;
 template class VortexEmitter<2>;
 template class VortexEmitter<3>;
 template std::size_t seedVortexParticles<2>(VortexParticles<2>&, const VortexSeedSettings<2>&, const GridSpec<2>&,
-                                            std::size_t, Rng&, const GridVorticity<2>*);
+                                            std::size_t, Rng&, const Vorticity<2>*);
 template std::size_t seedVortexParticles<3>(VortexParticles<3>&, const VortexSeedSettings<3>&, const GridSpec<3>&,
-                                            std::size_t, Rng&, const GridVorticity<3>*);
+                                            std::size_t, Rng&, const Vorticity<3>*);
 
 }  // namespace msim::fluid

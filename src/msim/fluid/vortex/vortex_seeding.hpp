@@ -9,6 +9,8 @@
 //              cylinder centered at the source region's midpoint oriented upward"; the sense of
 //              rotation is not given, this one spins a rising ring outwards at its top); 2D: the
 //              z component of that, +-magnitude on the two sides of the axis;
+//   Vertical   omega_p = +-magnitude e_up, the sign at random (Fig. 3.3's river: "vorticity
+//              pointing either up or down", eddies about vertical axes); 2D: +-magnitude;
 //   LocalFlow  omega_p = the grid's vorticity at x_p (cell-centred, D-linear); no particle where
 //              its magnitude is at most minimumFlowVorticity (seeding only where the flow swirls).
 // Everything is drawn from a msim::Rng, so a seed gives the same particles on every machine.
@@ -20,26 +22,23 @@
 
 #include "msim/core/grid.hpp"
 #include "msim/core/rng.hpp"
+#include "msim/fluid/vortex/grid_vorticity.hpp"
 #include "msim/fluid/vortex/vortex_particles.hpp"
 
 namespace msim::fluid {
 
-// The grid's vorticity at cell centres: the layout of fluid::Vorticity<D> (fluid/smoke
-// computeVorticity), 3 components in 3D, omega_z in component 0 in 2D.
-template <int D>
-using GridVorticity = Grid<Eigen::Matrix<float, (D == 3 ? 3 : 1), 1>, D>;
 
-enum class SeedVorticity { Random, Azimuthal, LocalFlow };
+enum class SeedVorticity { Random, Azimuthal, Vertical, LocalFlow };
 
 template <int D>
 struct VortexSeedSettings {
   Vec<D> regionMin = Vec<D>::Zero();  // seeding box, lower corner [m]; inside the domain
   Vec<D> regionMax = Vec<D>::Zero();  // upper corner [m]; >= regionMin on every axis
   SeedVorticity vorticity = SeedVorticity::Random;
-  double magnitude = 2e-3;  // |omega_p| for Random and Azimuthal [1/s] (Fig. 3.4: 2e-3)
+  double magnitude = 2e-3;  // |omega_p| for Random, Azimuthal and Vertical [1/s] (Fig. 3.4: 2e-3)
   double radius = 0.0;      // kernel radius r_p [m]; > 0 required (the seed uses 3-4 cells, 40 in Fig. 3.3)
   double strength = 1.0;    // eps_p >= 0 (not given by the seed; tuned together with magnitude)
-  int upAxis = 1;           // the cylinder's axis for Azimuthal
+  int upAxis = 1;           // the cylinder's axis for Azimuthal, the direction for Vertical
   double minimumFlowVorticity = 0.0;  // LocalFlow: no particle where |omega_grid| <= this [1/s]
 
   // std::invalid_argument naming `context` (e.g. the scene key) and the field: a region not inside
@@ -54,7 +53,7 @@ struct VortexSeedSettings {
 template <int D>
 std::size_t seedVortexParticles(VortexParticles<D>& particles, const VortexSeedSettings<D>& settings,
                                 const GridSpec<D>& domain, std::size_t count, Rng& rng,
-                                const GridVorticity<D>* flowVorticity = nullptr);
+                                const Vorticity<D>* flowVorticity = nullptr);
 
 // A source emitting at a uniform rate [particles/s]: each emit(dt) adds floor(carry + rate dt)
 // particles and keeps the fraction for the next call, so the count after any sequence of steps is
@@ -64,7 +63,7 @@ class VortexEmitter {
  public:
   VortexEmitter(const VortexSeedSettings<D>& settings, const GridSpec<D>& domain, double rate, std::uint64_t seed,
                 const std::string& context = "vortex seeding");
-  std::size_t emit(VortexParticles<D>& particles, double dt, const GridVorticity<D>* flowVorticity = nullptr);
+  std::size_t emit(VortexParticles<D>& particles, double dt, const Vorticity<D>* flowVorticity = nullptr);
   double rate() const { return rate_; }
 
  private:

@@ -24,6 +24,7 @@
 #include "msim/scene/keys/scene_obstacles.hpp"
 #include "msim/scene/schema/shape_schema.hpp"
 #include "msim/scene/keys/subgrid_turbulence_keys.hpp"
+#include "msim/scene/keys/vortex_particle_keys.hpp"
 
 namespace msim::scene {
 
@@ -35,6 +36,7 @@ constexpr const char* kPhi = "liquid_phi";  // the surface: the fine one with su
 constexpr const char* kSimulationPhi = "liquid_sim_phi";  // with turbulence: the simulation grid's
 constexpr const char* kLevelSetParticles = "level_set_particles";
 constexpr const char* kFlipParticles = "flip_particles";
+constexpr const char* kVortexPoints = "vortex_particles";
 
 void declareLiquid(Schema& root) {
   Schema liquid = Schema::object("the liquid and how its surface is tracked (docs/liquid.md)");
@@ -56,6 +58,7 @@ void declareLiquid(Schema& root) {
       "surface on a finer grid, which is written, meshed, previewed and rendered");
   declareSubgridTurbulenceKeys(turbulence, "ripple the surface with sub-grid turbulence", 1.0e-6);
   liquid.field("turbulence", turbulence);
+  liquid.field("vortex_particles", vortexParticleKeys());
   root.field("liquid", liquid);
 
   Schema body = Schema::object("liquid present at the start");
@@ -147,6 +150,7 @@ class LiquidPhenomenon final : public Phenomenon {
       solver_.addLiquid(shape->distanceField(spec), sceneVector<D>(bodies[i].at("velocity")));
     }
     sources_.emplace(scene, solver_.solid(), volume());
+    solver_.setVortexLayer(vortexLayer<D>(scene, "liquid"));
     if (scene.resolved.at("liquid").at("turbulence").at("enabled").get<bool>())
       turbulence_.emplace(solver_.spec(), liquidTurbulenceParams<D>(scene), solver_.params().advection, solver_.phi(),
                           obstacles_.empty() ? nullptr : &solver_.solid());
@@ -221,10 +225,19 @@ class LiquidPhenomenon final : public Phenomenon {
     else
       writer.addPoints(kLevelSetParticles, levelSetCloud(), solver_.spec().dx);
     if (!obstacles_.empty()) writer.addLevelSet("obstacle_distance", obstacles_.cellDistance(time_));
+    if (solver_.vortexLayer())
+      writer.addPoints(kVortexPoints, vortexParticleCloud(solver_.vortexLayer()->particles()), solver_.spec().dx);
   }
 
-  // The surface as a triangle mesh (3D): mesh/<name>_NNNN.ply and/or .obj (liquid.mesh_format).
+  // The surface as a triangle mesh (3D): mesh/<name>_NNNN.ply and/or .obj (liquid.mesh_format);
+  // the vortex particles with their vorticity: particles/<name>_NNNN.ply.
   void writeFrameData(const std::filesystem::path& runDir, int frame) const override {
+    if (solver_.vortexLayer()) {
+      const std::filesystem::path dir = runDir / "particles";
+      std::filesystem::create_directories(dir);
+      io::writePlyPoints(dir / fmt::format("{}_{:04d}.ply", name_, frame),
+                         vortexParticleCloud(solver_.vortexLayer()->particles()));
+    }
     if constexpr (D == 3) {
       if (meshFormat_ == "none") return;
       const std::filesystem::path dir = runDir / "mesh";
@@ -280,6 +293,9 @@ class LiquidPhenomenon final : public Phenomenon {
       solver_.levelSetParticles().assign(std::move(positions), radius, std::move(signs));
     }
     solver_.restore(phi, velocity, 0);
+    solver_.setTime(time);
+    if (fluid::VortexLayer<D>* layer = solver_.vortexLayer())
+      restoreVortexParticles(saved, kVortexPoints, *layer, source_);
     volume_ = volume();
     if (turbulence_) {
       // The fine surface continues from the saved one; the noise particles start afresh.
@@ -302,7 +318,9 @@ class LiquidPhenomenon final : public Phenomenon {
             {"pressure_iterations", s.pressureIterations},
             {"pressure_unconverged_steps", unconverged_},
             {"particles", s.particles},
-            {"escaped_particles", s.escaped}};
+            {"escaped_particles", s.escaped},
+            {"enstrophy", s.enstrophy}};
+    if (solver_.vortexLayer()) j["vortex_particles"] = s.vortexParticles;
     if (turbulence_) {
       j["fine_volume_m3"] = numerics::enclosedVolume(turbulence_->phi(), &turbulence_->fineSolid());
       j["ripple_height_m"] = turbulence_->meanRippleHeight();

@@ -19,7 +19,7 @@
 #include "msim/scene/scene_file.hpp"
 #include "msim/scene/keys/scene_obstacles.hpp"
 #include "msim/scene/smoke/smoke_scene_keys.hpp"
-#include "msim/scene/smoke/vortex_particle_keys.hpp"
+#include "msim/scene/keys/vortex_particle_keys.hpp"
 #include "msim/scene/keys/turbulent_wind_keys.hpp"
 #include "msim/scene/reports/turbulent_wind_report.hpp"
 
@@ -62,7 +62,7 @@ class SmokePhenomenon final : public Phenomenon {
     const Vec<D> u0 = sceneVector<D>(r.at("smoke").at("initial_velocity"));
     for (int a = 0; a < D; ++a) solver_.velocity().component(a).fill(static_cast<float>(u0[a]));
     // Vortex particles before the obstacles, which the solver hands them.
-    solver_.setVortexLayer(vortexLayer<D>(scene));
+    solver_.setVortexLayer(vortexLayer<D>(scene, "smoke"));
     if (!obstacles_.empty()) placeObstacles(0.0);
 
     if (r.at("fire").at("enabled").get<bool>()) {
@@ -160,7 +160,8 @@ class SmokePhenomenon final : public Phenomenon {
     writeFaceVelocities(writer, solver_.velocity());
     writer.addFloatGrid("pressure", solver_.pressure());
     if (!obstacles_.empty()) writer.addLevelSet("obstacle_distance", obstacles_.cellDistance(time_));
-    if (solver_.vortexLayer()) writer.addPoints(kVortexPoints, vortexCloud(), solver_.spec().dx);
+    if (solver_.vortexLayer())
+      writer.addPoints(kVortexPoints, vortexParticleCloud(solver_.vortexLayer()->particles()), solver_.spec().dx);
   }
 
   // particles/<name>_NNNN.ply: the vortex particles with their vorticity (wx, wy, wz).
@@ -168,7 +169,8 @@ class SmokePhenomenon final : public Phenomenon {
     if (!solver_.vortexLayer()) return;
     const std::filesystem::path dir = runDir / "particles";
     std::filesystem::create_directories(dir);
-    io::writePlyPoints(dir / fmt::format("{}_{:04d}.ply", name_, frame), vortexCloud());
+    io::writePlyPoints(dir / fmt::format("{}_{:04d}.ply", name_, frame),
+                       vortexParticleCloud(solver_.vortexLayer()->particles()));
   }
 
   io::Image preview() const override {
@@ -201,7 +203,8 @@ class SmokePhenomenon final : public Phenomenon {
       restoreGrid(saved, solver_.scalarName(i), solver_.scalar(i), source_);
     restoreFaceVelocities(saved, solver_.velocity(), source_);
     restoreGrid(saved, "pressure", solver_.pressure(), source_);
-    if (fluid::VortexLayer<D>* layer = solver_.vortexLayer()) restoreVortexParticles(saved, *layer);
+    if (fluid::VortexLayer<D>* layer = solver_.vortexLayer())
+      restoreVortexParticles(saved, kVortexPoints, *layer, source_);
   }
 
   // Each wind's spectrum against the prescribed one (winds/), and its measures in run.json.
@@ -243,44 +246,6 @@ class SmokePhenomenon final : public Phenomenon {
   }
 
   static constexpr const char* kVortexPoints = "vortex_particles";
-
-  io::PointCloud vortexCloud() const {
-    const fluid::VortexParticles<D>& v = solver_.vortexLayer()->particles();
-    io::PointCloud cloud;
-    std::vector<io::PointAttribute> w = {{"wx", {}}, {"wy", {}}, {"wz", {}}};
-    for (std::size_t p = 0; p < v.size(); ++p) {
-      Vecf<3> x = Vecf<3>::Zero();
-      for (int a = 0; a < D; ++a) x[a] = v.positions()[p][a];
-      cloud.positions.push_back(x);
-      const fluid::VortexVector<D>& omega = v.vorticities()[p];
-      Vec3 omega3(0.0, 0.0, omega[0]);  // 2D: omega_z only
-      if constexpr (D == 3) omega3 = omega;
-      for (int a = 0; a < 3; ++a) w[static_cast<std::size_t>(a)].values.push_back(static_cast<float>(omega3[a]));
-    }
-    cloud.attributes = std::move(w);
-    return cloud;
-  }
-
-  // The particles of a saved frame, with the layer's radius and strength (the emitter restarts:
-  // a resumed run seeds the same count, not the same particles).
-  void restoreVortexParticles(const io::VdbFile& saved, fluid::VortexLayer<D>& layer) {
-    const io::PointCloud cloud = saved.points(kVortexPoints);
-    const auto& wx = savedPointAttribute(cloud, "wx", saved.path(), source_);
-    const auto& wy = savedPointAttribute(cloud, "wy", saved.path(), source_);
-    const auto& wz = savedPointAttribute(cloud, "wz", saved.path(), source_);
-    fluid::VortexParticles<D>& particles = layer.particles();
-    particles.clear();
-    for (std::size_t p = 0; p < cloud.positions.size(); ++p) {
-      Vec<D> x;
-      for (int a = 0; a < D; ++a) x[a] = cloud.positions[p][a];
-      fluid::VortexVector<D> omega;
-      if constexpr (D == 3)
-        omega = fluid::VortexVector<D>(wx[p], wy[p], wz[p]);
-      else
-        omega[0] = wz[p];
-      particles.add(x, omega, layer.settings().seed.radius, layer.settings().seed.strength);
-    }
-  }
 
   void placeObstacles(double time) {
     solver_.setObstacles(obstacles_.nodalDistance(time));

@@ -10,7 +10,7 @@
 #include "msim/scene/scene_file.hpp"
 #include "msim/scene/keys/scene_obstacles.hpp"
 #include "msim/scene/schema/shape_schema.hpp"
-#include "msim/scene/smoke/vortex_particle_keys.hpp"
+#include "msim/scene/keys/vortex_particle_keys.hpp"
 #include "msim/scene/keys/subgrid_turbulence_keys.hpp"
 #include "msim/scene/keys/turbulent_wind_keys.hpp"
 
