@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <functional>
+#include <optional>
 #include <string>
 
 #include <Eigen/Geometry>
@@ -186,6 +187,30 @@ TEST(CollisionGeometry, EdgeEdgeMatchesDenseSamplingOnRandomCases) {
     expectConsistent(r, p0, p1, q0, q1, what);
     expectMatchesSampling(r.distance, sampledEdgeEdgeDistance(p0, p1, q0, q1), what);
   }
+}
+
+// The repulsions' shortcut: the full computation's answer whenever its closest points lie inside
+// both edges, none otherwise.
+TEST(CollisionGeometry, EdgeEdgeInteriorAgreesWithTheFullComputation) {
+  Rng rng(21);
+  int interior = 0;
+  for (int trial = 0; trial < 5000; ++trial) {
+    const Vec3 p0 = randomPoint(rng), p1 = randomPoint(rng), q0 = randomPoint(rng), q1 = randomPoint(rng);
+    const EdgeEdgeProximity full = edgeEdgeProximity(p0, p1, q0, q1);
+    const std::optional<EdgeEdgeProximity> inside = edgeEdgeInteriorProximity(p0, p1, q0, q1);
+    const bool expected = full.s > 0.0 && full.s < 1.0 && full.t > 0.0 && full.t < 1.0;
+    ASSERT_EQ(inside.has_value(), expected) << "trial " << trial;
+    if (!inside) continue;
+    ++interior;
+    EXPECT_NEAR(inside->distance, full.distance, 1e-14);
+    EXPECT_NEAR(inside->s, full.s, 1e-14);
+    EXPECT_NEAR(inside->t, full.t, 1e-14);
+    EXPECT_LT((inside->normal - full.normal).norm(), 1e-12);
+  }
+  EXPECT_GT(interior, 500);  // both kinds occur
+  EXPECT_LT(interior, 4500);
+  // Parallel edges have no unique interior pair: none.
+  EXPECT_FALSE(edgeEdgeInteriorProximity(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(1, 1, 0)));
 }
 
 TEST(CollisionGeometry, EdgeEdgeKnownCases) {

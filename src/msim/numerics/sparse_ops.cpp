@@ -5,7 +5,9 @@
 #include <utility>
 #include <vector>
 
+#include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_reduce.h>
 
 #include "msim/core/parallel.hpp"
 
@@ -83,8 +85,21 @@ SparseRowMatrix parallelProduct(const SparseRowMatrix& A, const SparseRowMatrix&
 }
 
 double parallelDot(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
-  return parallelSum(static_cast<std::size_t>(a.size()),
-                     [&](std::size_t i) { return a[static_cast<Eigen::Index>(i)] * b[static_cast<Eigen::Index>(i)]; });
+  // Blocks of fixed bounds, each summed by Eigen's vectorised dot and joined along a fixed tree
+  // (tbb::parallel_deterministic_reduce): the same sum on every run and thread count, at the speed
+  // of SIMD on every core rather than of a serial chain of additions.
+  constexpr Eigen::Index kBlock = 4096;
+  const Eigen::Index blocks = (a.size() + kBlock - 1) / kBlock;
+  return tbb::parallel_deterministic_reduce(
+      tbb::blocked_range<Eigen::Index>(0, blocks, 1), 0.0,
+      [&](const tbb::blocked_range<Eigen::Index>& r, double sum) {
+        for (Eigen::Index block = r.begin(); block != r.end(); ++block) {
+          const Eigen::Index first = block * kBlock, length = std::min(kBlock, a.size() - first);
+          sum += a.segment(first, length).dot(b.segment(first, length));
+        }
+        return sum;
+      },
+      [](double x, double y) { return x + y; });
 }
 
 }  // namespace msim::numerics

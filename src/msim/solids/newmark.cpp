@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 
+#include "msim/core/parallel.hpp"
 #include "msim/solids/altitude_spring.hpp"
 
 namespace msim::solids {
@@ -14,6 +15,9 @@ namespace {
 
 // Iterations a solve needs before its convergence rate tells whether the multigrid hierarchy has aged.
 constexpr int kRateSample = 8;
+// applyTerms' chunks: a small cloth (a few thousand springs) runs in one, where the threads' start
+// would cost more than they save; the product is the same either way.
+constexpr std::size_t kTermGrain = 8192;
 
 struct JacobiPreconditioner {
   const Eigen::VectorXd& inverseDiagonal;
@@ -78,6 +82,7 @@ void NewmarkStepper::gatherTerms(const MassSpringSystem& system, const std::vect
     shortestSpring_ = std::min(shortestSpring_, l0);
     addTerm(t.v.data(), choice.weights.data(), 4, choice.normal, t.damping, reach * t.stiffness / l0, 0.0);
   }
+  gatherIncidence(system.size());
   if (settings_.preconditioner != SolvePreconditioner::Jacobi) return;
   inverseDiagonal_.resize(static_cast<Eigen::Index>(3 * system.size()));
   for (std::size_t p = 0; p < system.size(); ++p) inverseDiagonal_.segment<3>(static_cast<Eigen::Index>(3 * p)).setConstant(system.mass[p]);
@@ -90,15 +95,40 @@ void NewmarkStepper::gatherTerms(const MassSpringSystem& system, const std::vect
   inverseDiagonal_ = inverseDiagonal_.cwiseInverse();
 }
 
+void NewmarkStepper::gatherIncidence(std::size_t particles) {
+  incidenceStart_.assign(particles + 1, 0);
+  for (const SpringTerm& t : terms_)
+    for (int i = 0; i < t.count; ++i) ++incidenceStart_[static_cast<std::size_t>(t.node[i]) + 1];
+  for (std::size_t p = 0; p < particles; ++p) incidenceStart_[p + 1] += incidenceStart_[p];
+  incidence_.resize(static_cast<std::size_t>(incidenceStart_[particles]));
+  std::vector<int>& next = incidenceFill_;
+  next.assign(incidenceStart_.begin(), incidenceStart_.end() - 1);
+  for (std::size_t k = 0; k < terms_.size(); ++k)
+    for (int i = 0; i < terms_[k].count; ++i)
+      incidence_[static_cast<std::size_t>(next[static_cast<std::size_t>(terms_[k].node[i])]++)] = {static_cast<int>(k), terms_[k].weight[i]};
+  termForces_.resize(terms_.size());
+}
+
+// Two passes on all cores: each term's force from the particles it joins, then each particle's sum
+// over its terms in the terms' order (no two threads write one particle; the same sums whatever the
+// thread count).
 void NewmarkStepper::applyTerms(const double* u, double* y, bool elasticOnly) const {
-  for (const SpringTerm& t : terms_) {
+  parallelFor(0, terms_.size(), [&](std::size_t k) {
+    const SpringTerm& t = terms_[k];
     Vec3 relative = Vec3::Zero();
     for (int i = 0; i < t.count; ++i) relative += t.weight[i] * Eigen::Map<const Vec3>(u + 3 * t.node[i]);
     const double along = relative.dot(t.direction);
-    const Vec3 f = (elasticOnly ? t.stiffness : t.coefficient) * along * t.direction +
-                   t.sideways * (relative - along * t.direction);
-    for (int i = 0; i < t.count; ++i) Eigen::Map<Vec3>(y + 3 * t.node[i]) += t.weight[i] * f;
-  }
+    termForces_[k] = (elasticOnly ? t.stiffness : t.coefficient) * along * t.direction +
+                     t.sideways * (relative - along * t.direction);
+  }, kTermGrain);
+  parallelFor(0, incidenceStart_.size() - 1, [&](std::size_t p) {
+    Vec3 sum = Vec3::Zero();
+    for (int j = incidenceStart_[p]; j < incidenceStart_[p + 1]; ++j) {
+      const auto& [term, weight] = incidence_[static_cast<std::size_t>(j)];
+      sum += weight * termForces_[static_cast<std::size_t>(term)];
+    }
+    Eigen::Map<Vec3>(y + 3 * p) += sum;
+  }, kTermGrain / 2);
 }
 
 NewmarkStats NewmarkStepper::solveHalfStep(const MassSpringSystem& system, const std::vector<Vec3>& base,
@@ -184,13 +214,14 @@ NewmarkStats NewmarkStepper::conjugateGradients(const MassSpringSystem& system, 
     // y = A u on the free particles (pinned rows zero), term by term.
     const auto product = [&](const Eigen::VectorXd& u, Eigen::VectorXd& y) {
       y.resize(u.size());
-      for (std::size_t p = 0; p < system.size(); ++p) {
+      parallelFor(0, system.size(), [&](std::size_t p) {
         const auto row = static_cast<Eigen::Index>(3 * p);
         y.segment<3>(row) = system.mass[p] * u.segment<3>(row);
-      }
+      }, 4096);
       applyTerms(u.data(), y.data(), false);
-      for (std::size_t p = 0; p < system.size(); ++p)
+      parallelFor(0, system.size(), [&](std::size_t p) {
         if (system.pinned[p]) y.segment<3>(static_cast<Eigen::Index>(3 * p)).setZero();
+      }, 4096);
     };
     const JacobiPreconditioner jacobi{inverseDiagonal_};
     solve = numerics::preconditionedCg(product, jacobi, unknowns_, residualVector_, target2, settings_.cgMaxIterations, workspace_);

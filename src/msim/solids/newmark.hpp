@@ -21,6 +21,7 @@
 // velocity that moves the positions gets the inelastic and elastic repulsions before step 2 (step
 // B.2) and the end velocity the inelastic ones with friction (step B.8; self_repulsion.hpp).
 #include <array>
+#include <utility>
 #include <vector>
 
 #include "msim/core/vec.hpp"
@@ -77,6 +78,8 @@ class NewmarkStepper {
   // The matrix's spring terms linearised at `at` (reach c = dt with implicit springs, else 0), and
   // the inverse of its diagonal.
   void gatherTerms(const MassSpringSystem& system, const std::vector<Vec3>& at, double h, double reach);
+  // The terms each particle takes part in (incidence_, CSR by particle) for applyTerms.
+  void gatherIncidence(std::size_t particles);
   // y += (elasticOnly ? h c K : A - M) u, u and y 3 values per particle.
   void applyTerms(const double* u, double* y, bool elasticOnly) const;
   NewmarkStats conjugateGradients(const MassSpringSystem& system, double h, double rhsNorm2, std::vector<Vec3>& out);
@@ -86,6 +89,9 @@ class NewmarkStepper {
   std::vector<int> touched_;  // the body each particle met in the step, or -1
   std::vector<double> inverseMass_;
   std::vector<SpringTerm> terms_;
+  std::vector<int> incidenceStart_, incidenceFill_;      // per particle, into incidence_
+  std::vector<std::pair<int, double>> incidence_;        // (term, the particle's weight in it)
+  mutable std::vector<Vec3> termForces_;                 // applyTerms' scratch, one per term
   std::vector<Vec3> residual_, product_, linearisedAt_, previous_;
   double shortestSpring_ = 0.0;  // rest length, or altitude, over the last gathered terms
   NewmarkMatrix matrix_;

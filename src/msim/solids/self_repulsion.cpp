@@ -53,6 +53,23 @@ void SelfRepulsion::gatherContacts(const std::vector<Vec3>& x) {
   const double h = settings_.thickness;
   // Closer than h, and crossed by less than 2h (deeper than repulsion can mend: collisions act).
   const auto within = [h](double gap) { return gap < h && gap > -2.0 * h; };
+  const auto& triangles = mesh_->triangles();
+  const auto& edges = mesh_->edges();
+  faceNormals_.resize(triangles.size());
+  parallelFor(0, triangles.size(), [&](std::size_t i) {
+    const auto& t = triangles[i];
+    const Vec3& a = x[static_cast<std::size_t>(t[0])];
+    const Vec3 normal = (x[static_cast<std::size_t>(t[1])] - a).cross(x[static_cast<std::size_t>(t[2])] - a);
+    const double length = normal.norm();
+    faceNormals_[i] = length > 0.0 ? Vec3(normal / length) : Vec3::Zero();
+  });
+  edgeMidpoints_.resize(edges.size());
+  edgeHalfLengths_.resize(edges.size());
+  parallelFor(0, edges.size(), [&](std::size_t i) {
+    const Vec3 &p0 = x[static_cast<std::size_t>(edges[i][0])], &p1 = x[static_cast<std::size_t>(edges[i][1])];
+    edgeMidpoints_[i] = 0.5 * (p0 + p1);
+    edgeHalfLengths_[i] = 0.5 * (p1 - p0).norm();
+  });
   constexpr std::size_t kBlock = 2048;
   const std::size_t pointBlocks = (pointTriangle_.size() + kBlock - 1) / kBlock;
   const std::size_t edgeBlocks = (edgeEdge_.size() + kBlock - 1) / kBlock;
@@ -64,17 +81,17 @@ void SelfRepulsion::gatherContacts(const std::vector<Vec3>& x) {
       const std::size_t end = std::min(pointTriangle_.size(), (block + 1) * kBlock);
       for (std::size_t i = block * kBlock; i < end; ++i) {
         const PointTriangleHistory& p = pointTriangle_[i];
-        const auto& t = mesh_->triangles()[static_cast<std::size_t>(p.pair.triangle)];
+        const auto triangle = static_cast<std::size_t>(p.pair.triangle);
+        const auto& t = triangles[triangle];
         const Vec3& xp = x[static_cast<std::size_t>(p.pair.point)];
-        const Vec3 &a = x[static_cast<std::size_t>(t[0])], &b = x[static_cast<std::size_t>(t[1])], &c = x[static_cast<std::size_t>(t[2])];
-        Vec3 normal = (b - a).cross(c - a);
-        const double length = normal.norm();
-        if (!(length > 0.0)) continue;
-        normal /= p.flipped ? -length : length;
+        const Vec3& a = x[static_cast<std::size_t>(t[0])];
+        if (faceNormals_[triangle].squaredNorm() == 0.0) continue;  // no area
+        const Vec3 normal = p.flipped ? Vec3(-faceNormals_[triangle]) : faceNormals_[triangle];
         const double gap = (xp - a).dot(normal);  // the distance from the face along the remembered side
         if (!within(gap)) continue;
         // Only where the point lies over the face: near an edge or a corner the edge pairs act.
-        const std::optional<Vec3> weights = faceProjectionWeights(xp, a, b, c);
+        const std::optional<Vec3> weights =
+            faceProjectionWeights(xp, a, x[static_cast<std::size_t>(t[1])], x[static_cast<std::size_t>(t[2])]);
         if (!weights || !(weights->minCoeff() > 0.0)) continue;
         found.push_back({ContactStencil::pointTriangle(p.pair.point, t, *weights), normal, gap});
       }
@@ -83,11 +100,18 @@ void SelfRepulsion::gatherContacts(const std::vector<Vec3>& x) {
       const std::size_t end = std::min(edgeEdge_.size(), first + kBlock);
       for (std::size_t i = first; i < end; ++i) {
         const EdgeEdgeHistory& p = edgeEdge_[i];
-        const auto& e = mesh_->edges()[static_cast<std::size_t>(p.pair.first)];
-        const auto& f = mesh_->edges()[static_cast<std::size_t>(p.pair.second)];
-        const EdgeEdgeProximity prox = edgeEdgeProximity(x[static_cast<std::size_t>(e[0])], x[static_cast<std::size_t>(e[1])],
-                                                         x[static_cast<std::size_t>(f[0])], x[static_cast<std::size_t>(f[1])]);
-        if (!(prox.s > 0.0 && prox.s < 1.0 && prox.t > 0.0 && prox.t < 1.0)) continue;  // end points: the point pairs act
+        const auto first = static_cast<std::size_t>(p.pair.first), second = static_cast<std::size_t>(p.pair.second);
+        // Most candidate pairs are far apart: every point of an edge lies within half its length of
+        // its midpoint, so the midpoints' distance less both half lengths bounds the gap from below.
+        const double reach = 2.0 * h + edgeHalfLengths_[first] + edgeHalfLengths_[second];
+        if ((edgeMidpoints_[first] - edgeMidpoints_[second]).squaredNorm() >= reach * reach) continue;
+        const auto& e = edges[first];
+        const auto& f = edges[second];
+        const std::optional<EdgeEdgeProximity> interior =
+            edgeEdgeInteriorProximity(x[static_cast<std::size_t>(e[0])], x[static_cast<std::size_t>(e[1])],
+                                      x[static_cast<std::size_t>(f[0])], x[static_cast<std::size_t>(f[1])]);
+        if (!interior) continue;  // closest at an end point: the point-face pairs act
+        const EdgeEdgeProximity& prox = *interior;
         const bool crossed = p.side.dot(prox.normal) < settings_.edgeFlipEpsilon;
         const double gap = crossed ? -prox.distance : prox.distance;
         if (!within(gap)) continue;

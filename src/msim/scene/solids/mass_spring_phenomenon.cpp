@@ -311,6 +311,7 @@ class MassSpringPhenomenon final : public Phenomenon {
       ++unconverged_;
       logger().warn("{}: a solve of step {} did not converge ({} iterations)", kind_, steps_, s.iterations);
     }
+    if (kind_ == "cloth") refereeStep();
   }
 
   void checkFinite(long stepIndex, double time) const override {
@@ -403,12 +404,9 @@ class MassSpringPhenomenon final : public Phenomenon {
       j["unresolved_collision_steps"] = unresolvedSteps_;
     }
     if (kind_ == "cloth") {
-      // The exact referee, independent of the collision handling (collision/triangle_intersection.hpp).
-      j["self_intersections"] = solids::countSelfIntersections(system_.x, mesh_.triangles);
-      long inside = 0;
-      for (std::size_t v = 0; v < system_.size(); ++v)
-        for (const auto& shape : bodyShapes_) inside += shape->distance(system_.x[v]) < -1e-9;
-      j["vertices_inside_bodies"] = inside;
+      j["self_intersections"] = selfIntersections_;
+      j["vertices_inside_bodies"] = verticesInside_;
+      j["intersecting_steps"] = intersectingSteps_;
     }
     if (!system_.tetrahedra.empty()) {
       long inverted = 0;
@@ -420,6 +418,22 @@ class MassSpringPhenomenon final : public Phenomenon {
   }
 
  private:
+  // The exact referee after every step, independent of the collision handling
+  // (collision/triangle_intersection.hpp): intersecting triangle pairs and vertices inside bodies.
+  // A step that leaves any is counted and named in a warning.
+  void refereeStep() {
+    ScopedStage stage(timers_, "cloth: intersection check");
+    selfIntersections_ = static_cast<long>(solids::countSelfIntersections(system_.x, mesh_.triangles));
+    verticesInside_ = 0;
+    for (std::size_t v = 0; v < system_.size(); ++v)
+      for (const auto& shape : bodyShapes_) verticesInside_ += shape->distance(system_.x[v]) < -1e-9;
+    if (selfIntersections_ == 0 && verticesInside_ == 0) return;
+    ++intersectingSteps_;
+    logger().warn("cloth: step {} (t = {:.4g} s) ends with {} intersecting triangle pairs and {} vertices inside "
+                  "bodies",
+                  steps_, time_, selfIntersections_, verticesInside_);
+  }
+
   // Each triangle's drag c A ((u - v) . n) n at the step's start, u the winds at its centroid and
   // v its mean velocity, a third on each vertex (linear drag along the normal, as in Selle ch. 6's
   // leaves and wardrobe).
@@ -657,6 +671,7 @@ class MassSpringPhenomenon final : public Phenomenon {
   double massPerDragArea_ = 0.0;  // the smallest m / A over the free particles [kg/m^2]
   double time_ = 0.0;  // simulated [s]
   long steps_ = 0, iterations_ = 0, unconverged_ = 0, preconditionerSetups_ = 0;
+  long selfIntersections_ = 0, verticesInside_ = 0, intersectingSteps_ = 0;  // refereeStep
   int contacts_ = 0;
 };
 

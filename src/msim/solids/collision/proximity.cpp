@@ -92,6 +92,40 @@ PointTriangleProximity pointTriangleProximity(const Vec3& p, const Vec3& a, cons
   return result;
 }
 
+namespace {
+
+// The result for the closest points at (s, t), their squared distance given.
+EdgeEdgeProximity edgeEdgeResult(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1, double s, double t,
+                                 double squared) {
+  const Vec3 u = p1 - p0, v = q1 - q0, w = p0 - q0;
+  EdgeEdgeProximity result;
+  result.s = s;
+  result.t = t;
+  result.distance = std::sqrt(squared);
+  if (result.distance > touchingDistance(largestCoordinate(p0, p1, q0, q1))) {
+    result.normal = (w + s * u - t * v) / result.distance;
+  } else {
+    result.normal = touchingNormal(u.cross(v), u.squaredNorm() >= v.squaredNorm() ? u : v);
+  }
+  return result;
+}
+
+}  // namespace
+
+std::optional<EdgeEdgeProximity> edgeEdgeInteriorProximity(const Vec3& p0, const Vec3& p1, const Vec3& q0,
+                                                           const Vec3& q1) {
+  const Vec3 u = p1 - p0, v = q1 - q0, w = p0 - q0;
+  // As in edgeEdgeProximity: the squared distance is convex in (s, t), so a critical point
+  // strictly inside the unit square is its minimum, and without one the minimum lies on the square's
+  // boundary.
+  const double determinant = u.cross(v).squaredNorm();
+  if (!(determinant > 0.0)) return std::nullopt;
+  const double uu = u.dot(u), uv = u.dot(v), vv = v.dot(v), uw = u.dot(w), vw = v.dot(w);
+  const double s = (uv * vw - vv * uw) / determinant, t = (uu * vw - uv * uw) / determinant;
+  if (!(s > 0.0 && s < 1.0 && t > 0.0 && t < 1.0)) return std::nullopt;
+  return edgeEdgeResult(p0, p1, q0, q1, s, t, (w + s * u - t * v).squaredNorm());
+}
+
 EdgeEdgeProximity edgeEdgeProximity(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1) {
   const Vec3 u = p1 - p0, v = q1 - q0, w = p0 - q0;
   const Vec3 uxv = u.cross(v);
@@ -123,16 +157,7 @@ EdgeEdgeProximity edgeEdgeProximity(const Vec3& p0, const Vec3& p1, const Vec3& 
   consider(closestSegmentParameter(q0, p0, p1), 0.0);
   consider(closestSegmentParameter(q1, p0, p1), 1.0);
 
-  EdgeEdgeProximity result;
-  result.s = bestS;
-  result.t = bestT;
-  result.distance = std::sqrt(bestSquared);
-  if (result.distance > touchingDistance(largestCoordinate(p0, p1, q0, q1))) {
-    result.normal = (w + bestS * u - bestT * v) / result.distance;
-  } else {
-    result.normal = touchingNormal(uxv, u.squaredNorm() >= v.squaredNorm() ? u : v);
-  }
-  return result;
+  return edgeEdgeResult(p0, p1, q0, q1, bestS, bestT, bestSquared);
 }
 
 }  // namespace msim::solids

@@ -34,4 +34,10 @@ struct EdgeEdgeProximity {
 
 EdgeEdgeProximity edgeEdgeProximity(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1);
 
+// edgeEdgeProximity when its closest points lie strictly inside both edges (the lines' common
+// perpendicular: the only case repulsions act on, the end points being the point-face pairs'),
+// else nullopt; skips the four end-point candidates, which then cannot be the closest.
+std::optional<EdgeEdgeProximity> edgeEdgeInteriorProximity(const Vec3& p0, const Vec3& p1, const Vec3& q0,
+                                                           const Vec3& q1);
+
 }  // namespace msim::solids
