@@ -168,6 +168,39 @@ TEST(CrowdCli, ResumeContinuesFromTheLastCompleteFrame) {
   EXPECT_EQ(static_cast<double>(table.rows.size()), agentFrames);
 }
 
+// A set of exits (goals[].more_shapes): a 20 x 10 m room with a 1.2 m door in each end wall and
+// one goal made of the two spaces behind them. Everyone leaves, and each door takes the agents
+// nearer to it: about half each, those from the west half of the room through the west door.
+TEST(CrowdCli, ExitSetSendsEachAgentToTheNearestDoor) {
+  const fs::path dir = scratch("crowd_exit_set");
+  writeText(dir / "s.json", R"({
+  "name": "exits", "phenomenon": "crowd",
+  "domain": {"min": [0, 0], "max": [24, 10], "resolution": 48},
+  "time": {"duration": 40, "fps": 1},
+  "goals": [{"name": "out", "exit": true, "shape": {"type": "box", "min": [0, 3], "max": [1, 7]},
+             "more_shapes": [{"type": "box", "min": [23, 3], "max": [24, 7]}]}],
+  "obstacles": [{"shape": {"type": "box", "min": [2, 0], "max": [2.3, 4.4]}},
+                {"shape": {"type": "box", "min": [2, 5.6], "max": [2.3, 10]}},
+                {"shape": {"type": "box", "min": [21.7, 0], "max": [22, 4.4]}},
+                {"shape": {"type": "box", "min": [21.7, 5.6], "max": [22, 10]}}],
+  "groups": [{"count": 160, "region": {"type": "box", "min": [3, 0.5], "max": [21, 9.5]}, "goal": "out"}],
+  "measurement_lines": [{"name": "west", "from": [1.5, 0], "to": [1.5, 10]},
+                        {"name": "east", "from": [22.5, 10], "to": [22.5, 0]}],
+  "outputs": {"mp4": false, "vdb": false, "png": false}, "crowd": {"trajectories": false}
+})");
+  const Result r = runMsim("run " + (dir / "s.json").string() + " -q --out " + (dir / "out").string());
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  const json run = readJson(dir / "out" / "run.json");
+  EXPECT_EQ(run.at("frames").back().at("agents").get<int>(), 0) << "the room empties";
+  const json& lines = run.at("results").at("measurement_lines");
+  // The lines count crossings with a sign by side; their magnitudes are the agents through each door.
+  const double west = std::abs(lines.at("west").at("net_crossings").get<double>());
+  const double east = std::abs(lines.at("east").at("net_crossings").get<double>());
+  EXPECT_NEAR(west + east, 160.0, 4.0);
+  EXPECT_GT(west, 0.35 * 160) << "west " << west << " east " << east;
+  EXPECT_GT(east, 0.35 * 160) << "west " << west << " east " << east;
+}
+
 TEST(CrowdCli, BadInputNamesTheKey) {
   expectInputError("crowd_3d",
                    replaced(doorway(), R"("min": [0, 0], "max": [20, 20], "resolution")",
@@ -196,4 +229,14 @@ TEST(CrowdCli, BadInputNamesTheKey) {
                    {"cannot be reached"});
   expectInputError("crowd_too_many", replaced(doorway(), R"("count": 400)", R"("count": 4000)"),
                    {"groups[0].count", "do not fit"});
+  // A member of an exit set that agents cannot stand in (inside a wall).
+  expectInputError("crowd_exit_set_member",
+                   replaced(doorway(), R"("exit": true})",
+                            R"("exit": true, "more_shapes": [{"type": "box", "min": [15.1, 1], "max": [15.4, 2]}]})"),
+                   {"goals[0].more_shapes[0]"});
+  expectInputError("crowd_exit_set_point",
+                   replaced(doorway(), R"("shape": {"type": "box", "min": [17, 7], "max": [20, 13]}, "exit": true})",
+                            R"("shape": {"type": "point", "position": [18, 10]}, "exit": true,
+                               "more_shapes": [{"type": "box", "min": [17, 1], "max": [20, 3]}]})"),
+                   {"goals[0].more_shapes", "not a point"});
 }

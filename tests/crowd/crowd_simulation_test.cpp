@@ -65,7 +65,7 @@ TEST(CrowdSimulation, DensityStaysCappedAtTheFreeAreaLimitEveryStep) {
   std::vector<Polygon> walls = {rectangle(Vec2(15, 0), Vec2(15.5, 9.4)), rectangle(Vec2(15, 10.6), Vec2(15.5, 20))};
   Goal exit;
   exit.kind = Goal::Kind::Region;
-  exit.region = rectangle(Vec2(17, 7), Vec2(20, 13));
+  exit.regions = {rectangle(Vec2(17, 7), Vec2(20, 13))};
   exit.exit = true;
   NavigationFieldOptions nav;
   nav.hi = hi;
@@ -104,7 +104,7 @@ TEST(CrowdSimulation, InflowsSpawnAtTheirRateAndExitsRemoveAgents) {
   const Vec2 hi(30, 10);
   Goal east;
   east.kind = Goal::Kind::Region;
-  east.region = rectangle(Vec2(28, 0), Vec2(30, 10));
+  east.regions = {rectangle(Vec2(28, 0), Vec2(30, 10))};
   east.exit = true;
   Inflow in;
   in.region = rectangle(Vec2(0.5, 0.5), Vec2(2, 9.5));
@@ -205,8 +205,8 @@ TEST(CrowdSimulation, UicAndOrcaAgentsShareAScene) {
   const Vec2 hi(40, 40);
   Goal east, north;
   east.kind = north.kind = Goal::Kind::Region;
-  east.region = rectangle(Vec2(38, 0), Vec2(40, 40));
-  north.region = rectangle(Vec2(0, 38), Vec2(40, 40));
+  east.regions = {rectangle(Vec2(38, 0), Vec2(40, 40))};
+  north.regions = {rectangle(Vec2(0, 38), Vec2(40, 40))};
   east.exit = north.exit = true;
   auto planner = std::make_shared<DirectPlanner>(std::vector<Goal>{east, north});
   Agents agents = randomAgents(200, Vec2(2, 14), Vec2(12, 26), 0, AgentModel::Uic, 3);

@@ -104,12 +104,31 @@ TEST(CrowdNavigationField, EnclosedGoalIsUnreachable) {
 TEST(CrowdNavigationField, RegionGoal) {
   Goal g;
   g.kind = Goal::Kind::Region;
-  g.region = rectangle({8, 0}, {10, 10});
+  g.regions = {rectangle({8, 0}, {10, 10})};
   const NavigationField field({g}, {}, box({0, 0}, {10, 10}, 0.25, 0.25));
   EXPECT_NEAR(field.distance(0, {2, 5}), 6.0, 0.05);
   EXPECT_GT(field.direction(0, {2, 5}).x(), 0.999);
   EXPECT_EQ(field.distance(0, {9, 5}), 0.0);
   EXPECT_EQ(field.direction(0, {9, 5}), Vec2::Zero());
+}
+
+// A set of exits (RiMEA's exit choice): one field seeded from both doors of a 10 m room; the
+// distance is to the nearer door along the walkable path, so agents split where the paths are
+// equal, and a wall between one of them and the agent sends it to the other.
+TEST(CrowdNavigationField, ExitSetLeadsToTheNearestMember) {
+  Goal exits;
+  exits.kind = Goal::Kind::Region;
+  exits.regions = {rectangle({0, 4}, {0.5, 6}), rectangle({9.5, 4}, {10, 6})};
+  const NavigationField field({exits}, {}, box({0, 0}, {10, 10}, 0.25, 0.25));
+  EXPECT_NEAR(field.distance(0, {3, 5}), 2.5, 0.05);
+  EXPECT_LT(field.direction(0, {3, 5}).x(), -0.999);
+  EXPECT_NEAR(field.distance(0, {8, 5}), 1.5, 0.05);
+  EXPECT_GT(field.direction(0, {8, 5}).x(), 0.999);
+  EXPECT_EQ(field.distance(0, {9.8, 5}), 0.0);
+  // A wall at x = 2 from y = 1 to 9 hides the west door from (3, 5): the east one is nearer now.
+  const NavigationField walled({exits}, {rectangle({2, 1}, {2.3, 9})}, box({0, 0}, {10, 10}, 0.25, 0.25));
+  EXPECT_NEAR(walled.distance(0, {3, 5}), 6.5, 0.1);
+  EXPECT_GT(walled.direction(0, {3, 5}).x(), 0.999);
 }
 
 TEST(CrowdNavigationField, ManyGoalsAreIndependent) {

@@ -76,7 +76,7 @@ TEST(CrowdRoadmap, EnclosedGoalIsUnreachable) {
 TEST(CrowdRoadmap, RegionGoalBehindAWall) {
   Goal g;
   g.kind = Goal::Kind::Region;
-  g.region = rectangle({16, 0}, {20, 20});
+  g.regions = {rectangle({16, 0}, {20, 20})};
   // Wall at x = 10 from y = 0 to y = 15: go round its upper end.
   const Roadmap roadmap({g}, {rectangle({9.8, -1}, {10.2, 15})}, box({0, 0}, {20, 20}));
   const Vec2 agent(5, 5);

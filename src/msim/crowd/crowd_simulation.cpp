@@ -183,7 +183,7 @@ void CrowdSimulation::plan() {
     const Vec2 x = agents_.position[i].cast<double>();
     double speed = agents_.maxSpeed[i];
     if (!goal.isPoint) {  // a region: arrived inside it
-      if (!goal.exit && contains(goals_[g].region, x)) {
+      if (!goal.exit && goals_[g].inside(x)) {
         agents_.preferredVelocity[i].setZero();
         return;
       }

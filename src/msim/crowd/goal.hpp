@@ -1,6 +1,10 @@
 #pragma once
-// Where agents want to go: a point, or a region (any point inside counts as arrived). Exits are
-// goals whose agents leave the scene on arrival (evacuations, outflow regions).
+// Where agents want to go: a point, or a set of regions (any point inside any of them counts as
+// arrived). A set of several regions is a choice of exits: one navigation field is seeded from all
+// of them, so each agent heads for the one nearest along its path. Exits are goals whose agents
+// leave the scene on arrival (evacuations, outflow regions).
+#include <vector>
+
 #include "msim/core/vec.hpp"
 #include "msim/crowd/polygon.hpp"
 
@@ -9,13 +13,19 @@ namespace msim::crowd {
 struct Goal {
   enum class Kind { Point, Region };
   Kind kind = Kind::Point;
-  Vec2 point = Vec2::Zero();  // Kind::Point [m]
-  Polygon region;             // Kind::Region
-  double arrivalRadius = 0.5; // Kind::Point: arrived within this distance [m]
-  bool exit = false;          // arrived agents are removed from the scene
+  Vec2 point = Vec2::Zero();     // Kind::Point [m]
+  std::vector<Polygon> regions;  // Kind::Region: one or more (a set of exits)
+  double arrivalRadius = 0.5;    // Kind::Point: arrived within this distance [m]
+  bool exit = false;             // arrived agents are removed from the scene
 
+  // Kind::Region: x lies in one of the regions.
+  bool inside(const Vec2& x) const {
+    for (const Polygon& r : regions)
+      if (contains(r, x)) return true;
+    return false;
+  }
   bool reached(const Vec2& x) const {
-    return kind == Kind::Point ? (x - point).squaredNorm() <= arrivalRadius * arrivalRadius : contains(region, x);
+    return kind == Kind::Point ? (x - point).squaredNorm() <= arrivalRadius * arrivalRadius : inside(x);
   }
 };
 

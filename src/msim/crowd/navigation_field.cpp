@@ -195,20 +195,26 @@ NavigationField::NavigationField(std::vector<Goal> goals, std::vector<Polygon> o
         throw InputError(fmt::format("goals[{}]: no walkable cell within the arrival radius {:g} m of point {} (closer than "
                                      "the clearance {:g} m to an obstacle?)", g, goal.arrivalRadius, str(goal.point), reach));
     } else {
-      validateSimple(goal.region, fmt::format("goals[{}].region", g));
-      const Box b = boundsOf(goal.region);
-      cellRange(b.lo - Vec2::Constant(1.5 * h), b.hi + Vec2::Constant(1.5 * h), c0, c1);
-      bool inside = false;
-      for (int j = c0[1]; j <= c1[1]; ++j)
-        for (int i = c0[0]; i <= c1[0]; ++i) {
-          if (blocked_[index(i, j)]) continue;
-          const double d = std::max(0.0, signedDistance(goal.region, centre(i, j)));
-          inside |= d == 0;
-          if (d <= 1.5 * h) seeds[g].emplace_back(index(i, j), d);
-        }
-      if (!inside)
-        throw InputError(fmt::format("goals[{}].region: no walkable cell centre inside the region (outside the domain, "
-                                     "inside an obstacle, or smaller than a {:g} m cell?)", g, h));
+      // Every region of a set seeds the same front: the field's distance is to the nearest one.
+      for (std::size_t m = 0; m < goal.regions.size(); ++m) {
+        const Polygon& region = goal.regions[m];
+        // The scene's names: the first region is the goal's shape, the others its more_shapes.
+        const std::string key = m == 0 ? fmt::format("goals[{}].region", g) : fmt::format("goals[{}].more_shapes[{}]", g, m - 1);
+        validateSimple(region, key);
+        const Box b = boundsOf(region);
+        cellRange(b.lo - Vec2::Constant(1.5 * h), b.hi + Vec2::Constant(1.5 * h), c0, c1);
+        bool inside = false;
+        for (int j = c0[1]; j <= c1[1]; ++j)
+          for (int i = c0[0]; i <= c1[0]; ++i) {
+            if (blocked_[index(i, j)]) continue;
+            const double d = std::max(0.0, signedDistance(region, centre(i, j)));
+            inside |= d == 0;
+            if (d <= 1.5 * h) seeds[g].emplace_back(index(i, j), d);
+          }
+        if (!inside)
+          throw InputError(fmt::format("{}: no walkable cell centre inside the region (outside the domain, inside an "
+                                       "obstacle, or smaller than a {:g} m cell?)", key, h));
+      }
     }
   }
 
@@ -282,7 +288,7 @@ Stencil stencil(const Vec2& lo, double h, const IVec2& n, const Vec2& x) {
 
 double NavigationField::distance(std::size_t goal, const Vec2& position) const {
   const Goal& g = goals_.at(goal);
-  if (g.kind == Goal::Kind::Region && contains(g.region, position)) return 0.0;
+  if (g.kind == Goal::Kind::Region && g.inside(position)) return 0.0;
   const Stencil s = stencil(options_.lo, options_.cellSize, n_, position);
   double sum = 0, weight = 0;
   bool walkable = false;

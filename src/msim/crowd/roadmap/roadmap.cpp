@@ -172,15 +172,21 @@ Roadmap::Roadmap(std::vector<Goal> goals, std::vector<Polygon> obstacles, const 
     const auto gv = static_cast<std::uint32_t>(midpointCount_ + g);
     Vec2 anchor = goal.point;
     if (goal.kind == Goal::Kind::Region) {
-      validateSimple(goal.region, fmt::format("goals[{}].region", g));
+      // A goal vertex stands at one place; a set of exits needs the navigation field's fronts.
+      if (goal.regions.size() != 1)
+        throw InputError(fmt::format("goals[{}]: the roadmap plans for goals of one region, this one has {}; use "
+                                     "crowd.planner.type = 'navigation_field' for a set of exits",
+                                     g, goal.regions.size()));
+      const Polygon& region = goal.regions.front();
+      validateSimple(region, fmt::format("goals[{}].region", g));
       // Fan-triangle centroids from vertex 0 until one lies inside (the first does if convex).
       anchor = Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
-      for (std::size_t k = 1; k + 1 < goal.region.size() && !anchor.allFinite(); ++k) {
-        const Vec2 c = (goal.region.vertex(0) + goal.region.vertex(k) + goal.region.vertex(k + 1)) / 3.0;
-        if (contains(goal.region, c)) anchor = c;
+      for (std::size_t k = 1; k + 1 < region.size() && !anchor.allFinite(); ++k) {
+        const Vec2 c = (region.vertex(0) + region.vertex(k) + region.vertex(k + 1)) / 3.0;
+        if (contains(region, c)) anchor = c;
       }
       for (std::uint32_t v = 0; v < midpointCount_; ++v)
-        if (contains(goal.region, positions_[v])) links.emplace_back(v, gv, 0.0f);
+        if (contains(region, positions_[v])) links.emplace_back(v, gv, 0.0f);
     }
     positions_.push_back(anchor);
     const std::string what = goal.kind == Goal::Kind::Point ? fmt::format("goals[{}]: point {}", g, str(anchor))

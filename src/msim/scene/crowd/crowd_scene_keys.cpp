@@ -255,9 +255,18 @@ struct Builder {
         requireInside(crowd::regularPolygon(g.point, 1e-6, 3), key + ".shape.position");
       } else {
         g.kind = crowd::Goal::Kind::Region;
-        g.region = regionPolygon(shape);
-        crowd::validateSimple(g.region, fmt::format("{}: '{}.shape'", source, key));
-        requireInside(g.region, key + ".shape");
+        g.regions.push_back(regionPolygon(shape));
+        crowd::validateSimple(g.regions.back(), fmt::format("{}: '{}.shape'", source, key));
+        requireInside(g.regions.back(), key + ".shape");
+      }
+      const json& more = list[k].at("more_shapes");
+      if (!more.empty() && g.kind == crowd::Goal::Kind::Point)
+        fail(key + ".more_shapes", "a set of regions needs 'shape' to be a region too, not a point");
+      for (std::size_t m = 0; m < more.size(); ++m) {
+        const std::string member = fmt::format("{}.more_shapes[{}]", key, m);
+        g.regions.push_back(regionPolygon(more[m]));
+        crowd::validateSimple(g.regions.back(), fmt::format("{}: '{}'", source, member));
+        requireInside(g.regions.back(), member);
       }
       goalNames.push_back(name);
       out.goals.push_back(std::move(g));
@@ -445,6 +454,9 @@ void declareCrowdKeys(Schema& root) {
   Schema goal = Schema::object("a place agents walk to");
   goal.string("name", "referred to by groups[].goal and inflows[].goal").required();
   goal.field("shape", regionSchema("the goal: a point or a region", true).required());
+  goal.array("more_shapes", regionSchema("a further region of the goal", false),
+             "further regions of this goal: with 'shape' a set (of exits, say), each agent heading for the member "
+             "nearest along its path");
   goal.boolean("exit", false, "agents that arrive leave the scene (evacuations)");
   root.array("goals", goal, "destinations");
   Schema obstacle = Schema::object("obstacle, static unless it is given a motion");
