@@ -3,6 +3,9 @@
 // the outputs a run writes, --resume, and bad input that names its key.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include <nlohmann/json.hpp>
 
 #include "cli_harness.hpp"
@@ -201,6 +204,38 @@ TEST(CrowdCli, ExitSetSendsEachAgentToTheNearestDoor) {
   EXPECT_GT(east, 0.35 * 160) << "west " << west << " east " << east;
 }
 
+// RiMEA test 7 (a population's walking speeds): 200 agents spread thinly along a 100 m corridor,
+// speeds uniform in [0.8, 1.6] m/s, walk east; after 5 s their measured speeds cover that range
+// with its mean.
+TEST(CrowdCli, GroupWalksWithItsSpeedDistribution) {
+  const fs::path dir = scratch("crowd_speed_spread");
+  writeText(dir / "s.json", R"({
+  "name": "spread", "phenomenon": "crowd",
+  "domain": {"min": [0, 0], "max": [120, 10], "resolution": 120},
+  "time": {"duration": 5, "fps": 1},
+  "goals": [{"name": "east", "shape": {"type": "box", "min": [118, 0], "max": [120, 10]}, "exit": true}],
+  "groups": [{"count": 200, "region": {"type": "box", "min": [1, 1], "max": [100, 9]}, "goal": "east",
+              "speed_distribution": "uniform", "speed_min": 0.8, "speed_max": 1.6}],
+  "outputs": {"mp4": false, "vdb": false, "png": false}
+})");
+  const Result r = runMsim("run " + (dir / "s.json").string() + " -q --out " + (dir / "out").string());
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  const auto table = msim::io::readCsv(dir / "out" / "trajectories.csv");
+  double sum = 0.0, lo = 1e9, hi = 0.0;
+  int n = 0;
+  for (const auto& row : table.rows) {
+    if (row[0] != 5.0) continue;  // the last frame
+    const double speed = std::hypot(row[4], row[5]);
+    sum += speed, lo = std::min(lo, speed), hi = std::max(hi, speed), ++n;
+  }
+  ASSERT_EQ(n, 200);
+  EXPECT_NEAR(sum / n, 1.2, 0.05);
+  EXPECT_LT(lo, 0.9);
+  EXPECT_GT(lo, 0.7);
+  EXPECT_GT(hi, 1.5);
+  EXPECT_LT(hi, 1.7);
+}
+
 TEST(CrowdCli, BadInputNamesTheKey) {
   expectInputError("crowd_3d",
                    replaced(doorway(), R"("min": [0, 0], "max": [20, 20], "resolution")",
@@ -229,6 +264,10 @@ TEST(CrowdCli, BadInputNamesTheKey) {
                    {"cannot be reached"});
   expectInputError("crowd_too_many", replaced(doorway(), R"("count": 400)", R"("count": 4000)"),
                    {"groups[0].count", "do not fit"});
+  expectInputError("crowd_zero_speed",
+                   replaced(doorway(), R"("goal": "out"}])",
+                            R"("goal": "out", "speed_distribution": "uniform", "speed_min": 0, "speed_max": 1.5}])"),
+                   {"groups[0].speed_min", "> 0"});
   // A member of an exit set that agents cannot stand in (inside a wall).
   expectInputError("crowd_exit_set_member",
                    replaced(doorway(), R"("exit": true})",

@@ -336,6 +336,7 @@ void CrowdSimulation::arriveAndSpawn(double dt) {
         throw SimulationError(fmt::format("inflows[{}]: no free room for a new agent in the region", k));
       AgentSpec spec = f.agent;
       spec.position = x.cast<float>();
+      if (f.speeds.kind != SpeedDistribution::Kind::Fixed) spec.maxSpeed = static_cast<float>(f.speeds.sample(rng));
       agents_.add(spec);
       ++stats_.spawned;
     }

@@ -23,6 +23,7 @@
 #include "msim/crowd/goal.hpp"
 #include "msim/crowd/orca.hpp"
 #include "msim/crowd/planner.hpp"
+#include "msim/crowd/speed_distribution.hpp"
 #include "msim/crowd/uic_projection.hpp"
 
 namespace msim::crowd {
@@ -33,6 +34,7 @@ struct Inflow {
   double rate = 1.0;  // [agents/s]
   double start = 0.0, stop = std::numeric_limits<double>::infinity();  // [s]
   AgentSpec agent;    // goal, radius, speed, model, group of the new agents (position ignored)
+  SpeedDistribution speeds;  // each new agent's speed, unless Fixed (then agent.maxSpeed)
 };
 
 // A scripted agent walks its waypoints in order at its maximum speed and then stands (or loops).

@@ -51,7 +51,15 @@ void agentKeys(Schema& s, bool opposite) {
   s.string("model", "uic", "uic: the continuum (ch. 4.4); orca: per-agent ORCA; scripted: walks 'waypoints'")
       .choices({"uic", "orca", "scripted"});
   s.number("radius", "m", 0.0, "body radius; 0 = crowd.agent.radius").min(0.0);
-  s.number("max_speed", "m/s", 0.0, "walking speed; 0 = crowd.agent.max_speed").min(0.0);
+  s.number("max_speed", "m/s", 0.0, "walking speed (the mean of a normal distribution); 0 = crowd.agent.max_speed")
+      .min(0.0);
+  s.string("speed_distribution", "fixed",
+           "fixed: every agent walks at max_speed; uniform: drawn from [speed_min, speed_max]; normal: N(max_speed, "
+           "speed_sd) truncated to [speed_min, speed_max] (a population's spread, RiMEA test 7)")
+      .choices({"fixed", "uniform", "normal"});
+  s.number("speed_min", "m/s", 0.0, "uniform and normal: the slowest walker");
+  s.number("speed_max", "m/s", 0.0, "uniform and normal: the fastest walker");
+  s.number("speed_sd", "m/s", 0.0, "normal: the standard deviation");
 }
 
 Schema crowdKeys() {
@@ -297,6 +305,26 @@ struct Builder {
     return a;
   }
 
+  // The walking speeds of a group or inflow (speed_distribution and its keys); exit 2 naming the
+  // key for speeds that can be zero or negative.
+  crowd::SpeedDistribution speedDistribution(const json& entry, const crowd::AgentSpec& base, const std::string& key) const {
+    crowd::SpeedDistribution d;
+    const std::string kind = entry.at("speed_distribution").get<std::string>();
+    d.kind = kind == "uniform" ? crowd::SpeedDistribution::Kind::Uniform
+             : kind == "normal" ? crowd::SpeedDistribution::Kind::Normal
+                                : crowd::SpeedDistribution::Kind::Fixed;
+    d.mean = base.maxSpeed;
+    d.sd = entry.at("speed_sd").get<double>();
+    d.min = entry.at("speed_min").get<double>();
+    d.max = entry.at("speed_max").get<double>();
+    try {
+      d.validate(key);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(fmt::format("{}: {}", source, e.what()));
+    }
+    return d;
+  }
+
   // Uniform random points in the region where an agent of the radius clears every obstacle.
   Vec2 randomPoint(Rng& rng, const Polygon& region, float radius, const std::string& key) const {
     const Vec2 x = crowd::randomFreePoint(rng, region, radius, obstacleIndex);
@@ -350,13 +378,16 @@ struct Builder {
       if (!scripted && !g.at("waypoints").empty()) fail(key + ".waypoints", "only scripted agents follow waypoints");
       const std::uint32_t goal = opposite ? 0 : goalIndex(g, key);
       const Vec2 centre = regionCentre(g.at("region"), region);
+      const crowd::SpeedDistribution speeds = speedDistribution(g, base, key);
       Rng groupRng = rng.split(k);
       std::vector<Vec2> points(static_cast<std::size_t>(count));
       for (Vec2& x : points) x = randomPoint(groupRng, region, base.radius, key + ".region");
       crowd::sortSpatially(points);
+      Rng speedRng = rng.split(list.size() + k);  // apart from the positions': adding spread moves no one
       for (const Vec2& x : points) {
         crowd::AgentSpec a = base;
         a.position = x.cast<float>();
+        a.maxSpeed = static_cast<float>(speeds.sample(speedRng));
         a.goal = goal;
         if (opposite && !scripted) {
           crowd::Goal mirrored;
@@ -391,6 +422,7 @@ struct Builder {
       in.stop = f.at("stop").get<double>();
       if (in.stop <= in.start) fail(key + ".stop", "must come after 'start'");
       in.agent = agentSpec(f, static_cast<std::uint32_t>(r.at("groups").size() + k));
+      in.speeds = speedDistribution(f, in.agent, key);
       if (in.agent.model == crowd::AgentModel::Scripted) fail(key + ".model", "inflow agents cannot be scripted");
       if (f.at("goal").get<std::string>() == "opposite") fail(key + ".goal", "inflow agents need a named goal");
       in.agent.goal = goalIndex(f, key);
