@@ -204,6 +204,30 @@ TEST(CrowdCli, ExitSetSendsEachAgentToTheNearestDoor) {
   EXPECT_GT(east, 0.35 * 160) << "west " << west << " east " << east;
 }
 
+// A domain grid finer than an agent (0.25 m cells for agents 0.5 m across) used to stall the
+// continuum: one agent alone filled a cell beyond rho_max. The continuum now takes cells of at
+// least the agents' diameter, so the doorway empties at 0.25 m cells exactly as at 0.5 m, and
+// within 10% of it at 1 m.
+TEST(CrowdCli, FineDomainGridDoesNotStallTheCrowd) {
+  const auto remaining = [](const std::string& name, int resolution) {
+    const fs::path dir = scratch(name);
+    writeText(dir / "s.json", replaced(doorway(), R"("resolution": 40)", "\"resolution\": " + std::to_string(resolution)));
+    const Result r = runMsim("run " + (dir / "s.json").string() + " -q --out " + (dir / "out").string());
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    std::vector<int> agents;
+    const json run = readJson(dir / "out" / "run.json");
+    for (const json& f : run.at("frames")) agents.push_back(f.at("agents").get<int>());
+    return agents;
+  };
+  const std::vector<int> half = remaining("crowd_grid_half", 40), quarter = remaining("crowd_grid_quarter", 80),
+                         whole = remaining("crowd_grid_whole", 20);
+  EXPECT_EQ(quarter, half);
+  ASSERT_EQ(whole.size(), half.size());
+  // After 20 s the 1 m continuum has let out within 10% of the agents the 0.5 m one has.
+  EXPECT_NEAR(400 - whole.back(), 400 - half.back(), 0.1 * (400 - half.back()));
+  EXPECT_GT(400 - half.back(), 60);
+}
+
 // RiMEA test 7 (a population's walking speeds): 200 agents spread thinly along a 100 m corridor,
 // speeds uniform in [0.8, 1.6] m/s, walk east; after 5 s their measured speeds cover that range
 // with its mean.

@@ -79,6 +79,12 @@ CrowdSimulation::CrowdSimulation(const CrowdSettings& settings, std::vector<Poly
     validateSimple(obstacles_[k], fmt::format("obstacles[{}]", k));
     freeArea_.addStaticObstacle(obstacles_[k]);
   }
+  // A continuum grid that overhangs the walkable box (its cell does not divide the box) has no
+  // room for agents beyond the walls: those strips are covered.
+  const Vec2 gridHi = settings_.grid.origin + settings_.grid.extent();
+  const double sliver = 1e-9 * settings_.grid.dx;
+  if (gridHi.x() > settings_.hi.x() + sliver) freeArea_.addStaticObstacle(rectangle(Vec2(settings_.hi.x(), settings_.lo.y()), gridHi));
+  if (gridHi.y() > settings_.hi.y() + sliver) freeArea_.addStaticObstacle(rectangle(Vec2(settings_.lo.x(), settings_.hi.y()), gridHi));
   for (std::size_t k = 0; k < moving_.size(); ++k) {
     validateSimple(moving_[k].shape, fmt::format("moving obstacle {}", k));
     if (!moving_[k].velocity.allFinite() || !moving_[k].amplitude.allFinite() || !std::isfinite(moving_[k].frequency))

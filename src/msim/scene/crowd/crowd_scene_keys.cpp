@@ -1,5 +1,6 @@
 #include "msim/scene/crowd/crowd_scene_keys.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -77,6 +78,11 @@ Schema crowdKeys() {
   uic.number("rho_max", "1/m^2", 0.0, "maximum density; 0 = eq. 4.4, 2 alpha / (sqrt(3) d_min^2)").min(0.0);
   uic.number("tolerance", "", 5e-3, "QP tolerance: overdensity left per cell, relative to rho_max").min(0.0, Bound::Exclusive);
   uic.integer("max_iterations", 500, "MPRGP iterations per solve").min(1);
+  uic.number("cell_size", "m", 0.0,
+             "the continuum's cell; 0 = the domain's cell, coarsened by a whole factor to at least the agents' "
+             "diameter d_min (one agent alone in a smaller cell exceeds rho_max and the continuum stalls the crowd); "
+             "walls and doors stay exact polygons at any size, and planning has crowd.planner.cell_size")
+      .min(0.0);
   uic.string("speed_density", "constant",
              "walking speed of the continuum: 'constant' max_speed (the seed), or 'weidmann': slower in dense "
              "regions along Weidmann's (1993) fundamental diagram, as ch. 4.4.1 suggests")
@@ -180,8 +186,7 @@ struct Builder {
   void domainAndGrid() {
     if (scene.dimensions != 2) fail("domain.min", "crowds are planar: give 2 numbers for domain.min and domain.max");
     out.settings.lo = sceneVector<2>(r.at("domain").at("min"));
-    out.settings.grid = scene.gridSpec<2>();
-    out.settings.hi = out.settings.lo + out.settings.grid.extent();
+    out.settings.hi = out.settings.lo + scene.gridSpec<2>().extent();
   }
 
   void settings() {
@@ -222,6 +227,32 @@ struct Builder {
     out.colourBy = c.at("colour_by").get<std::string>();
     out.trajectories = c.at("trajectories").get<bool>();
     out.denseFraction = c.at("dense_fraction").get<double>();
+    continuumGrid(u.at("cell_size").get<double>());
+  }
+
+  // The UIC's grid over the walkable box, from the box's lower corner; where its cells overhang
+  // the box the simulation counts them covered. Its cell is the domain's unless that is smaller
+  // than an agent: a cell of side h holds at most 1/h^2 of one agent's density, which beyond
+  // rho_max makes the continuum hold back even a lone walker.
+  void continuumGrid(double cellSize) {
+    const GridSpec<2> domain = scene.gridSpec<2>();
+    double cell = cellSize;
+    if (cell == 0.0) {
+      const int factor = std::max(1, static_cast<int>(std::ceil(out.dMin / domain.dx - 1e-9)));
+      cell = factor * domain.dx;
+      if (factor > 1)
+        logger().info("{}: the crowd continuum takes cells of {:g} m ({} x {} domain cells, at least the agents' diameter "
+                      "{:g} m); set crowd.uic.cell_size to choose",
+                      source, cell, factor, factor, out.dMin);
+    } else if (cell < out.dMin) {
+      logger().warn("{}: crowd.uic.cell_size = {:g} m is below the agents' diameter {:g} m: one agent alone can exceed "
+                    "rho_max in a cell and the continuum may stall the crowd",
+                    source, cell, out.dMin);
+    }
+    const Vec2 extent = out.settings.hi - out.settings.lo;
+    IVec2 res;
+    for (int a = 0; a < 2; ++a) res[a] = std::max(1, static_cast<int>(std::ceil(extent[a] / cell - 1e-9)));
+    out.settings.grid = GridSpec<2>(out.settings.lo, cell, res);
   }
 
   void obstacles() {
