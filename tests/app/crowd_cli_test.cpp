@@ -228,6 +228,34 @@ TEST(CrowdCli, FineDomainGridDoesNotStallTheCrowd) {
   EXPECT_GT(400 - half.back(), 60);
 }
 
+// crowd.uic.speed_density = weidmann reads the density agents feel, counted over about 1.5 m: a
+// lone walker in a thin crowd keeps Weidmann's free speed, and the middle of a block at 2.5 /m^2
+// walks near Weidmann's 0.45 m/s there (the density of one 0.5 m cell would have slowed both).
+TEST(CrowdCli, WeidmannSpeedsFollowTheFundamentalDiagram) {
+  const auto meanSpeed = [](const std::string& name, int count, const std::string& region, double x0, double x1) {
+    const fs::path dir = scratch(name);
+    writeText(dir / "s.json", R"({"name": "fd", "phenomenon": "crowd",
+      "domain": {"min": [0, 0], "max": [120, 10], "resolution": 240}, "time": {"duration": 4, "fps": 1},
+      "crowd": {"uic": {"speed_density": "weidmann"}, "agent": {"max_speed": 1.34}},
+      "goals": [{"name": "east", "shape": {"type": "box", "min": [118, 0], "max": [120, 10]}, "exit": true}],
+      "groups": [{"count": )" + std::to_string(count) + R"(, "region": )" + region + R"(, "goal": "east"}],
+      "outputs": {"mp4": false, "vdb": false, "png": false}})");
+    const Result r = runMsim("run " + (dir / "s.json").string() + " -q --out " + (dir / "out").string());
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    const auto table = msim::io::readCsv(dir / "out" / "trajectories.csv");
+    double sum = 0.0;
+    int n = 0;
+    for (const auto& row : table.rows)
+      if (row[0] == 4.0 && row[2] > x0 && row[2] < x1) sum += std::hypot(row[4], row[5]), ++n;
+    return n > 0 ? sum / n : 0.0;
+  };
+  // 200 agents over 100 x 8 m: 0.25 /m^2, Weidmann 1.33 m/s.
+  EXPECT_NEAR(meanSpeed("crowd_fd_sparse", 200, R"({"type": "box", "min": [1, 1], "max": [100, 9]})", 0.0, 120.0), 1.33, 0.1);
+  // 1000 agents over 40 x 10 m: 2.5 /m^2, Weidmann 0.45 m/s (measured in the block's middle).
+  EXPECT_NEAR(meanSpeed("crowd_fd_dense", 1000, R"({"type": "box", "min": [10, 0], "max": [50, 10]})", 22.0, 38.0), 0.45,
+              0.07);
+}
+
 // RiMEA test 7 (a population's walking speeds): 200 agents spread thinly along a 100 m corridor,
 // speeds uniform in [0.8, 1.6] m/s, walk east; after 5 s their measured speeds cover that range
 // with its mean.
