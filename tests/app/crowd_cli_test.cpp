@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <nlohmann/json.hpp>
 
@@ -254,6 +255,31 @@ TEST(CrowdCli, WeidmannSpeedsFollowTheFundamentalDiagram) {
   // 1000 agents over 40 x 10 m: 2.5 /m^2, Weidmann 0.45 m/s (measured in the block's middle).
   EXPECT_NEAR(meanSpeed("crowd_fd_dense", 1000, R"({"type": "box", "min": [10, 0], "max": [50, 10]})", 22.0, 38.0), 0.45,
               0.07);
+}
+
+// RiMEA test 9's idea on scenes/crowd_evacuation_room.json: 1000 people leave a 30 x 20 m room
+// through four 1 m doors, each to the nearest; with the two east doors closed the room takes
+// 1.7-2.3 times as long (the same people through half the doors).
+TEST(CrowdCli, EvacuationRoomTakesAboutTwiceAsLongThroughTwoExits) {
+  const std::string scene = std::string(MSIM_SOURCE_DIR) + "/scenes/crowd_evacuation_room.json";
+  const std::string quiet = "--set outputs.png=false --set outputs.vdb=false --set outputs.mp4=false "
+                            "--set crowd.trajectories=false --set time.duration=200";
+  const auto emptiedAt = [](const json& run) {
+    for (const json& f : run.at("frames"))
+      if (f.at("agents").get<int>() == 0) return f.at("time_s").get<double>();
+    return std::numeric_limits<double>::infinity();
+  };
+  const json four = runScene("crowd_evacuation_four", scene, quiet);
+  const json two = runScene("crowd_evacuation_two", scene,
+                            quiet + R"( --set 'goals[0].more_shapes=[{"type": "box", "min": [-3, 13.5], "max": [-1, 16.5]}]')");
+  ASSERT_TRUE(four.contains("frames") && two.contains("frames"));
+  const double tFour = emptiedAt(four), tTwo = emptiedAt(two);
+  std::printf("evacuation room: four exits %.1f s, two %.1f s (ratio %.2f)\n", tFour, tTwo, tTwo / tFour);
+  EXPECT_GT(tTwo / tFour, 1.7);
+  EXPECT_LT(tTwo / tFour, 2.3);
+  // The four doors share the room: each end wall lets out about half.
+  const json& lines = four.at("results").at("measurement_lines");
+  EXPECT_NEAR(std::abs(lines.at("west").at("net_crossings").get<double>()), 500.0, 60.0);
 }
 
 // RiMEA test 7 (a population's walking speeds): 200 agents spread thinly along a 100 m corridor,
