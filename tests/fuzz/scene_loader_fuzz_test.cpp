@@ -19,7 +19,7 @@ constexpr int kCasesPerScene = 64;
 
 std::vector<std::filesystem::path> shippedScenes() {
   std::vector<std::filesystem::path> scenes;
-  for (const auto& e : std::filesystem::directory_iterator(std::filesystem::path(MSIM_SOURCE_DIR) / "scenes"))
+  for (const auto& e : std::filesystem::recursive_directory_iterator(std::filesystem::path(MSIM_SOURCE_DIR) / "scenes"))
     if (e.path().extension() == ".json") scenes.push_back(e.path());
   std::sort(scenes.begin(), scenes.end());
   return scenes;

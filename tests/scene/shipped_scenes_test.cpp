@@ -1,4 +1,4 @@
-// Every scene shipped in scenes/ loads, validates, builds its phenomenon, and `msim info` can
+// Every scene shipped in scenes/ (and its subfolders) loads, validates, builds its phenomenon, and `msim info` can
 // list each of its parameters with a unit where the parameter has one.
 #include <gtest/gtest.h>
 
@@ -15,7 +15,7 @@ using namespace msim;
 
 TEST(ShippedScenes, AllLoadBuildAndDescribeWithUnits) {
   int scenes = 0;
-  for (const auto& entry : fs::directory_iterator(fs::path(MSIM_SOURCE_DIR) / "scenes")) {
+  for (const auto& entry : fs::recursive_directory_iterator(fs::path(MSIM_SOURCE_DIR) / "scenes")) {
     if (entry.path().extension() != ".json") continue;
     ++scenes;
     SCOPED_TRACE(entry.path().string());
