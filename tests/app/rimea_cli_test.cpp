@@ -76,3 +76,30 @@ TEST(RimeaCli, Test7WalkingSpeedsOfAPopulation) {
   EXPECT_GE(*std::min_element(speeds.begin(), speeds.end()), 0.6 - 1e-3);
   EXPECT_LE(*std::max_element(speeds.begin(), speeds.end()), 2.0 + 1e-3);
 }
+
+// Test 12 (the effect of a bottleneck): 150 people pass a 1 m wide passage between two rooms; the
+// queue forms in front of it (above 2 /m^2 in the 3 x 6 m before it) and not behind it (below
+// 1 /m^2 in the 3 x 6 m after it), and everyone leaves.
+TEST(RimeaCli, Test12QueueFormsBeforeTheBottleneckNotBehindIt) {
+  const fs::path out = runRimea("rimea_12_bottleneck");
+  EXPECT_EQ(readJson(out / "run.json").at("frames").back().at("agents").get<int>(), 0);
+  const auto table = msim::io::readCsv(out / "trajectories.csv");
+  std::vector<int> before(1000, 0), after(1000, 0);
+  for (const auto& row : table.rows) {
+    const auto frame = static_cast<std::size_t>(row[0]);
+    const double x = row[2], y = row[3];
+    if (frame >= before.size() || y < 2.0 || y >= 8.0) continue;
+    if (x >= 7.0 && x < 10.0) ++before[frame];
+    if (x >= 14.0 && x < 17.0) ++after[frame];
+  }
+  EXPECT_GT(*std::max_element(before.begin(), before.end()) / 18.0, 2.0);
+  EXPECT_LT(*std::max_element(after.begin(), after.end()) / 18.0, 1.0);
+}
+
+// Counter-flow: two groups of 60 meet head-on in a 4 m corridor and pass each other: no deadlock,
+// everyone out at the far end.
+TEST(RimeaCli, CounterFlowPassesWithoutDeadlock) {
+  const json run = readJson(runRimea("rimea_counterflow") / "run.json");
+  EXPECT_EQ(run.at("frames").back().at("agents").get<int>(), 0);
+  EXPECT_LT(run.at("results").at("evacuation").at("t100_s").get<double>(), 70.0);
+}
