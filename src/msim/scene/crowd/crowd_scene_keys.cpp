@@ -186,7 +186,8 @@ struct Builder {
   void domainAndGrid() {
     if (scene.dimensions != 2) fail("domain.min", "crowds are planar: give 2 numbers for domain.min and domain.max");
     out.settings.lo = sceneVector<2>(r.at("domain").at("min"));
-    out.settings.hi = out.settings.lo + scene.gridSpec<2>().extent();
+    // The walls stand where the scene puts them; the continuum's grid may overhang them.
+    out.settings.hi = sceneVector<2>(r.at("domain").at("max"));
   }
 
   void settings() {
