@@ -7,8 +7,8 @@
 #include <fmt/format.h>
 
 #include "msim/core/error.hpp"
-#include "msim/core/parallel.hpp"
 #include "msim/core/interpolation.hpp"
+#include "msim/core/parallel.hpp"
 #include "msim/core/resample.hpp"
 #include "msim/fluid/vortex/vortex_solids.hpp"
 #include "msim/numerics/level_set/extrapolation.hpp"
@@ -409,24 +409,21 @@ void LiquidSolver<D>::setVortexLayer(std::unique_ptr<VortexLayer<D>> layer) {
   vortex_ = std::move(layer);
   if (!vortex_) return;
   if (solidDistance_) vortex_->setSolid(*solidDistance_);
-  vortex_->seedInitial(flowVorticity());
-  removeVortexParticlesInSolid<D>(vortex_->particles(), [&](const Vec<D>& x) { return -double(sampleLinear<D>(phi_, x)); });
+  vortex_->seedInitial(vortex_->flowVorticity(velocity_));
+  dropVortexParticlesInAir();
 }
 
 template <int D>
 void LiquidSolver<D>::advanceVortexParticles(double dt) {
   ScopedStage s(timers_, "liquid: vortex particles");
-  vortex_->advance(velocity_, dt, time_, flowVorticity());
-  // Particles in the air (phi > 0, read D-linearly at the cell centres) carry nothing there.
-  removeVortexParticlesInSolid<D>(vortex_->particles(), [&](const Vec<D>& x) { return -double(sampleLinear<D>(phi_, x)); });
+  vortex_->advance(velocity_, dt, time_, vortex_->flowVorticity(velocity_));
+  dropVortexParticlesInAir();
 }
 
 template <int D>
-const Vorticity<D>* LiquidSolver<D>::flowVorticity() {
-  if (!vortex_ || !vortex_->needsFlowVorticity()) return nullptr;
-  if (!flowVorticity_) flowVorticity_.emplace(spec_);
-  computeVorticity(velocity_, *flowVorticity_);
-  return &*flowVorticity_;
+void LiquidSolver<D>::dropVortexParticlesInAir() {
+  // phi > 0 (read D-linearly at the cell centres) is air, which carries no vorticity.
+  removeVortexParticlesInSolid<D>(vortex_->particles(), [&](const Vec<D>& x) { return -double(sampleLinear<D>(phi_, x)); });
 }
 
 template <int D>

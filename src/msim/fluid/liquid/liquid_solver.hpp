@@ -202,8 +202,7 @@ class LiquidSolver {
   bool liquidCell(std::size_t cell) const { return phi_[cell] < 0.0f && solid_[cell] <= 0.5f; }
   // The vortex particles' move (VortexLayer::advance), then those outside the liquid go.
   void advanceVortexParticles(double dt);
-  // The grid's vorticity when the vortex particles seed from it, else null.
-  const Vorticity<D>* flowVorticity();
+  void dropVortexParticlesInAir();
   // Whether face f of `axis` has a cell on either side for which isLiquid(cell index) holds.
   template <typename IsLiquid>
   bool faceTouches(int axis, const IVec<D>& f, IsLiquid&& isLiquid) const;
@@ -236,7 +235,6 @@ class LiquidSolver {
   std::optional<MacGrid<D>> wallInflow_;  // emitters' wall faces (markWallInflow), this step
   bool inflowThisStep_ = false, inflowApplied_ = false;  // set by emit(); in the projection
   std::unique_ptr<VortexLayer<D>> vortex_;
-  std::optional<Vorticity<D>> flowVorticity_;  // for vortex particles seeded with the flow's vorticity
   double time_ = 0.0;
   StageTimers timers_;
 };

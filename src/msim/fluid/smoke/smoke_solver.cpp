@@ -55,15 +55,7 @@ void SmokeSolver<D>::setObstacles(const Grid<float, D>& nodalSolidPhi) {
 template <int D>
 void SmokeSolver<D>::setVortexLayer(std::unique_ptr<VortexLayer<D>> layer) {
   vortex_ = std::move(layer);
-  if (vortex_) vortex_->seedInitial(flowVorticity());
-}
-
-template <int D>
-const Vorticity<D>* SmokeSolver<D>::flowVorticity() {
-  if (!vortex_ || !vortex_->needsFlowVorticity()) return nullptr;
-  if (!flowVorticity_) flowVorticity_.emplace(spec_);
-  computeVorticity(velocity_, *flowVorticity_);
-  return &*flowVorticity_;
+  if (vortex_) vortex_->seedInitial(vortex_->flowVorticity(velocity_));
 }
 
 template <int D>
@@ -209,7 +201,7 @@ void SmokeSolver<D>::step(double dt) {
   if (vortex_) {
     // The particles move with the divergence-free velocity (Selle ch. 3.3).
     ScopedStage s(timers_, "vortex particles");
-    vortex_->advance(velocity_, dt, time_, flowVorticity());
+    vortex_->advance(velocity_, dt, time_, vortex_->flowVorticity(velocity_));
   }
   {
     ScopedStage s(timers_, "advect scalars");

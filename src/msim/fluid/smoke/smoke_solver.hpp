@@ -230,8 +230,6 @@ class SmokeSolver {
   void applyWinds(double dt);
   void checkFinite() const;
   double measureDivergence();
-  // The grid's vorticity when the vortex particles seed from it, else null.
-  const Vorticity<D>* flowVorticity();
 
   GridSpec<D> spec_;
   SmokeParams<D> params_;
@@ -269,7 +267,6 @@ class SmokeSolver {
   std::optional<MacGrid<D>> advecting_;  // U + offset
   double time_ = 0.0;
   std::unique_ptr<VortexLayer<D>> vortex_;
-  std::optional<Vorticity<D>> flowVorticity_;  // for vortex particles seeded with the flow's vorticity
 };
 
 }  // namespace msim::fluid

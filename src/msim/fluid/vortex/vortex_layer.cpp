@@ -45,6 +45,14 @@ void VortexLayer<D>::advance(const MacGrid<D>& velocity, double dt, double time,
   if (to > from) emitter_.emit(particles_, to - from, flowVorticity);
 }
 
+template <int D>
+const Vorticity<D>* VortexLayer<D>::flowVorticity(const MacGrid<D>& velocity) {
+  if (!needsFlowVorticity()) return nullptr;
+  if (!flowVorticity_) flowVorticity_.emplace(velocity.spec());
+  computeVorticity(velocity, *flowVorticity_);
+  return &*flowVorticity_;
+}
+
 template class VortexLayer<2>;
 template class VortexLayer<3>;
 

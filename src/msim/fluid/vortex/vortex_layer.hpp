@@ -51,6 +51,9 @@ class VortexLayer {
   VortexParticles<D>& particles() { return particles_; }
   const VortexLayerSettings<D>& settings() const { return settings_; }
   bool needsFlowVorticity() const { return settings_.seed.vorticity == SeedVorticity::LocalFlow; }
+  // The grid's vorticity of `velocity` when the seeding takes the local flow's (kept in the layer,
+  // computed anew per call), else null: what advance and seedInitial want.
+  const Vorticity<D>* flowVorticity(const MacGrid<D>& velocity);
 
  private:
   VortexLayerSettings<D> settings_;
@@ -58,6 +61,7 @@ class VortexLayer {
   VortexParticles<D> particles_;
   VortexEmitter<D> emitter_;
   std::optional<Grid<float, D>> solidPhi_;
+  std::optional<Vorticity<D>> flowVorticity_;
 };
 
 }  // namespace msim::fluid
