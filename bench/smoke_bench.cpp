@@ -8,6 +8,8 @@
 #include <benchmark/benchmark.h>
 
 #include <memory>
+#include <utility>
+#include <vector>
 
 #include "msim/fluid/smoke/smoke_solver.hpp"
 
@@ -16,6 +18,14 @@ using namespace msim;
 namespace {
 
 constexpr double kStep = 1.0 / 48.0;
+
+// The cells whose centres lie within `radius` of `centre`, fully covered: a ball source.
+std::vector<std::pair<std::size_t, float>> ballCells(const fluid::SmokeSolver<3>& smoke, const Vec3& centre, double radius) {
+  std::vector<std::pair<std::size_t, float>> cells;
+  for (std::size_t i = 0; i < smoke.spec().cellCount(); ++i)
+    if ((smoke.density().position(smoke.density().coord(i)) - centre).norm() < radius) cells.emplace_back(i, 1.0f);
+  return cells;
+}
 
 // A plume from a hot vent near the floor, open top, after three steps (a developed plume, warm
 // caches and pressure).
@@ -29,9 +39,7 @@ std::unique_ptr<fluid::SmokeSolver<3>> plume(const IVec3& res) {
   p.projection.pcg.tolerance = 1e-4;
   auto smoke = std::make_unique<fluid::SmokeSolver<3>>(spec, p);
   fluid::SmokeSource<3> source;
-  const Vec3 centre(0.5, 0.1, 0.5);
-  for (std::size_t i = 0; i < spec.cellCount(); ++i)
-    if ((smoke->density().position(smoke->density().coord(i)) - centre).norm() < 0.08) source.cells.emplace_back(i, 1.0f);
+  source.cells = ballCells(*smoke, Vec3(0.5, 0.1, 0.5), 0.08);
   source.density = 1.0;
   source.temperature = 400.0;
   source.velocity = Vec3(0.0, 0.5, 0.0);
@@ -55,9 +63,7 @@ std::unique_ptr<fluid::SmokeSolver<3>> explosion(int particles) {
   p.vorticityEpsilon = 0.0;
   auto smoke = std::make_unique<fluid::SmokeSolver<3>>(spec, p);
   fluid::SmokeSource<3> source;
-  const Vec3 centre(0.5, 0.2, 0.5);
-  for (std::size_t i = 0; i < spec.cellCount(); ++i)
-    if ((smoke->density().position(smoke->density().coord(i)) - centre).norm() < 0.08) source.cells.emplace_back(i, 1.0f);
+  source.cells = ballCells(*smoke, Vec3(0.5, 0.2, 0.5), 0.08);
   source.density = 1.0;
   source.temperature = 700.0;
   source.expansion = 40.0;
