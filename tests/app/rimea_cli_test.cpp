@@ -96,10 +96,16 @@ TEST(RimeaCli, Test12QueueFormsBeforeTheBottleneckNotBehindIt) {
   EXPECT_LT(*std::max_element(after.begin(), after.end()) / 18.0, 1.0);
 }
 
-// Counter-flow: two groups of 60 meet head-on in a 4 m corridor and pass each other: no deadlock,
-// everyone out at the far end.
+// Counter-flow: two groups of 60 meet head-on in a 4 m corridor and pass each other: no deadlock
+// (the mean speed, which falls to about 0.3 m/s while they pass, never below 0.2 m/s), everyone
+// out at the far end.
 TEST(RimeaCli, CounterFlowPassesWithoutDeadlock) {
   const json run = readJson(runRimea("rimea_counterflow") / "run.json");
   EXPECT_EQ(run.at("frames").back().at("agents").get<int>(), 0);
-  EXPECT_LT(run.at("results").at("evacuation").at("t100_s").get<double>(), 70.0);
+  double slowest = 1e9;
+  for (const json& f : run.at("frames"))
+    if (f.at("agents").get<int>() > 0) slowest = std::min(slowest, f.at("mean_speed_mps").get<double>());
+  std::printf("counter-flow: slowest mean speed %.2f m/s, all out after %.1f s\n", slowest,
+              run.at("results").at("evacuation").at("t100_s").get<double>());
+  EXPECT_GT(slowest, 0.2);
 }

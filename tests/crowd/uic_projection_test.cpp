@@ -128,36 +128,6 @@ TEST(UicProjection, RenormUsesEachGroupsOwnSpeed) {
   for (std::size_t i = 0; i < c.x.size(); ++i) EXPECT_NEAR((c.out[i] - c.v[i]).norm(), 0.0f, 1e-5);
 }
 
-TEST(UicProjection, WeidmannSpeedsFollowTheFundamentalDiagram) {
-  // A uniform crowd at 2 agents/m^2 (below rho_max: p = 0) walking along +x at v0: with
-  // density-dependent speeds every face carries Weidmann's v(rho) for the agents per square metre
-  // around it (1.34 (1 - e^{-1.913 (1/2 - 1/5.4)}) = 0.605 m/s at rho = 2), instead of v0. On
-  // these 1 m cells the counting window is the cell itself, so rho is the mean of the face's two
-  // cells.
-  Crowd c;
-  convergingLattice(c, Vec2f(2.0f, 2.0f), Vec2f(18.0f, 18.0f), 2.0, Vec2f(1e6f, 10.0f), 1.34f);
-  UicSettings s = settings();
-  s.weidmannSpeeds = true;
-  UicProjection uic(grid20(), s);
-  Grid<float, 2> f(grid20(), 1.0f);
-  const UicStats& stats = uic.project(c.x, c.v, c.speed, f, 0.1, c.out);
-  EXPECT_EQ(stats.activeCells, 0);
-  const auto& vx = uic.velocity().component(0);
-  const auto& cells = uic.density();
-  int interior = 0;
-  for (int j = 4; j < 16; ++j)
-    for (int i = 4; i < 16; ++i) {
-      const IVec2 face(i, j);
-      const float rho = 0.5f * (cells(IVec2(i - 1, j)) + cells(face));
-      EXPECT_NEAR(vx(face), weidmannSpeed(rho), 1e-4) << i << " " << j;
-      if (std::abs(rho - 2.0f) < 0.05f) {
-        EXPECT_NEAR(vx(face), 0.605, 0.03);  // v changes by -0.4 m/s per agent/m^2 at rho = 2
-        ++interior;
-      }
-    }
-  EXPECT_GT(interior, 20);
-}
-
 TEST(UicProjection, ConvergingCrowdIsCappedAndSatisfiesKkt) {
   Crowd c;
   convergingLattice(c, Vec2f(4, 4), Vec2f(16, 16), 0.9 * kRhoMax, Vec2f(10.0f, 10.0f), 1.4f);

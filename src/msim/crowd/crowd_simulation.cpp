@@ -85,6 +85,7 @@ CrowdSimulation::CrowdSimulation(const CrowdSettings& settings, std::vector<Poly
   const double sliver = 1e-9 * settings_.grid.dx;
   if (gridHi.x() > settings_.hi.x() + sliver) freeArea_.addStaticObstacle(rectangle(Vec2(settings_.hi.x(), settings_.lo.y()), gridHi));
   if (gridHi.y() > settings_.hi.y() + sliver) freeArea_.addStaticObstacle(rectangle(Vec2(settings_.lo.x(), settings_.hi.y()), gridHi));
+  walkingDensity_.emplace(settings_.lo, settings_.hi, obstacles_, settings_.speedDensity);
   for (std::size_t k = 0; k < moving_.size(); ++k) {
     validateSimple(moving_[k].shape, fmt::format("moving obstacle {}", k));
     if (!moving_[k].velocity.allFinite() || !moving_[k].amplitude.allFinite() || !std::isfinite(moving_[k].frequency))
@@ -286,9 +287,18 @@ void CrowdSimulation::moveUic(double dt) {
     velocity = uicVelocity_;
   }
   const std::size_t n = position.size();
+  // Walking speeds along the fundamental diagram: v_max of the continuum (renorm) and the cap below.
+  std::span<const float> walk = speed;
+  if (n > 0 && settings_.speedDensity.enabled) {
+    walkDensity_.resize(n);
+    walkSpeed_.resize(n);
+    walkingDensity_->setPeople(agents_.position);
+    walkingDensity_->measure(position, preferred, speed, walkDensity_, walkSpeed_);
+    walk = walkSpeed_;
+  }
   if (n > 0 && settings_.uic) {
     freeArea_.update(discCentres_, discRadii_, movingNow_);
-    stats_.uic = uic_.project(position, preferred, speed, freeArea_.fraction(), dt, velocity);
+    stats_.uic = uic_.project(position, preferred, walk, freeArea_.fraction(), dt, velocity);
   } else {
     std::copy(preferred.begin(), preferred.end(), velocity.begin());
     stats_.uic = UicStats{};
@@ -302,10 +312,30 @@ void CrowdSimulation::moveUic(double dt) {
     // people cannot walk that fast, so the correction is spread over several steps instead.
     Vec2f v = velocity[k];
     const float norm = v.norm();
-    if (norm > agents_.maxSpeed[i]) v *= agents_.maxSpeed[i] / norm;
+    if (norm > walk[k]) v *= walk[k] / norm;
     agents_.velocity[i] = v;
     agents_.position[i] += h * v;
   });
+}
+
+CrowdSimulation::FreeWalkers CrowdSimulation::freeWalkers() {
+  const std::size_t n = agents_.size();
+  if (n == 0) return {};
+  frameDensity_.resize(n);
+  frameSpeed_.resize(n);
+  walkingDensity_->setPeople(agents_.position);
+  walkingDensity_->measure(agents_.position, agents_.preferredVelocity, agents_.maxSpeed, frameDensity_, frameSpeed_);
+  FreeWalkers out;
+  double sum = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (agents_.model[i] == AgentModel::Scripted || frameDensity_[i] >= kFreeDensity ||
+        agents_.preferredVelocity[i].norm() < 0.5f * agents_.maxSpeed[i])
+      continue;
+    ++out.count;
+    sum += agents_.velocity[i].norm();
+  }
+  out.meanSpeed = out.count > 0 ? sum / double(out.count) : 0.0;
+  return out;
 }
 
 void CrowdSimulation::arriveAndSpawn(double dt) {

@@ -25,6 +25,7 @@
 #include "msim/crowd/planner.hpp"
 #include "msim/crowd/speed_distribution.hpp"
 #include "msim/crowd/uic_projection.hpp"
+#include "msim/crowd/walking_density.hpp"
 
 namespace msim::crowd {
 
@@ -61,6 +62,9 @@ struct CrowdSettings {
   GridSpec<2> grid;                           // the continuum grid of the UIC
   bool uic = true;                            // off: agents walk their preferred velocity (Fig. 4.3b)
   UicSettings uicSettings;
+  // The UIC agents' walking speed falls with the density ahead along Weidmann's fundamental
+  // diagram (walking_density.hpp); disabled: the seed's constant v_max.
+  SpeedDensitySettings speedDensity;
   bool collisionResolution = true;            // off: Fig. 4.3c
   CollisionResolutionParams collision;
   OrcaParams orca;
@@ -115,6 +119,17 @@ class CrowdSimulation {
   // The fastest an agent may walk [m/s] (for CFL-like time step limits).
   double maxSpeed() const;
 
+  // Agents that want to walk (preferred speed at least half their maximum; scripted ones aside)
+  // and have free space ahead (fewer than kFreeDensity others per m^2 in the square ahead,
+  // walking_density.hpp): their number and mean speed. A crowd whose free walkers stand still has
+  // stalled, whatever the cause (a continuum that cannot work on its grid, a deadlock).
+  static constexpr double kFreeDensity = 1.0;
+  struct FreeWalkers {
+    std::size_t count = 0;
+    double meanSpeed = 0.0;  // [m/s]
+  };
+  FreeWalkers freeWalkers();
+
  private:
   void validateAgent(std::size_t i, const std::string& what) const;
   // Index of the agent with this id, size() if it has left.
@@ -157,6 +172,7 @@ class CrowdSimulation {
   float obstacleReach_ = 0.0f;
   FreeArea freeArea_;
   UicProjection uic_;
+  std::optional<WalkingDensity> walkingDensity_;  // speeds when speedDensity.enabled; freeWalkers()
   OrcaSolver orca_;
   CollisionResolver resolver_;
   CrowdStepStats stats_;
@@ -164,7 +180,7 @@ class CrowdSimulation {
 
   // Per-step scratch, kept to avoid allocation.
   std::vector<Vec2f> orcaVelocity_, discCentres_, uicPosition_, uicPreferred_, uicVelocity_;
-  std::vector<float> discRadii_, uicSpeed_;
+  std::vector<float> discRadii_, uicSpeed_, walkDensity_, walkSpeed_, frameDensity_, frameSpeed_;
   std::vector<std::uint32_t> uicIndex_;
   std::vector<std::uint8_t> remove_;
 };

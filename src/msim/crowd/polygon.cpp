@@ -101,6 +101,46 @@ bool segmentHitsPolygon(const Polygon& polygon, const Vec2& a, const Vec2& b) {
   return contains(polygon, 0.5 * (a + b));
 }
 
+double polygonDistance(const Polygon& a, const Polygon& b) {
+  if (contains(a, b.vertex(0)) || contains(b, a.vertex(0))) return 0.0;
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const Vec2 &p = a.vertex(i), &q = a.vertex(i + 1);
+    for (std::size_t j = 0; j < b.size(); ++j) {
+      const Vec2 &r = b.vertex(j), &s = b.vertex(j + 1);
+      if (segmentsIntersect(p, q, r, s)) return 0.0;
+      // Two disjoint segments are closest at an end point of one of them.
+      best = std::min({best, (closestPointOnSegment(p, q, r) - r).norm(), (closestPointOnSegment(p, q, s) - s).norm(),
+                       (closestPointOnSegment(r, s, p) - p).norm(), (closestPointOnSegment(r, s, q) - q).norm()});
+    }
+  }
+  return best;
+}
+
+double narrowestPassage(const std::vector<Polygon>& obstacles, const Vec2& lo, const Vec2& hi, double minWidth) {
+  double best = std::numeric_limits<double>::infinity();
+  auto consider = [&](double gap) {
+    if (gap >= minWidth) best = std::min(best, gap);
+  };
+  std::vector<Vec2> boxLo(obstacles.size()), boxHi(obstacles.size());
+  for (std::size_t k = 0; k < obstacles.size(); ++k) {
+    bounds(obstacles[k], boxLo[k], boxHi[k]);
+    for (int a = 0; a < 2; ++a) {
+      if (boxLo[k][a] > lo[a]) consider(boxLo[k][a] - lo[a]);
+      if (boxHi[k][a] < hi[a]) consider(hi[a] - boxHi[k][a]);
+    }
+  }
+  for (std::size_t k = 0; k < obstacles.size(); ++k)
+    for (std::size_t m = k + 1; m < obstacles.size(); ++m) {
+      // The bounds' gap is a lower bound of the polygons' distance: pairs farther apart than the
+      // narrowest passage found so far cannot narrow it.
+      const Vec2 gap = (boxLo[m] - boxHi[k]).cwiseMax(boxLo[k] - boxHi[m]).cwiseMax(0.0);
+      if (gap.norm() >= best) continue;
+      consider(polygonDistance(obstacles[k], obstacles[m]));
+    }
+  return best;
+}
+
 void validateSimple(const Polygon& polygon, const std::string& what) {
   const std::size_t n = polygon.size();
   if (n < 3) throw InputError(fmt::format("{}: a polygon needs at least 3 vertices, got {}", what, n));

@@ -34,6 +34,14 @@ bool segmentsIntersect(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& 
 // True if the open segment (a, b) crosses an edge of the polygon or runs through its inside.
 bool segmentHitsPolygon(const Polygon& polygon, const Vec2& a, const Vec2& b);
 
+// Distance between two polygons' closed regions: 0 where they touch, overlap or one holds the
+// other [m].
+double polygonDistance(const Polygon& a, const Polygon& b);
+// The narrowest passage of a walkable box [lo, hi] with these obstacles: the least gap, between
+// two obstacles or between an obstacle and the box's sides, that is at least `minWidth` wide
+// (narrower gaps pass no one and are walls in effect) [m]; infinity without one.
+double narrowestPassage(const std::vector<Polygon>& obstacles, const Vec2& lo, const Vec2& hi, double minWidth);
+
 // Throws InputError("<what>: ...") if the polygon has fewer than 3 vertices, a non-finite or
 // repeated vertex, zero area, or two non-adjacent edges that intersect (the message names the
 // edges). `what` names the object for the user, e.g. "obstacles[3]".

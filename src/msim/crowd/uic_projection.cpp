@@ -482,36 +482,6 @@ void UicProjection::subtractGradient(const MacGrid<2>& u, const Eigen::VectorXd&
   }
 }
 
-// Agents per free square metre over (2 w + 1)^2 cells, w = floor(0.75 m / dx) (about 1.5 m a
-// side): the window's agents over its free area (obstacles and walls hold no one, so a crowd
-// pressed against a door frame reads as dense as it is). Sums by rows, then by columns.
-void UicProjection::smoothDensity() {
-  const int nx = grid_.res.x(), ny = grid_.res.y();
-  const int w = static_cast<int>(std::floor(0.75 / grid_.dx));
-  if (localDensity_.count() != density_.count()) localDensity_ = rowSums_ = rowFree_ = Grid<float, 2>(grid_);
-  tbb::parallel_for(0, ny, [&](int j) {
-    for (int i = 0; i < nx; ++i) {
-      float mass = 0.0f, free = 0.0f;
-      for (int k = std::max(0, i - w); k <= std::min(nx - 1, i + w); ++k) {
-        mass += density_(IVec2(k, j));
-        free += freeArea_(IVec2(k, j));
-      }
-      rowSums_(IVec2(i, j)) = mass;
-      rowFree_(IVec2(i, j)) = free;
-    }
-  });
-  tbb::parallel_for(0, ny, [&](int j) {
-    for (int i = 0; i < nx; ++i) {
-      float mass = 0.0f, free = 0.0f;
-      for (int k = std::max(0, j - w); k <= std::min(ny - 1, j + w); ++k) {
-        mass += rowSums_(IVec2(i, k));
-        free += rowFree_(IVec2(i, k));
-      }
-      localDensity_(IVec2(i, j)) = free > 0.0f ? mass / free : 0.0f;
-    }
-  });
-}
-
 // renorm (eq. 4.11): scale the face velocity vector to v_max on faces that carry agents. The
 // tangential component is the density-weighted mean of the four neighbouring faces of the other
 // axis, so a uniform field is reproduced exactly and empty faces do not bias it towards zero.
@@ -550,13 +520,7 @@ void UicProjection::renorm(const MacGrid<2>& u, MacGrid<2>& out) const {
           }
           const float tangential = wSum > 0.0f ? wv / wSum : 0.0f;
           const float speed = std::sqrt(in[idx] * in[idx] + tangential * tangential);
-          float target = vmax[idx];
-          if (settings_.weidmannSpeeds) {
-            // The two cells beside the face: (i - 1, j) and (i, j) for x, (i, j - 1) and (i, j) for y.
-            const float local = 0.5f * (localDensity_(IVec2(i, j)) + localDensity_(IVec2(i + dc, j + dr)));
-            target = static_cast<float>(vmax[idx] * weidmannSpeed(local, settings_.weidmann) / settings_.weidmann.v0);
-          }
-          if (vmax[idx] > 0.0f && speed > minFraction * vmax[idx]) o[idx] = in[idx] * (target / speed);
+          if (vmax[idx] > 0.0f && speed > minFraction * vmax[idx]) o[idx] = in[idx] * (vmax[idx] / speed);
         }
     });
   }
@@ -641,7 +605,6 @@ const UicStats& UicProjection::project(std::span<const Vec2f> positions, std::sp
   assembleRhs(preferred_, dt, true, rhs_);
   const auto inner = solve(rhs_, innerPressure_);
   subtractGradient(preferred_, innerPressure_, inner_);
-  if (settings_.weidmannSpeeds) smoothDensity();
   renorm(inner_, renormed_);
   // Outer psolve on the renormalised velocities with the full sigma^n.
   assembleRhs(renormed_, dt, false, rhs_);

@@ -39,7 +39,6 @@
 #include "msim/core/mac_grid.hpp"
 #include "msim/core/transfer.hpp"
 #include "msim/crowd/agents.hpp"
-#include "msim/crowd/fundamental_diagram.hpp"
 #include "msim/numerics/bound_qp.hpp"
 #include "msim/numerics/bound_qp_mic0.hpp"
 
@@ -58,16 +57,6 @@ struct UicSettings {
   // Faces whose pressure-corrected speed is below this fraction of v_max keep their velocity in
   // renorm: their direction is noise (e.g. opposing streams cancelling).
   double renormMinFraction = 1e-3;
-  // Density-dependent walking speed, the extension ch. 4.4.1 suggests ("v_max ... can also be made
-  // variable for each grid cell, depending on the density ... agents in dense regions have been
-  // observed to walk more slowly (Fruin, 1971)"): renorm scales each face to
-  // v_max * v_W(rho_local) / v0 with Weidmann's fundamental diagram v_W (fundamental_diagram.hpp)
-  // instead of v_max. rho_local counts the agents per free square metre over a square of about
-  // 1.5 m (the areas Weidmann's densities were counted over): one agent splatted into a cell of
-  // 0.5 m reads 4 agents/m^2 there, which would slow a lone walker to a third of its speed. Off: the seed's constant v_max, under which a door at rho_max passes
-  // rho_max v_max (4 agents/(m s) at the defaults), two to three times what people achieve.
-  bool weidmannSpeeds = false;
-  WeidmannParams weidmann;
 };
 
 struct UicStats {
@@ -150,11 +139,7 @@ class UicProjection {
   };
   std::vector<SplatChunk> chunks_;
 
-  // weidmannSpeeds: the density averaged over about 1.5 x 1.5 m around each cell (localDensity).
-  void smoothDensity();
-
   Grid<float, 2> density_, pressure_, predicted_, freeArea_, ratio_;
-  Grid<float, 2> localDensity_, rowSums_, rowFree_;  // weidmannSpeeds: smoothed rho and its scratch
   MacGrid<2> faceDensity_, preferred_, speed_, inner_, renormed_, velocity_;
 
   std::array<std::vector<double>, 2> lowerWeight_;  // stencil of A (numerics/bound_qp_mic0.hpp)

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "msim/core/error.hpp"
+#include "msim/core/log.hpp"
 #include "msim/crowd/fundamental_diagram.hpp"
 #include "msim/crowd/measurement_line.hpp"
 #include "msim/crowd/metric_plots.hpp"
@@ -220,7 +221,10 @@ class CrowdPhenomenon final : public Phenomenon {
               {"nn_dense_agents", nn_.dense},
               {"nn_dense_ratio_sum", nn_.denseRatioSum},
               {"nn_dense_mean_ratio", nn_.dense > 0 ? nn_.meanDenseRatio() : 0.0},
-              {"nn_min_ratio", std::isfinite(nn_.minRatio) ? nn_.minRatio : 0.0}};
+              {"nn_min_ratio", std::isfinite(nn_.minRatio) ? nn_.minRatio : 0.0},
+              {"free_walkers", freeWalkers_.count},
+              {"free_walkers_mean_speed_mps", freeWalkers_.meanSpeed},
+              {"stalled", stalledNow_ ? 1 : 0}};
     for (std::size_t k = 0; k < setup_.lines.size(); ++k)
       s["line_" + setup_.lines[k].name + "_crossings"] = lineCrossings_[k];
     return s;
@@ -257,6 +261,9 @@ class CrowdPhenomenon final : public Phenomenon {
                                     {"dense_mean_distance_over_dmin", dense > 0 ? ratioSum / dense : 0.0},
                                     {"dense_threshold_per_m2", setup_.denseFraction * rhoMax()}};
     results["rho_max_per_m2"] = rhoMax();
+    int stalled = 0;
+    for (const json& f : frames) stalled += f.value("stalled", 0);
+    results["stalled_frames"] = stalled;
     results["planner"] = setup_.plannerName;
     json evacuation = json::object();
     for (double q : {0.5, 0.9, 1.0}) {
@@ -297,10 +304,28 @@ class CrowdPhenomenon final : public Phenomenon {
   }
 
   // Frame metrics, measured once per frame (every step would cost a Voronoi diagram per step).
+  // A crowd that stands still with room ahead has stalled: warn once (the frames are counted in
+  // run.json). Free walkers are those that want to walk and have fewer than 1 other per m^2 ahead
+  // (CrowdSimulation::freeWalkers); a stall needs at least 5 of them and 1% of the crowd.
+  void checkStall() {
+    static constexpr double kStalledSpeed = 0.2;  // [m/s]
+    freeWalkers_ = sim_->freeWalkers();
+    const std::size_t enough = std::max<std::size_t>(5, sim_->agents().size() / 100);
+    stalledNow_ = sim_->time() > 0.0 && freeWalkers_.count >= enough && freeWalkers_.meanSpeed < kStalledSpeed;
+    if (stalledNow_ && !warnedStall_) {
+      warnedStall_ = true;
+      logger().warn("{}: the crowd stalls at t = {:.4g} s: {} agents with free space ahead walk at {:.2g} m/s on average "
+                    "(below {} m/s); check crowd.uic.cell_size against the agents' diameter, and goals that cannot "
+                    "be reached (stalled frames are counted in run.json)",
+                    source_, sim_->time(), freeWalkers_.count, freeWalkers_.meanSpeed, kStalledSpeed);
+    }
+  }
+
   void measureFrame() {
     ScopedStage stage(timers_, "crowd: metrics");
     const crowd::Agents& a = sim_->agents();
     speed_ = crowd::speedStats(a.velocity);
+    checkStall();
     agentDensity_.clear();
     nn_ = crowd::NearestNeighbourFrame{};
     maxDensity_ = 0.0;
@@ -401,6 +426,9 @@ class CrowdPhenomenon final : public Phenomenon {
   double uicSolveSeconds_ = 0.0;  // QP solve time of those steps (Fig. 4.10)
   double iterationsPerStep_ = 0.0;  // of the last complete frame
   double solveMsPerStep_ = 0.0;     // of the last complete frame
+  crowd::CrowdSimulation::FreeWalkers freeWalkers_;
+  bool stalledNow_ = false;  // this frame
+  bool warnedStall_ = false;
 };
 
 void declare(Schema& root) { declareCrowdKeys(root); }

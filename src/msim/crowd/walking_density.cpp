@@ -1,0 +1,109 @@
+#include "msim/crowd/walking_density.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "msim/crowd/free_area.hpp"
+
+namespace msim::crowd {
+namespace {
+
+// The table's cell: fine enough that a door frame's corner cell misplaces little of a 1.5 m
+// square, coarse enough that a 400 m site stays a few million cells.
+constexpr double kTableCell = 0.25;
+
+void check(const SpeedDensitySettings& s) {
+  auto bad = [](const std::string& what) { throw std::invalid_argument("speed-density settings: " + what); };
+  if (!(s.window > 0.0) || !std::isfinite(s.window)) bad(fmt::format("window = {} m must be positive", s.window));
+  if (!(s.lookahead >= 0.0) || !(s.lookahead < 0.5 * s.window))
+    bad(fmt::format("lookahead = {} m must lie in [0, window / 2 = {})", s.lookahead, 0.5 * s.window));
+  if (!(s.minFreeArea > 0.0) || !std::isfinite(s.minFreeArea))
+    bad(fmt::format("minFreeArea = {} m^2 must be positive", s.minFreeArea));
+  if (!(s.weidmann.v0 > 0.0) || !(s.weidmann.gamma > 0.0) || !(s.weidmann.rhoJam > 0.0))
+    bad("Weidmann's v0, gamma and rho_jam must be positive");
+}
+
+}  // namespace
+
+WalkingDensity::WalkingDensity(const Vec2& lo, const Vec2& hi, std::span<const Polygon> obstacles,
+                               const SpeedDensitySettings& settings)
+    : settings_(settings), lo_(lo), hi_(hi) {
+  check(settings_);
+  const Vec2 extent = hi - lo;
+  if (!(extent.x() > 0.0) || !(extent.y() > 0.0)) throw std::invalid_argument("speed-density settings: empty walkable box");
+  nx_ = std::max(1, static_cast<int>(std::ceil(extent.x() / kTableCell)));
+  ny_ = std::max(1, static_cast<int>(std::ceil(extent.y() / kTableCell)));
+  cell_ = std::max(extent.x() / nx_, extent.y() / ny_);
+  FreeArea free(GridSpec<2>(lo, cell_, IVec2(nx_, ny_)));
+  for (const Polygon& p : obstacles) free.addStaticObstacle(p);
+  // Summed-area table over corners: table(i, j) = free area of [lo, lo + (i, j) cell].
+  const double area = cell_ * cell_;
+  const std::size_t stride = static_cast<std::size_t>(nx_) + 1;
+  table_.assign(stride * (static_cast<std::size_t>(ny_) + 1), 0.0);
+  for (int j = 0; j < ny_; ++j) {
+    double row = 0.0;
+    for (int i = 0; i < nx_; ++i) {
+      row += free.fraction()(IVec2(i, j)) * area;
+      table_[(j + 1) * stride + i + 1] = table_[j * stride + i + 1] + row;
+    }
+  }
+}
+
+double WalkingDensity::integral(double x, double y) const {
+  const double sx = std::clamp((x - lo_.x()) / cell_, 0.0, double(nx_));
+  const double sy = std::clamp((y - lo_.y()) / cell_, 0.0, double(ny_));
+  const int i = std::min(static_cast<int>(sx), nx_ - 1), j = std::min(static_cast<int>(sy), ny_ - 1);
+  const double fx = sx - i, fy = sy - j;
+  const std::size_t stride = static_cast<std::size_t>(nx_) + 1;
+  const double* row0 = table_.data() + static_cast<std::size_t>(j) * stride + i;
+  const double* row1 = row0 + stride;
+  return (1.0 - fy) * ((1.0 - fx) * row0[0] + fx * row0[1]) + fy * ((1.0 - fx) * row1[0] + fx * row1[1]);
+}
+
+double WalkingDensity::freeArea(const Vec2& c) const {
+  const double h = 0.5 * settings_.window;
+  const double x0 = std::max(c.x() - h, lo_.x()), x1 = std::min(c.x() + h, hi_.x());
+  const double y0 = std::max(c.y() - h, lo_.y()), y1 = std::min(c.y() + h, hi_.y());
+  if (!(x1 > x0) || !(y1 > y0)) return 0.0;
+  return std::max(0.0, integral(x1, y1) - integral(x0, y1) - integral(x1, y0) + integral(x0, y0));
+}
+
+void WalkingDensity::setPeople(std::span<const Vec2f> people) {
+  people_.build(people, static_cast<float>(settings_.window));
+}
+
+void WalkingDensity::measure(std::span<const Vec2f> positions, std::span<const Vec2f> preferred,
+                             std::span<const float> maxSpeed, std::span<float> density, std::span<float> speed) const {
+  const std::size_t n = positions.size();
+  if (preferred.size() != n || maxSpeed.size() != n || density.size() != n || speed.size() != n)
+    throw std::invalid_argument("WalkingDensity::measure: spans of different sizes");
+  const float half = static_cast<float>(0.5 * settings_.window);
+  const float ahead = static_cast<float>(settings_.lookahead);
+  const WeidmannParams& w = settings_.weidmann;
+  const std::span<const Vec2f> sorted = people_.sortedPoints();
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t k = r.begin(); k != r.end(); ++k) {
+      const float norm = preferred[k].norm();
+      const Vec2f c = norm > 0.0f ? Vec2f(positions[k] + preferred[k] * (ahead / norm)) : positions[k];
+      int inside = 0;
+      people_.forEachSlotRowNear(c, half, [&](std::uint32_t first, std::uint32_t last) {
+        for (std::uint32_t s = first; s < last; ++s) {
+          const Vec2f d = sorted[s] - c;
+          inside += std::abs(d.x()) <= half && std::abs(d.y()) <= half;
+        }
+      });
+      // The pedestrian stands in its own square (lookahead < window / 2): the others are one fewer.
+      const double others = std::max(0, inside - 1);
+      const double rho = others / std::max(settings_.minFreeArea, freeArea(c.cast<double>()));
+      density[k] = static_cast<float>(rho);
+      speed[k] = static_cast<float>(maxSpeed[k] * weidmannSpeed(rho, w) / w.v0);
+    }
+  });
+}
+
+}  // namespace msim::crowd
