@@ -5,12 +5,14 @@
 #include <cstdlib>
 #include <memory>
 #include <random>
+#include <vector>
 
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
 
 #include "msim/crowd/collision_resolution.hpp"
 #include "msim/crowd/orca.hpp"
+#include "msim/crowd/walking_density.hpp"
 
 namespace {
 
@@ -109,6 +111,21 @@ void BM_OrcaStep(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(n));
 }
+// The default model's walking speeds (walking_density.hpp): the neighbour grid of everyone and the
+// count of the others in each agent's square ahead, at 2 agents/m^2.
+void BM_WalkingSpeeds(benchmark::State& state) {
+  const std::size_t n = static_cast<std::size_t>(state.range(0));
+  const Agents a = denseCrowd(n, AgentModel::Uic);
+  const float side = std::sqrt(static_cast<float>(n) / 2.0f);
+  WalkingDensity walking(msim::Vec2(-1, -1), msim::Vec2(side + 1, side + 1), {}, {});
+  std::vector<float> density(n), speed(n);
+  for (auto _ : state) {
+    walking.measure(a.position, a.preferredVelocity, a.maxSpeed, density, speed);
+    benchmark::DoNotOptimize(speed.data());
+  }
+}
+
+BENCHMARK(BM_WalkingSpeeds)->Arg(10'000)->Arg(100'000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_OrcaStep)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace

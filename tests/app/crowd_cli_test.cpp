@@ -234,17 +234,17 @@ TEST(CrowdCli, FineDomainGridDoesNotStallTheCrowd) {
   EXPECT_NEAR(400 - whole.back(), 400 - half.back(), 0.1 * (400 - half.back()));
   EXPECT_GT(400 - half.back(), 30);
   // Cells that do not divide the floor (0.45 m across a 20 m width) leave its walls where the
-  // scene puts them: the evacuation room runs and empties as at 0.5 m (138 s).
+  // scene puts them: the evacuation room runs and empties as at 0.5 m (147 s).
   const json odd = runScene("crowd_grid_odd", std::string(MSIM_SOURCE_DIR) + "/scenes/crowd_evacuation_room.json",
                             "--set domain.resolution=80 --set outputs.png=false --set outputs.vdb=false "
                             "--set outputs.mp4=false --set crowd.trajectories=false");
   ASSERT_TRUE(odd.contains("results"));
-  EXPECT_NEAR(odd.at("results").at("evacuation").at("t100_s").get<double>(), 138.0, 13.8);
+  EXPECT_NEAR(odd.at("results").at("evacuation").at("t100_s").get<double>(), 147.0, 14.7);
 }
 
-// crowd.uic.speed_density = weidmann reads the density agents feel, counted over about 1.5 m: a
-// lone walker in a thin crowd keeps Weidmann's free speed, and the middle of a block at 2.5 /m^2
-// walks near Weidmann's 0.45 m/s there (the density of one 0.5 m cell would have slowed both).
+// The default speed_density = weidmann reads the density of the others in the 1.5 m square ahead: a
+// lone walker in a thin crowd keeps Weidmann's free speed, and the middle of a block walks near
+// Weidmann's speed for its density (the default's door capacities are in bottleneck_cli_test.cpp).
 TEST(CrowdCli, WeidmannSpeedsFollowTheFundamentalDiagram) {
   const auto meanSpeed = [](const std::string& name, int count, const std::string& region, double x0, double x1) {
     const fs::path dir = scratch(name);
@@ -265,9 +265,17 @@ TEST(CrowdCli, WeidmannSpeedsFollowTheFundamentalDiagram) {
   };
   // 200 agents over 100 x 8 m: 0.25 /m^2, Weidmann 1.33 m/s.
   EXPECT_NEAR(meanSpeed("crowd_fd_sparse", 200, R"({"type": "box", "min": [1, 1], "max": [100, 9]})", 0.0, 120.0), 1.33, 0.1);
-  // 1000 agents over 40 x 10 m: 2.5 /m^2, Weidmann 0.45 m/s (measured in the block's middle).
-  EXPECT_NEAR(meanSpeed("crowd_fd_dense", 1000, R"({"type": "box", "min": [10, 0], "max": [50, 10]})", 22.0, 38.0), 0.45,
-              0.07);
+  // Blocks of 40 x 10 m at 1, 2 and 2.5 /m^2, measured in their middle: Weidmann 1.05, 0.60 and
+  // 0.45 m/s; counting only the others ahead walks up to about 0.12 m/s faster.
+  const std::string block = R"({"type": "box", "min": [10, 0], "max": [50, 10]})";
+  const double at1 = meanSpeed("crowd_fd_1", 400, block, 22.0, 38.0), at2 = meanSpeed("crowd_fd_2", 800, block, 22.0, 38.0),
+               at25 = meanSpeed("crowd_fd_dense", 1000, block, 22.0, 38.0);
+  std::printf("speed at 1, 2, 2.5 /m^2: %.3f %.3f %.3f m/s (Weidmann 1.05 0.60 0.45)\n", at1, at2, at25);
+  EXPECT_NEAR(at1, 1.05, 0.15);
+  EXPECT_NEAR(at2, 0.60, 0.15);
+  EXPECT_NEAR(at25, 0.45, 0.07);
+  EXPECT_GT(at1, at2);
+  EXPECT_GT(at2, at25);
 }
 
 // RiMEA test 9's idea on scenes/crowd_evacuation_room.json: 1000 people leave a 30 x 20 m room
@@ -297,7 +305,8 @@ TEST(CrowdCli, EvacuationRoomTakesAboutTwiceAsLongThroughTwoExits) {
 
 // RiMEA test 7 (a population's walking speeds): 200 agents spread thinly along a 100 m corridor,
 // speeds uniform in [0.8, 1.6] m/s, walk east; after 5 s their measured speeds cover that range
-// with its mean.
+// with its mean. Placed at random, a few have someone in the square ahead of them and walk a little
+// below their own speed (the default model's fundamental diagram: 0.85 of it at 0.9 /m^2).
 TEST(CrowdCli, GroupWalksWithItsSpeedDistribution) {
   const fs::path dir = scratch("crowd_speed_spread");
   writeText(dir / "s.json", R"({
@@ -320,9 +329,10 @@ TEST(CrowdCli, GroupWalksWithItsSpeedDistribution) {
     sum += speed, lo = std::min(lo, speed), hi = std::max(hi, speed), ++n;
   }
   ASSERT_EQ(n, 200);
+  std::printf("speeds uniform in [0.8, 1.6]: walked %.2f-%.2f m/s, mean %.3f\n", lo, hi, sum / n);
   EXPECT_NEAR(sum / n, 1.2, 0.05);
   EXPECT_LT(lo, 0.9);
-  EXPECT_GT(lo, 0.7);
+  EXPECT_GT(lo, 0.6);
   EXPECT_GT(hi, 1.5);
   EXPECT_LT(hi, 1.7);
 }

@@ -26,7 +26,6 @@ struct Measured {
 
 Measured measure(WalkingDensity& wd, const std::vector<Vec2f>& people, const std::vector<Vec2f>& heading,
                  float maxSpeed = 1.34f) {
-  wd.setPeople(people);
   Measured m{std::vector<float>(people.size()), std::vector<float>(people.size())};
   const std::vector<float> speeds(people.size(), maxSpeed);
   wd.measure(people, heading, speeds, m.density, m.speed);
@@ -79,7 +78,7 @@ TEST(WalkingDensity, FreeAreaOfTheSquareMatchesExactClipping) {
 
 TEST(WalkingDensity, CountsTheOthersInTheSquareAhead) {
   // A lattice of spacing 0.5 m (4 /m^2) at x, y = 0.25 + 0.5 k, walking +x. The square ahead of a
-  // walker at a lattice point spans [x - 0.25, x + 1.25] x [y - 0.75, y + 0.75]: 3 x 3 points, 8 of
+  // walker at a lattice point spans [x - 0.25, x + 1.25] x [y - 0.75, y + 0.75]: 3 x 3 people, 8 of
   // them others, 8 / 2.25 = 3.56 /m^2.
   WalkingDensity wd(Vec2(0, 0), Vec2(20, 20), {}, {});
   std::vector<Vec2f> people, heading;
@@ -89,15 +88,23 @@ TEST(WalkingDensity, CountsTheOthersInTheSquareAhead) {
       heading.emplace_back(1.3f, 0.0f);
     }
   const Measured m = measure(wd, people, heading, 1.4f);
-  const std::size_t middle = 20 * 40 + 20;
-  EXPECT_NEAR(m.density[middle], 8.0 / 2.25, 1e-5);
-  EXPECT_NEAR(m.speed[middle], 1.4 * weidmannSpeed(8.0 / 2.25) / 1.34, 1e-5);
-  // At the east edge the square ahead leaves the box: 1 x 3 points on 0.5 x 1.5 m^2 of floor.
-  const std::size_t east = 20 * 40 + 39;
-  EXPECT_NEAR(m.density[east], 2.0 / (0.5 * 1.5), 1e-5);
-  // Walking -y instead: the same count by symmetry.
-  std::vector<Vec2f> south(heading.size(), Vec2f(0.0f, -1.0f));
-  EXPECT_NEAR(measure(wd, people, south).density[middle], 8.0 / 2.25, 1e-5);
+  for (const int i : {10, 20, 30})
+    for (const int j : {10, 20, 30}) {
+      const std::size_t k = static_cast<std::size_t>(j) * 40 + i;
+      EXPECT_NEAR(m.density[k], 8.0 / 2.25, 1e-4) << i << " " << j;
+      EXPECT_NEAR(m.speed[k], 1.4 * weidmannSpeed(8.0 / 2.25) / 1.34, 1e-4);
+    }
+  // Standing still, the square is centred on the person: 8 others again.
+  const std::vector<Vec2f> still(heading.size(), Vec2f(0.0f, 0.0f));
+  EXPECT_NEAR(measure(wd, people, still).density[20 * 40 + 20], 8.0 / 2.25, 1e-4);
+  // Every other column (spacing 1 m along x): 2 x 3 people in the square, 5 others.
+  std::vector<Vec2f> sparse, sparseHeading;
+  for (std::size_t k = 0; k < people.size(); k += 2) {
+    sparse.push_back(people[k]);
+    sparseHeading.push_back(heading[k]);
+  }
+  const Measured half = measure(wd, sparse, sparseHeading);
+  EXPECT_NEAR(half.density[20 * 20 + 10], 5.0 / 2.25, 1e-4);
 }
 
 TEST(WalkingDensity, LoneWalkerKeepsItsFreeSpeedAndWallsCountAsCovered) {
@@ -106,14 +113,21 @@ TEST(WalkingDensity, LoneWalkerKeepsItsFreeSpeedAndWallsCountAsCovered) {
   const Measured alone = measure(wd, {Vec2f(3, 5)}, {Vec2f(1, 0)}, 1.2f);
   EXPECT_EQ(alone.density[0], 0.0f);
   EXPECT_EQ(alone.speed[0], 1.2f);
-  // Two walkers side by side 0.6 m before a 0.5 m wall: the square ahead of each, x in
-  // [9.15, 10.65], holds the other on 1.0 x 1.5 m^2 of floor.
-  const Measured pair = measure(wd, {Vec2f(9.4f, 5.0f), Vec2f(9.4f, 5.6f)}, {Vec2f(1, 0), Vec2f(1, 0)});
-  EXPECT_NEAR(pair.density[0], 1.0 / 1.5, 1e-4);
-  EXPECT_NEAR(pair.speed[0], weidmannSpeed(1.0 / 1.5), 1e-5);
-  // Standing still (no preferred direction): the square is centred on the walker.
-  const Measured still = measure(wd, {Vec2f(9.0f, 5.0f), Vec2f(9.5f, 5.0f)}, {Vec2f(0, 0), Vec2f(0, 0)});
-  EXPECT_NEAR(still.density[0], 1.0 / 2.25, 1e-4);
+  // Nine people on a 0.5 m lattice just before the wall: walking into it, the square ahead of the
+  // middle one ([9.2, 10.7] in x) holds 5 others on 1.0 x 1.5 m^2 of floor (the wall covers the
+  // rest); walking away, 5 others on 2.25 m^2.
+  std::vector<Vec2f> block, east, west;
+  for (int j = -1; j <= 1; ++j)
+    for (int i = -1; i <= 1; ++i) {
+      block.emplace_back(9.45f + 0.5f * i, 5.0f + 0.5f * j);
+      east.emplace_back(1.0f, 0.0f);
+      west.emplace_back(-1.0f, 0.0f);
+    }
+  const Measured intoWall = measure(wd, block, east), away = measure(wd, block, west);
+  EXPECT_NEAR(wd.freeArea(Vec2(9.95, 5.0)), 2.25 - 0.5 * 1.5, 1e-9);
+  EXPECT_NEAR(intoWall.density[4], 5.0 / 1.5, 1e-4);
+  EXPECT_NEAR(away.density[4], 5.0 / 2.25, 1e-4);
+  EXPECT_LT(intoWall.speed[4], away.speed[4]);
 }
 
 TEST(WalkingDensity, RejectsSettingsOutOfRange) {

@@ -250,11 +250,23 @@ void CrowdSimulation::moveOrca(double dt) {
   });
 }
 
+// Each agent's speed on the fundamental diagram for the density ahead (walking_density.hpp), for
+// the UIC agents' step.
+void CrowdSimulation::walkingSpeeds() {
+  const std::size_t n = agents_.size();
+  walkDensity_.resize(n);
+  walkSpeed_.resize(n);
+  walkingDensity_->measure(agents_.position, agents_.preferredVelocity, agents_.maxSpeed, walkDensity_, walkSpeed_);
+}
+
 void CrowdSimulation::moveUic(double dt) {
   discCentres_.clear();
   discRadii_.clear();
   std::span<const Vec2f> position = agents_.position, preferred = agents_.preferredVelocity;
-  std::span<const float> speed = agents_.maxSpeed;
+  // Walking speeds: v_max of the continuum (renorm) and the cap below.
+  const std::span<const float> walking = settings_.speedDensity.enabled ? std::span<const float>(walkSpeed_)
+                                                                        : std::span<const float>(agents_.maxSpeed);
+  std::span<const float> speed = walking;
   std::span<Vec2f> velocity = agents_.velocity;
   // All agents UIC (the usual case): the grid transfers read the agents' own arrays. Otherwise the
   // UIC agents are compacted into contiguous arrays.
@@ -279,7 +291,7 @@ void CrowdSimulation::moveUic(double dt) {
       const std::size_t i = uicIndex_[k];
       uicPosition_[k] = agents_.position[i];
       uicPreferred_[k] = agents_.preferredVelocity[i];
-      uicSpeed_[k] = agents_.maxSpeed[i];
+      uicSpeed_[k] = walking[i];
     });
     position = uicPosition_;
     preferred = uicPreferred_;
@@ -287,18 +299,9 @@ void CrowdSimulation::moveUic(double dt) {
     velocity = uicVelocity_;
   }
   const std::size_t n = position.size();
-  // Walking speeds along the fundamental diagram: v_max of the continuum (renorm) and the cap below.
-  std::span<const float> walk = speed;
-  if (n > 0 && settings_.speedDensity.enabled) {
-    walkDensity_.resize(n);
-    walkSpeed_.resize(n);
-    walkingDensity_->setPeople(agents_.position);
-    walkingDensity_->measure(position, preferred, speed, walkDensity_, walkSpeed_);
-    walk = walkSpeed_;
-  }
   if (n > 0 && settings_.uic) {
     freeArea_.update(discCentres_, discRadii_, movingNow_);
-    stats_.uic = uic_.project(position, preferred, walk, freeArea_.fraction(), dt, velocity);
+    stats_.uic = uic_.project(position, preferred, speed, freeArea_.fraction(), dt, velocity);
   } else {
     std::copy(preferred.begin(), preferred.end(), velocity.begin());
     stats_.uic = UicStats{};
@@ -312,7 +315,7 @@ void CrowdSimulation::moveUic(double dt) {
     // people cannot walk that fast, so the correction is spread over several steps instead.
     Vec2f v = velocity[k];
     const float norm = v.norm();
-    if (norm > walk[k]) v *= walk[k] / norm;
+    if (norm > speed[k]) v *= speed[k] / norm;
     agents_.velocity[i] = v;
     agents_.position[i] += h * v;
   });
@@ -323,7 +326,6 @@ CrowdSimulation::FreeWalkers CrowdSimulation::freeWalkers() {
   if (n == 0) return {};
   frameDensity_.resize(n);
   frameSpeed_.resize(n);
-  walkingDensity_->setPeople(agents_.position);
   walkingDensity_->measure(agents_.position, agents_.preferredVelocity, agents_.maxSpeed, frameDensity_, frameSpeed_);
   FreeWalkers out;
   double sum = 0.0;
@@ -413,6 +415,10 @@ void CrowdSimulation::step(double dt, StageTimers* timers) {
     ScopedStage s(t, "crowd: scripted + orca");
     moveScripted(dt);
     moveOrca(dt);
+  }
+  if (settings_.speedDensity.enabled && stats_.uicAgents > 0) {
+    ScopedStage s(t, "crowd: walking speeds");
+    walkingSpeeds();
   }
   {
     ScopedStage s(t, "crowd: uic");

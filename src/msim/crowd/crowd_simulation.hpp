@@ -137,6 +137,7 @@ class CrowdSimulation {
   void plan();
   void moveScripted(double dt);
   void moveOrca(double dt);
+  void walkingSpeeds();
   void moveUic(double dt);
   void arriveAndSpawn(double dt);
   // Static and moving obstacles at time t, indexed for the local passes (only rebuilt when some move).

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>
@@ -52,6 +53,7 @@ WalkingDensity::WalkingDensity(const Vec2& lo, const Vec2& hi, std::span<const P
       table_[(j + 1) * stride + i + 1] = table_[j * stride + i + 1] + row;
     }
   }
+  people_.assign(table_.size(), 0);
 }
 
 double WalkingDensity::integral(double x, double y) const {
@@ -73,33 +75,61 @@ double WalkingDensity::freeArea(const Vec2& c) const {
   return std::max(0.0, integral(x1, y1) - integral(x0, y1) - integral(x1, y0) + integral(x0, y0));
 }
 
-void WalkingDensity::setPeople(std::span<const Vec2f> people) {
-  people_.build(people, static_cast<float>(settings_.window));
-}
-
-void WalkingDensity::measure(std::span<const Vec2f> positions, std::span<const Vec2f> preferred,
-                             std::span<const float> maxSpeed, std::span<float> density, std::span<float> speed) const {
-  const std::size_t n = positions.size();
+void WalkingDensity::measure(std::span<const Vec2f> people, std::span<const Vec2f> preferred,
+                             std::span<const float> maxSpeed, std::span<float> density, std::span<float> speed) {
+  const std::size_t n = people.size();
   if (preferred.size() != n || maxSpeed.size() != n || density.size() != n || speed.size() != n)
     throw std::invalid_argument("WalkingDensity::measure: spans of different sizes");
+  if (n == 0) return;
+  const std::size_t stride = static_cast<std::size_t>(nx_) + 1;
+  const float x0 = static_cast<float>(lo_.x()), y0 = static_cast<float>(lo_.y()), inv = static_cast<float>(1.0 / cell_);
+  const auto cellOf = [&](const Vec2f& p) {
+    const int i = std::clamp(static_cast<int>((p.x() - x0) * inv), 0, nx_ - 1);
+    const int j = std::clamp(static_cast<int>((p.y() - y0) * inv), 0, ny_ - 1);
+    return std::pair{i, j};
+  };
+  // People per cell, stored at the cell's upper corner, then summed along rows (rows in parallel)
+  // and down columns (blocks of columns in parallel, row by row within a block).
+  tbb::parallel_for(0, ny_ + 1, [&](int j) { std::fill_n(people_.data() + j * stride, stride, 0u); });
+  for (const Vec2f& p : people) {
+    const auto [i, j] = cellOf(p);
+    ++people_[(j + 1) * stride + i + 1];
+  }
+  tbb::parallel_for(1, ny_ + 1, [&](int j) {
+    std::uint32_t* row = people_.data() + j * stride;
+    for (int i = 1; i <= nx_; ++i) row[i] += row[i - 1];
+  });
+  constexpr int kColumns = 512;
+  tbb::parallel_for(0, (nx_ + kColumns) / kColumns, [&](int block) {
+    const int first = 1 + block * kColumns, last = std::min(nx_, first + kColumns - 1);
+    for (int j = 2; j <= ny_; ++j) {
+      std::uint32_t* row = people_.data() + j * stride;
+      const std::uint32_t* below = row - stride;
+      for (int i = first; i <= last; ++i) row[i] += below[i];
+    }
+  });
   const float half = static_cast<float>(0.5 * settings_.window);
   const float ahead = static_cast<float>(settings_.lookahead);
   const WeidmannParams& w = settings_.weidmann;
-  const std::span<const Vec2f> sorted = people_.sortedPoints();
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+  const std::uint32_t* count = people_.data();
+  const double* free = table_.data();
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t k = r.begin(); k != r.end(); ++k) {
       const float norm = preferred[k].norm();
-      const Vec2f c = norm > 0.0f ? Vec2f(positions[k] + preferred[k] * (ahead / norm)) : positions[k];
-      int inside = 0;
-      people_.forEachSlotRowNear(c, half, [&](std::uint32_t first, std::uint32_t last) {
-        for (std::uint32_t s = first; s < last; ++s) {
-          const Vec2f d = sorted[s] - c;
-          inside += std::abs(d.x()) <= half && std::abs(d.y()) <= half;
-        }
-      });
-      // The pedestrian stands in its own square (lookahead < window / 2): the others are one fewer.
-      const double others = std::max(0, inside - 1);
-      const double rho = others / std::max(settings_.minFreeArea, freeArea(c.cast<double>()));
+      const Vec2f c = norm > 0.0f ? Vec2f(people[k] + preferred[k] * (ahead / norm)) : people[k];
+      // The square's sides on the nearest cell lines, clamped to the box.
+      const auto line = [&](float x, float origin, int cells) {
+        return static_cast<std::size_t>(std::clamp(static_cast<int>(std::lround((x - origin) * inv)), 0, cells));
+      };
+      const std::size_t ia = line(c.x() - half, x0, nx_), ib = line(c.x() + half, x0, nx_);
+      const std::size_t ja = line(c.y() - half, y0, ny_), jb = line(c.y() + half, y0, ny_);
+      const auto box = [&](const auto* t) { return t[jb * stride + ib] - t[ja * stride + ib] - t[jb * stride + ia] + t[ja * stride + ia]; };
+      const std::uint32_t inside = box(count);
+      // The person itself, unless the snapped square left its cell out.
+      const auto [pi, pj] = cellOf(people[k]);
+      const bool self = std::size_t(pi) >= ia && std::size_t(pi) < ib && std::size_t(pj) >= ja && std::size_t(pj) < jb;
+      const double others = double(inside) - (self ? 1.0 : 0.0);
+      const double rho = std::max(0.0, others) / std::max(settings_.minFreeArea, box(free));
       density[k] = static_cast<float>(rho);
       speed[k] = static_cast<float>(maxSpeed[k] * weidmannSpeed(rho, w) / w.v0);
     }

@@ -19,20 +19,20 @@
 // door has the queue behind and free space ahead, and walks out at the speed that space allows.
 // Counting only the others gives a lone walker its free speed. Calibration (docs/evacuation.md):
 // with these two geometric choices and no fitted constant, doors of 0.8, 1.2, 1.6 and 2.4 m pass
-// 1.6-2.0 agents/(m s).
+// 1.6-1.9 agents/(m s).
 //
-// The free area comes from a summed-area table of the static obstacles' free fractions on a fine
-// grid (cells of at most 0.25 m), read with bilinear interpolation, which is exact for the
-// piecewise-constant fractions: the free area of any square costs four lookups. Outside the
-// walkable box counts as covered; moving obstacles (vehicles) count as free, so a pedestrian beside
-// a vehicle reads a slightly lower density than it stands in.
+// Both the people and the free area of a square come from summed-area tables on a fine grid
+// (cells of at most 0.25 m): the static obstacles' free area once, the people counted per cell each
+// step. The square is snapped to the nearest cell lines (its sides move by at most half a cell), so
+// each pedestrian costs eight lookups whatever the density. Outside the walkable box counts as
+// covered; moving obstacles (vehicles) count as free, so a pedestrian beside a vehicle reads a
+// slightly lower density than it stands in.
+#include <cstdint>
 #include <span>
 #include <vector>
 
-#include "msim/core/grid.hpp"
 #include "msim/core/vec.hpp"
 #include "msim/crowd/fundamental_diagram.hpp"
-#include "msim/crowd/neighbour_grid.hpp"
 #include "msim/crowd/polygon.hpp"
 
 namespace msim::crowd {
@@ -54,16 +54,14 @@ class WalkingDensity {
   // constants <= 0) or an empty box, InputError for a degenerate polygon (as FreeArea).
   WalkingDensity(const Vec2& lo, const Vec2& hi, std::span<const Polygon> obstacles, const SpeedDensitySettings& settings);
 
-  // Counts everyone at `people` (all agents, whatever their model) for the next measure() calls.
-  void setPeople(std::span<const Vec2f> people);
-  // For each pedestrian k at positions[k] (one of the people set, so counted once in its own
-  // square and subtracted) walking along preferred[k]: rho_k, the others per free square metre
-  // ahead, and speed[k] = maxSpeed[k] v_W(rho_k) / v0. Spans of equal size; parallel, no allocation.
-  void measure(std::span<const Vec2f> positions, std::span<const Vec2f> preferred, std::span<const float> maxSpeed,
-               std::span<float> density, std::span<float> speed) const;
+  // For each person k at people[k] (everyone in the scene, whatever their model) walking along
+  // preferred[k]: rho_k, the others per free square metre in the square ahead, and
+  // speed[k] = maxSpeed[k] v_W(rho_k) / v0. Spans of equal size; parallel; no allocation once warm.
+  void measure(std::span<const Vec2f> people, std::span<const Vec2f> preferred, std::span<const float> maxSpeed,
+               std::span<float> density, std::span<float> speed);
 
   // The free area [m^2] of the axis-aligned square of side `window` centred at c (clamped to the
-  // walkable box).
+  // walkable box), exact for the table's cells (bilinear between its corners).
   double freeArea(const Vec2& c) const;
   const SpeedDensitySettings& settings() const { return settings_; }
 
@@ -74,8 +72,8 @@ class WalkingDensity {
   Vec2 lo_, hi_;
   double cell_ = 0.25;
   int nx_ = 0, ny_ = 0;
-  std::vector<double> table_;  // (nx_ + 1) x (ny_ + 1) corner values: free area of [lo, corner]
-  NeighbourGrid people_;
+  std::vector<double> table_;          // (nx_ + 1) x (ny_ + 1) corners: free area of [lo, corner]
+  std::vector<std::uint32_t> people_;  // the same corners: people in [lo, corner], this step
 };
 
 }  // namespace msim::crowd
