@@ -52,6 +52,13 @@ void BM_Building2k(benchmark::State& state) { stepScene(state, scenePath("crowd_
 void BM_TradeShow80k(benchmark::State& state) { stepScene(state, scenePath("crowd_trade_show"), {}, 20); }
 void BM_Campsite100k(benchmark::State& state) { stepScene(state, scenePath("crowd_campsite"), {}, 20); }
 void BM_Mosque25k(benchmark::State& state) { stepScene(state, scenePath("crowd_mosque"), {}, 50); }
+// The same scenes with the default model's walking speeds (the scene files keep the seed's constant
+// speeds for its figures): its cost against Table 4.1's.
+const std::vector<std::string> kDefaultModel = {"crowd.uic.speed_density=weidmann"};
+void BM_Circle10kDefaultModel(benchmark::State& state) { stepScene(state, scenePath("crowd_circle"), kDefaultModel, 150); }
+void BM_TradeShow80kDefaultModel(benchmark::State& state) {
+  stepScene(state, scenePath("crowd_trade_show"), kDefaultModel, 20);
+}
 
 // Fig. 4.11: the circle with N agents (range 0, thousands), the disc and the domain grown by
 // sqrt(N / 10k) so density and cell size (2.5 m) stay those of the 10k scene; range 1 picks the
@@ -97,6 +104,8 @@ BENCHMARK(BM_Building2k)->Unit(benchmark::kMillisecond)->Iterations(50);
 BENCHMARK(BM_Mosque25k)->Unit(benchmark::kMillisecond)->Iterations(10);
 BENCHMARK(BM_TradeShow80k)->Unit(benchmark::kMillisecond)->Iterations(10);
 BENCHMARK(BM_Campsite100k)->Unit(benchmark::kMillisecond)->Iterations(10);
+BENCHMARK(BM_Circle10kDefaultModel)->Unit(benchmark::kMillisecond)->Iterations(100);
+BENCHMARK(BM_TradeShow80kDefaultModel)->Unit(benchmark::kMillisecond)->Iterations(10);
 BENCHMARK(BM_CircleScaling)
     ->ArgsProduct({{10, 30, 100, 300, 1000}, {0, 1}})
     ->Unit(benchmark::kMillisecond)

@@ -58,18 +58,21 @@ void expectOneTrajectoryRowPerAgentFrame(const fs::path& out, const json& run) {
 
 }  // namespace
 
-TEST(CrowdCli, CircleKeepsTheSeedsSpacing) {
-  // Fig. 4.5, 10,000 agents on 40 x 40 cells, the first 30 s (they meet in the middle at ~15 s).
-  const json run = runScene("crowd_circle", std::string(MSIM_SOURCE_DIR) + "/scenes/crowd_circle.json",
+// Fig. 4.5, 10,000 agents on 40 x 40 cells, the first 30 s (they meet in the middle at ~15 s), in
+// the seed's model (as the scene file runs) and in the default one.
+class CrowdCircle : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(CrowdCircle, KeepsTheSeedsSpacing) {
+  const json run = runScene("crowd_circle_" + GetParam(), std::string(MSIM_SOURCE_DIR) + "/scenes/crowd_circle.json",
                             "--frames 150 --set outputs.png=false --set outputs.vdb=false --set outputs.mp4=false "
-                            "--set crowd.trajectories=false");
+                            "--set crowd.trajectories=false --set crowd.uic.speed_density=" + GetParam());
   ASSERT_TRUE(run.contains("results"));
   const json& nn = run.at("results").at("nearest_neighbour");
   const double closer = nn.at("fraction_closer_than_dmin").get<double>();
   const double spacing = nn.at("dense_mean_distance_over_dmin").get<double>();
-  std::printf("circle: %.4f%% of agent-frames closer than d_min (seed < 0.12%%), mean nearest distance in dense "
+  std::printf("circle (%s): %.4f%% of agent-frames closer than d_min (seed < 0.12%%), mean nearest distance in dense "
               "regions %.3f d_min (seed 1.25) over %.0f dense agent-frames\n",
-              100 * closer, spacing, nn.at("dense_agent_frames").get<double>());
+              GetParam().c_str(), 100 * closer, spacing, nn.at("dense_agent_frames").get<double>());
   EXPECT_LT(closer, 0.005);
   EXPECT_GT(spacing, 1.1);
   EXPECT_LT(spacing, 1.35);
@@ -80,6 +83,8 @@ TEST(CrowdCli, CircleKeepsTheSeedsSpacing) {
   EXPECT_LE(worst, 1.05);
   EXPECT_GT(worst, 0.95);
 }
+
+INSTANTIATE_TEST_SUITE_P(CrowdCli, CrowdCircle, ::testing::Values("constant", "weidmann"));
 
 TEST(CrowdCli, DoorwayNeedsBothUicAndPairwiseResolution) {
   // Fig. 4.3 (a) both, (b) without UIC, (c) without collision resolution, in the seed's model
