@@ -132,7 +132,7 @@ TEST(WalkingDensity, LoneWalkerKeepsItsFreeSpeedAndWallsCountAsCovered) {
 
 TEST(WalkingDensity, RejectsSettingsOutOfRange) {
   SpeedDensitySettings s;
-  s.lookahead = 0.75;  // the square would no longer hold its walker
+  s.lookahead = 0.6;  // the snapped square might no longer hold its walker
   EXPECT_THROW(WalkingDensity(Vec2(0, 0), Vec2(10, 10), {}, s), std::invalid_argument);
   s = {};
   s.window = 0.0;

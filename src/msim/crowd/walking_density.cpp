@@ -21,8 +21,10 @@ constexpr double kTableCell = 0.25;
 void check(const SpeedDensitySettings& s) {
   auto bad = [](const std::string& what) { throw std::invalid_argument("speed-density settings: " + what); };
   if (!(s.window > 0.0) || !std::isfinite(s.window)) bad(fmt::format("window = {} m must be positive", s.window));
-  if (!(s.lookahead >= 0.0) || !(s.lookahead < 0.5 * s.window))
-    bad(fmt::format("lookahead = {} m must lie in [0, window / 2 = {})", s.lookahead, 0.5 * s.window));
+  // The person must stay inside its own square after snapping (measure()).
+  if (!(s.lookahead >= 0.0) || !(s.lookahead <= 0.5 * s.window - kTableCell))
+    bad(fmt::format("lookahead = {} m must lie in [0, window / 2 - {} = {}]", s.lookahead, kTableCell,
+                    0.5 * s.window - kTableCell));
   if (!(s.minFreeArea > 0.0) || !std::isfinite(s.minFreeArea))
     bad(fmt::format("minFreeArea = {} m^2 must be positive", s.minFreeArea));
   if (!(s.weidmann.v0 > 0.0) || !(s.weidmann.gamma > 0.0) || !(s.weidmann.rhoJam > 0.0))
@@ -119,17 +121,17 @@ void WalkingDensity::measure(std::span<const Vec2f> people, std::span<const Vec2
       const Vec2f c = norm > 0.0f ? Vec2f(people[k] + preferred[k] * (ahead / norm)) : people[k];
       // The square's sides on the nearest cell lines, clamped to the box.
       const auto line = [&](float x, float origin, int cells) {
-        return static_cast<std::size_t>(std::clamp(static_cast<int>(std::lround((x - origin) * inv)), 0, cells));
+        return static_cast<std::size_t>(std::clamp(static_cast<int>(std::floor((x - origin) * inv + 0.5f)), 0, cells));
       };
       const std::size_t ia = line(c.x() - half, x0, nx_), ib = line(c.x() + half, x0, nx_);
       const std::size_t ja = line(c.y() - half, y0, ny_), jb = line(c.y() + half, y0, ny_);
       const auto box = [&](const auto* t) { return t[jb * stride + ib] - t[ja * stride + ib] - t[jb * stride + ia] + t[ja * stride + ia]; };
+      // The person is at least window / 2 - lookahead (>= one cell) inside the square, and snapping
+      // moves a side by at most half a cell onto a cell line: its cell is counted, and the others
+      // are one fewer.
       const std::uint32_t inside = box(count);
-      // The person itself, unless the snapped square left its cell out.
-      const auto [pi, pj] = cellOf(people[k]);
-      const bool self = std::size_t(pi) >= ia && std::size_t(pi) < ib && std::size_t(pj) >= ja && std::size_t(pj) < jb;
-      const double others = double(inside) - (self ? 1.0 : 0.0);
-      const double rho = std::max(0.0, others) / std::max(settings_.minFreeArea, box(free));
+      const double others = inside > 0 ? double(inside - 1) : 0.0;
+      const double rho = others / std::max(settings_.minFreeArea, box(free));
       density[k] = static_cast<float>(rho);
       speed[k] = static_cast<float>(maxSpeed[k] * weidmannSpeed(rho, w) / w.v0);
     }

@@ -41,7 +41,7 @@ struct SpeedDensitySettings {
   bool enabled = true;     // off: the seed's constant v_max (Narain ch. 4.4.1)
   WeidmannParams weidmann;
   double window = 1.5;     // side of the counting square [m]
-  double lookahead = 0.5;  // its centre ahead of the pedestrian [m], below window / 2 so it holds them
+  double lookahead = 0.5;  // its centre ahead of the pedestrian [m], at most window / 2 - 0.25 so it holds them
   // The least free area a square counts as [m^2]: a pedestrian squeezed into a corner, with a
   // sliver of walkable floor in its square, does not read an extreme density from one neighbour.
   double minFreeArea = 0.5;
@@ -50,7 +50,7 @@ struct SpeedDensitySettings {
 class WalkingDensity {
  public:
   // The walkable box [lo, hi] and its static obstacles. Throws std::invalid_argument for settings
-  // out of range (window <= 0, lookahead < 0 or >= window / 2, minFreeArea <= 0, Weidmann
+  // out of range (window <= 0, lookahead < 0 or > window / 2 - 0.25 m, minFreeArea <= 0, Weidmann
   // constants <= 0) or an empty box, InputError for a degenerate polygon (as FreeArea).
   WalkingDensity(const Vec2& lo, const Vec2& hi, std::span<const Polygon> obstacles, const SpeedDensitySettings& settings);
 
