@@ -91,20 +91,27 @@ void WalkingDensity::measure(std::span<const Vec2f> people, std::span<const Vec2
     return std::pair{i, j};
   };
   // People per cell, stored at the cell's upper corner, then summed along rows (rows in parallel)
-  // and down columns (blocks of columns in parallel, row by row within a block).
-  tbb::parallel_for(0, ny_ + 1, [&](int j) { std::fill_n(people_.data() + j * stride, stride, 0u); });
+  // and down columns (blocks of columns in parallel, row by row within a block); all of it only
+  // over the corners [iLo, iHi] x [jLo, jHi] of the cells people stand in, to which the queries
+  // are clamped (beyond them there is no one to count).
+  int iLo = nx_, iHi = 0, jLo = ny_, jHi = 0;
+  for (const Vec2f& p : people) {
+    const auto [i, j] = cellOf(p);
+    iLo = std::min(iLo, i), iHi = std::max(iHi, i + 1), jLo = std::min(jLo, j), jHi = std::max(jHi, j + 1);
+  }
+  tbb::parallel_for(jLo, jHi + 1, [&](int j) { std::fill_n(people_.data() + j * stride + iLo, iHi - iLo + 1, 0u); });
   for (const Vec2f& p : people) {
     const auto [i, j] = cellOf(p);
     ++people_[(j + 1) * stride + i + 1];
   }
-  tbb::parallel_for(1, ny_ + 1, [&](int j) {
+  tbb::parallel_for(jLo + 1, jHi + 1, [&](int j) {
     std::uint32_t* row = people_.data() + j * stride;
-    for (int i = 1; i <= nx_; ++i) row[i] += row[i - 1];
+    for (int i = iLo + 1; i <= iHi; ++i) row[i] += row[i - 1];
   });
   constexpr int kColumns = 512;
-  tbb::parallel_for(0, (nx_ + kColumns) / kColumns, [&](int block) {
-    const int first = 1 + block * kColumns, last = std::min(nx_, first + kColumns - 1);
-    for (int j = 2; j <= ny_; ++j) {
+  tbb::parallel_for(0, (iHi - iLo + kColumns - 1) / kColumns, [&](int block) {
+    const int first = iLo + 1 + block * kColumns, last = std::min(iHi, first + kColumns - 1);
+    for (int j = jLo + 2; j <= jHi; ++j) {
       std::uint32_t* row = people_.data() + j * stride;
       const std::uint32_t* below = row - stride;
       for (int i = first; i <= last; ++i) row[i] += below[i];
@@ -125,13 +132,17 @@ void WalkingDensity::measure(std::span<const Vec2f> people, std::span<const Vec2
       };
       const std::size_t ia = line(c.x() - half, x0, nx_), ib = line(c.x() + half, x0, nx_);
       const std::size_t ja = line(c.y() - half, y0, ny_), jb = line(c.y() + half, y0, ny_);
-      const auto box = [&](const auto* t) { return t[jb * stride + ib] - t[ja * stride + ib] - t[jb * stride + ia] + t[ja * stride + ia]; };
+      const auto box = [&](const auto* t, std::size_t i0, std::size_t i1, std::size_t j0, std::size_t j1) {
+        return t[j1 * stride + i1] - t[j0 * stride + i1] - t[j1 * stride + i0] + t[j0 * stride + i0];
+      };
+      const auto ci = [&](std::size_t i) { return std::clamp(i, std::size_t(iLo), std::size_t(iHi)); };
+      const auto cj = [&](std::size_t j) { return std::clamp(j, std::size_t(jLo), std::size_t(jHi)); };
       // The person is at least window / 2 - lookahead (>= one cell) inside the square, and snapping
       // moves a side by at most half a cell onto a cell line: its cell is counted, and the others
       // are one fewer.
-      const std::uint32_t inside = box(count);
+      const std::uint32_t inside = box(count, ci(ia), ci(ib), cj(ja), cj(jb));
       const double others = inside > 0 ? double(inside - 1) : 0.0;
-      const double rho = others / std::max(settings_.minFreeArea, box(free));
+      const double rho = others / std::max(settings_.minFreeArea, box(free, ia, ib, ja, jb));
       density[k] = static_cast<float>(rho);
       speed[k] = static_cast<float>(maxSpeed[k] * weidmannSpeed(rho, w) / w.v0);
     }
