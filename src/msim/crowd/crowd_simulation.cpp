@@ -324,13 +324,14 @@ void CrowdSimulation::moveUic(double dt) {
 CrowdSimulation::FreeWalkers CrowdSimulation::freeWalkers() {
   const std::size_t n = agents_.size();
   if (n == 0) return {};
-  frameDensity_.resize(n);
-  frameSpeed_.resize(n);
-  walkingDensity_->measure(agents_.position, agents_.preferredVelocity, agents_.maxSpeed, frameDensity_, frameSpeed_);
+  // The step's walking-speed scratch serves here too: the next step measures afresh.
+  walkDensity_.resize(n);
+  walkSpeed_.resize(n);
+  walkingDensity_->measure(agents_.position, agents_.preferredVelocity, agents_.maxSpeed, walkDensity_, walkSpeed_);
   FreeWalkers out;
   double sum = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
-    if (agents_.model[i] == AgentModel::Scripted || frameDensity_[i] >= kFreeDensity ||
+    if (agents_.model[i] == AgentModel::Scripted || walkDensity_[i] >= kFreeDensity ||
         agents_.preferredVelocity[i].norm() < 0.5f * agents_.maxSpeed[i])
       continue;
     ++out.count;

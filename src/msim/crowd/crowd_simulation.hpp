@@ -181,7 +181,7 @@ class CrowdSimulation {
 
   // Per-step scratch, kept to avoid allocation.
   std::vector<Vec2f> orcaVelocity_, discCentres_, uicPosition_, uicPreferred_, uicVelocity_;
-  std::vector<float> discRadii_, uicSpeed_, walkDensity_, walkSpeed_, frameDensity_, frameSpeed_;
+  std::vector<float> discRadii_, uicSpeed_, walkDensity_, walkSpeed_;
   std::vector<std::uint32_t> uicIndex_;
   std::vector<std::uint8_t> remove_;
 };
