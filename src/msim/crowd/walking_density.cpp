@@ -31,6 +31,12 @@ void check(const SpeedDensitySettings& s) {
     bad("Weidmann's v0, gamma and rho_jam must be positive");
 }
 
+// out[c] += in[c] for c < count: the sliding sums' one operation, in its own function so that the
+// compiler knows the rows apart and vectorises it.
+void addRow(std::uint16_t* __restrict out, const std::uint16_t* __restrict in, int count) {
+  for (int c = 0; c < count; ++c) out[c] += in[c];
+}
+
 }  // namespace
 
 WalkingDensity::WalkingDensity(const Vec2& lo, const Vec2& hi, std::span<const Polygon> obstacles,
@@ -55,7 +61,31 @@ WalkingDensity::WalkingDensity(const Vec2& lo, const Vec2& hi, std::span<const P
       table_[(j + 1) * stride + i + 1] = table_[j * stride + i + 1] + row;
     }
   }
-  people_.assign(table_.size(), 0);
+  // The counting square: `across` whole cells, its lower-left corner anywhere from `pad` cells
+  // before the box to its last cell, so that it can hold any cell.
+  across_ = std::max(1, static_cast<int>(std::lround(settings_.window / cell_)));
+  pad_ = across_ - 1;
+  cornersX_ = nx_ + pad_;
+  const int cornersY = ny_ + pad_;
+  const double full = across_ * across_ * area;
+  freeSquare_.resize(static_cast<std::size_t>(cornersX_) * cornersY);
+  for (int ja = -pad_; ja < ny_; ++ja)
+    for (int ia = -pad_; ia < nx_; ++ia) {
+      const std::size_t i0 = std::max(ia, 0), i1 = std::min(ia + across_, nx_);
+      const std::size_t j0 = std::max(ja, 0), j1 = std::min(ja + across_, ny_);
+      const double free = table_[j1 * stride + i1] - table_[j0 * stride + i1] - table_[j1 * stride + i0] +
+                          table_[j0 * stride + i0];
+      freeSquare_[corner(ia, ja)] = static_cast<std::uint16_t>(std::lround(std::clamp(free / full, 0.0, 1.0) * kWhole));
+    }
+  // A square of open floor holds the full area: its speeds for the first counts, once.
+  fullArea_ = full;
+  openSpeed_.resize(kOpenCounts);
+  for (int k = 0; k < kOpenCounts; ++k)
+    openSpeed_[k] = static_cast<float>(weidmannSpeed(k / std::max(settings_.minFreeArea, full), settings_.weidmann) /
+                                       settings_.weidmann.v0);
+  cellPeople_.assign(static_cast<std::size_t>(nx_) * ny_, 0);
+  rowSums_.assign(static_cast<std::size_t>(cornersX_) * ny_, 0);
+  squarePeople_.assign(freeSquare_.size(), 0);
 }
 
 double WalkingDensity::integral(double x, double y) const {
@@ -83,68 +113,68 @@ void WalkingDensity::measure(std::span<const Vec2f> people, std::span<const Vec2
   if (preferred.size() != n || maxSpeed.size() != n || density.size() != n || speed.size() != n)
     throw std::invalid_argument("WalkingDensity::measure: spans of different sizes");
   if (n == 0) return;
-  const std::size_t stride = static_cast<std::size_t>(nx_) + 1;
   const float x0 = static_cast<float>(lo_.x()), y0 = static_cast<float>(lo_.y()), inv = static_cast<float>(1.0 / cell_);
   const auto cellOf = [&](const Vec2f& p) {
     const int i = std::clamp(static_cast<int>((p.x() - x0) * inv), 0, nx_ - 1);
     const int j = std::clamp(static_cast<int>((p.y() - y0) * inv), 0, ny_ - 1);
     return std::pair{i, j};
   };
-  // People per cell, stored at the cell's upper corner, then summed along rows (rows in parallel)
-  // and down columns (blocks of columns in parallel, row by row within a block); all of it only
-  // over the corners [iLo, iHi] x [jLo, jHi] of the cells people stand in, to which the queries
-  // are clamped (beyond them there is no one to count).
+  // People per cell, over the cells people stand in ([iLo, iHi] x [jLo, jHi]); then the people of
+  // every square that can hold one of them (corners [iLo - pad, iHi] x [jLo - pad, jHi]) as two
+  // sliding sums of `across` cells, along rows and then along columns. Each pass adds whole rows,
+  // which vectorises, and the rows go in parallel.
   int iLo = nx_, iHi = 0, jLo = ny_, jHi = 0;
   for (const Vec2f& p : people) {
     const auto [i, j] = cellOf(p);
-    iLo = std::min(iLo, i), iHi = std::max(iHi, i + 1), jLo = std::min(jLo, j), jHi = std::max(jHi, j + 1);
+    iLo = std::min(iLo, i), iHi = std::max(iHi, i), jLo = std::min(jLo, j), jHi = std::max(jHi, j);
   }
-  tbb::parallel_for(jLo, jHi + 1, [&](int j) { std::fill_n(people_.data() + j * stride + iLo, iHi - iLo + 1, 0u); });
+  const std::size_t nxs = static_cast<std::size_t>(nx_);
+  tbb::parallel_for(jLo, jHi + 1, [&](int j) { std::fill_n(cellPeople_.data() + j * nxs + iLo, iHi - iLo + 1, std::uint16_t(0)); });
   for (const Vec2f& p : people) {
     const auto [i, j] = cellOf(p);
-    ++people_[(j + 1) * stride + i + 1];
+    ++cellPeople_[j * nxs + i];
   }
-  tbb::parallel_for(jLo + 1, jHi + 1, [&](int j) {
-    std::uint32_t* row = people_.data() + j * stride;
-    for (int i = iLo + 1; i <= iHi; ++i) row[i] += row[i - 1];
+  const int width = iHi - iLo + 1 + pad_;  // corners per row that can hold someone
+  tbb::parallel_for(jLo, jHi + 1, [&](int j) {
+    // rowSums(ia, j) = sum of cellPeople(ia + k, j), k < across, over cells in [iLo, iHi].
+    std::uint16_t* out = rowSums_.data() + static_cast<std::size_t>(j) * cornersX_ + pad_;  // corner ia at out[ia]
+    const std::uint16_t* in = cellPeople_.data() + j * nxs;
+    std::fill_n(out + iLo - pad_, width, std::uint16_t(0));
+    for (int k = 0; k < across_; ++k) addRow(out + iLo - k, in + iLo, iHi - iLo + 1);
   });
-  constexpr int kColumns = 512;
-  tbb::parallel_for(0, (iHi - iLo + kColumns - 1) / kColumns, [&](int block) {
-    const int first = iLo + 1 + block * kColumns, last = std::min(iHi, first + kColumns - 1);
-    for (int j = jLo + 2; j <= jHi; ++j) {
-      std::uint32_t* row = people_.data() + j * stride;
-      const std::uint32_t* below = row - stride;
-      for (int i = first; i <= last; ++i) row[i] += below[i];
-    }
+  tbb::parallel_for(jLo - pad_, jHi + 1, [&](int ja) {
+    std::uint16_t* out = squarePeople_.data() + corner(iLo - pad_, ja);
+    std::fill_n(out, width, std::uint16_t(0));
+    for (int j = std::max(ja, jLo); j <= std::min(ja + pad_, jHi); ++j)
+      addRow(out, rowSums_.data() + static_cast<std::size_t>(j) * cornersX_ + iLo, width);
   });
-  const float half = static_cast<float>(0.5 * settings_.window);
+  const float centreShift = 0.5f * static_cast<float>(across_) - 0.5f;  // centre to lower-left corner, less rounding
   const float ahead = static_cast<float>(settings_.lookahead);
+  const float openDensity = static_cast<float>(1.0 / std::max(settings_.minFreeArea, fullArea_));
+  const double wholeArea = fullArea_ / kWhole;
   const WeidmannParams& w = settings_.weidmann;
-  const std::uint32_t* count = people_.data();
-  const double* free = table_.data();
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t k = r.begin(); k != r.end(); ++k) {
       const float norm = preferred[k].norm();
       const Vec2f c = norm > 0.0f ? Vec2f(people[k] + preferred[k] * (ahead / norm)) : people[k];
-      // The square's sides on the nearest cell lines, clamped to the box.
-      const auto line = [&](float x, float origin, int cells) {
-        return static_cast<std::size_t>(std::clamp(static_cast<int>(std::floor((x - origin) * inv + 0.5f)), 0, cells));
-      };
-      const std::size_t ia = line(c.x() - half, x0, nx_), ib = line(c.x() + half, x0, nx_);
-      const std::size_t ja = line(c.y() - half, y0, ny_), jb = line(c.y() + half, y0, ny_);
-      const auto box = [&](const auto* t, std::size_t i0, std::size_t i1, std::size_t j0, std::size_t j1) {
-        return t[j1 * stride + i1] - t[j0 * stride + i1] - t[j1 * stride + i0] + t[j0 * stride + i0];
-      };
-      const auto ci = [&](std::size_t i) { return std::clamp(i, std::size_t(iLo), std::size_t(iHi)); };
-      const auto cj = [&](std::size_t j) { return std::clamp(j, std::size_t(jLo), std::size_t(jHi)); };
-      // The person is at least window / 2 - lookahead (>= one cell) inside the square, and snapping
-      // moves a side by at most half a cell onto a cell line: its cell is counted, and the others
-      // are one fewer.
-      const std::uint32_t inside = box(count, ci(ia), ci(ib), cj(ja), cj(jb));
-      const double others = inside > 0 ? double(inside - 1) : 0.0;
-      const double rho = others / std::max(settings_.minFreeArea, box(free, ia, ib, ja, jb));
-      density[k] = static_cast<float>(rho);
-      speed[k] = static_cast<float>(maxSpeed[k] * weidmannSpeed(rho, w) / w.v0);
+      // The square whose centre lies nearest c, moved (by at most a cell where the lookahead is
+      // at its limit or the person is outside the box) so that it holds the person's cell: the
+      // others are one fewer than it holds.
+      const auto [i, j] = cellOf(people[k]);
+      const int ia = std::clamp(static_cast<int>(std::floor((c.x() - x0) * inv - centreShift)), i - pad_, i);
+      const int ja = std::clamp(static_cast<int>(std::floor((c.y() - y0) * inv - centreShift)), j - pad_, j);
+      const std::size_t at = corner(ia, ja);
+      const int others = static_cast<int>(squarePeople_[at]) - 1;
+      float factor;
+      if (freeSquare_[at] == kWhole && others < kOpenCounts) {
+        factor = openSpeed_[others];
+        density[k] = static_cast<float>(others) * openDensity;
+      } else {
+        const double rho = double(others) / std::max(settings_.minFreeArea, freeSquare_[at] * wholeArea);
+        density[k] = static_cast<float>(rho);
+        factor = static_cast<float>(weidmannSpeed(rho, w) / w.v0);
+      }
+      speed[k] = maxSpeed[k] * factor;
     }
   });
 }

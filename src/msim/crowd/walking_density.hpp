@@ -21,11 +21,12 @@
 // with these two geometric choices and no fitted constant, doors of 0.8, 1.2, 1.6 and 2.4 m pass
 // 1.6-1.9 agents/(m s).
 //
-// Both the people and the free area of a square come from summed-area tables on a fine grid
-// (cells of at most 0.25 m): the static obstacles' free area once, the people counted per cell each
-// step. The square is snapped to the nearest cell lines (its sides move by at most half a cell), so
-// each pedestrian costs eight lookups whatever the density. Outside the walkable box counts as
-// covered; moving obstacles (vehicles) count as free, so a pedestrian beside a vehicle reads a
+// The square is made of whole cells of a fine grid (at most 0.25 m; `window` rounded to a whole
+// number of them) and sits on the cell lines nearest its centre, so its sides move by at most half
+// a cell. The free area of every such square comes once from the static obstacles; the people of
+// every square that can hold someone are counted each step by two sliding sums over the cells
+// people stand in. Each pedestrian then costs two lookups whatever the density. Outside the
+// walkable box counts as covered; moving obstacles (vehicles) count as free, so a pedestrian beside a vehicle reads a
 // slightly lower density than it stands in.
 #include <cstdint>
 #include <span>
@@ -66,14 +67,28 @@ class WalkingDensity {
   const SpeedDensitySettings& settings() const { return settings_; }
 
  private:
+  static constexpr int kOpenCounts = 64;          // counts whose open-floor speeds are tabulated
+  static constexpr std::uint16_t kWhole = 65535;  // a square's free area when it is all floor
+
   double integral(double x, double y) const;  // free area of [lo, (x, y)], bilinear in the table
+  // The square whose lower-left corner is cell (ia, ja), ia in [-pad_, nx_), ja in [-pad_, ny_).
+  std::size_t corner(int ia, int ja) const {
+    return static_cast<std::size_t>(ja + pad_) * static_cast<std::size_t>(cornersX_) + static_cast<std::size_t>(ia + pad_);
+  }
 
   SpeedDensitySettings settings_;
   Vec2 lo_, hi_;
   double cell_ = 0.25;
   int nx_ = 0, ny_ = 0;
-  std::vector<double> table_;          // (nx_ + 1) x (ny_ + 1) corners: free area of [lo, corner]
-  std::vector<std::uint32_t> people_;  // the same corners: people in [lo, corner], this step
+  int across_ = 1, pad_ = 0, cornersX_ = 0;  // cells across a square; corners before the box; corners per row
+  double fullArea_ = 0.0;                    // a square of open floor [m^2]
+  std::vector<double> table_;                // (nx_ + 1) x (ny_ + 1) corners: free area of [lo, corner]
+  std::vector<std::uint16_t> freeSquare_;    // per square (corner()): its free area in fullArea_ / kWhole
+  std::vector<float> openSpeed_;             // v_W(k / fullArea_) / v0 for k others, k < kOpenCounts
+  // This step's people: per cell; per cell row and square column; per square (corner()). Counted
+  // modulo 2^16 (half the memory of 32 bits, and twice the lanes of the sums): exact while a
+  // square holds fewer than 65536 people.
+  std::vector<std::uint16_t> cellPeople_, rowSums_, squarePeople_;
 };
 
 }  // namespace msim::crowd
