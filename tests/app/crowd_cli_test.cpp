@@ -239,12 +239,13 @@ TEST(CrowdCli, FineDomainGridDoesNotStallTheCrowd) {
   EXPECT_NEAR(400 - whole.back(), 400 - half.back(), 0.1 * (400 - half.back()));
   EXPECT_GT(400 - half.back(), 30);
   // Cells that do not divide the floor (0.45 m across a 20 m width) leave its walls where the
-  // scene puts them: the evacuation room runs and empties as at 0.5 m (147 s).
+  // scene puts them: the evacuation room runs and empties within 10% of its time at 0.5 m (139.25 s,
+  // docs/evacuation.md).
   const json odd = runScene("crowd_grid_odd", std::string(MSIM_SOURCE_DIR) + "/scenes/crowd_evacuation_room.json",
                             "--set domain.resolution=80 --set outputs.png=false --set outputs.vdb=false "
                             "--set outputs.mp4=false --set crowd.trajectories=false");
   ASSERT_TRUE(odd.contains("results"));
-  EXPECT_NEAR(odd.at("results").at("evacuation").at("t100_s").get<double>(), 147.0, 14.7);
+  EXPECT_NEAR(odd.at("results").at("evacuation").at("t100_s").get<double>(), 139.25, 13.9);
 }
 
 // The default speed_density = weidmann reads the density of the others in the 1.5 m square ahead: a
