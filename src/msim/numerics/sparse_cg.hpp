@@ -48,15 +48,12 @@ SparseCgStats preconditionedCg(const Product& multiply, const Preconditioner& pr
     multiply(w.search, w.product);
     const double curvature = parallelDot(w.search, w.product);
     if (!(curvature > 0.0)) break;
-    const double alpha = rz / curvature;
-    x += alpha * w.search;
-    r -= alpha * w.product;
     ++stats.iterations;
-    stats.residualNorm2 = parallelDot(r, r);
+    stats.residualNorm2 = parallelStep(rz / curvature, w.search, w.product, x, r);
     if (stats.residualNorm2 <= target2) break;
     preconditioner.apply(r, w.z);
     const double rzNext = parallelDot(r, w.z);
-    w.search = w.z + (rzNext / rz) * w.search;
+    parallelDirection(w.z, rzNext / rz, w.search);
     rz = rzNext;
   }
   stats.converged = stats.residualNorm2 <= target2;

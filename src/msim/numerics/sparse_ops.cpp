@@ -84,22 +84,53 @@ SparseRowMatrix parallelProduct(const SparseRowMatrix& A, const SparseRowMatrix&
   return C;
 }
 
-double parallelDot(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
-  // Blocks of fixed bounds, each summed by Eigen's vectorised dot and joined along a fixed tree
-  // (tbb::parallel_deterministic_reduce): the same sum on every run and thread count, at the speed
-  // of SIMD on every core rather than of a serial chain of additions.
-  constexpr Eigen::Index kBlock = 4096;
-  const Eigen::Index blocks = (a.size() + kBlock - 1) / kBlock;
+namespace {
+
+// Blocks of fixed bounds, each summed with Eigen's vectorised kernels and joined along a fixed tree
+// (tbb::parallel_deterministic_reduce): the same sum on every run and thread count, at the speed
+// of SIMD on every core rather than of a serial chain of additions. f(first, length) -> double.
+constexpr Eigen::Index kBlock = 4096;
+
+template <typename F>
+double blockSum(Eigen::Index size, F&& f) {
+  const Eigen::Index blocks = (size + kBlock - 1) / kBlock;
   return tbb::parallel_deterministic_reduce(
       tbb::blocked_range<Eigen::Index>(0, blocks, 1), 0.0,
       [&](const tbb::blocked_range<Eigen::Index>& r, double sum) {
         for (Eigen::Index block = r.begin(); block != r.end(); ++block) {
-          const Eigen::Index first = block * kBlock, length = std::min(kBlock, a.size() - first);
-          sum += a.segment(first, length).dot(b.segment(first, length));
+          const Eigen::Index first = block * kBlock;
+          sum += f(first, std::min(kBlock, size - first));
         }
         return sum;
       },
       [](double x, double y) { return x + y; });
+}
+
+}  // namespace
+
+double parallelDot(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  return blockSum(a.size(), [&](Eigen::Index first, Eigen::Index length) {
+    return a.segment(first, length).dot(b.segment(first, length));
+  });
+}
+
+double parallelStep(double alpha, const Eigen::VectorXd& s, const Eigen::VectorXd& q, Eigen::VectorXd& x, Eigen::VectorXd& r) {
+  return blockSum(r.size(), [&](Eigen::Index first, Eigen::Index length) {
+    x.segment(first, length) += alpha * s.segment(first, length);
+    auto block = r.segment(first, length);
+    block -= alpha * q.segment(first, length);
+    return block.squaredNorm();
+  });
+}
+
+void parallelDirection(const Eigen::VectorXd& z, double beta, Eigen::VectorXd& s) {
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, (s.size() + kBlock - 1) / kBlock, 1),
+                    [&](const tbb::blocked_range<Eigen::Index>& r) {
+                      for (Eigen::Index block = r.begin(); block != r.end(); ++block) {
+                        const Eigen::Index first = block * kBlock, length = std::min(kBlock, s.size() - first);
+                        s.segment(first, length) = z.segment(first, length) + beta * s.segment(first, length);
+                      }
+                    });
 }
 
 }  // namespace msim::numerics

@@ -14,5 +14,10 @@ void parallelMultiply(const SparseRowMatrix& A, const Eigen::VectorXd& x, Eigen:
 SparseRowMatrix parallelProduct(const SparseRowMatrix& A, const SparseRowMatrix& B);
 // Dot product, the same whatever the thread count (core/parallel.hpp's parallelSum).
 double parallelDot(const Eigen::VectorXd& a, const Eigen::VectorXd& b);
+// Conjugate gradients' update x += alpha s, r -= alpha q, returning the new |r|^2 (equal to
+// parallelDot(r, r)), in one pass over the vectors on all cores.
+double parallelStep(double alpha, const Eigen::VectorXd& s, const Eigen::VectorXd& q, Eigen::VectorXd& x, Eigen::VectorXd& r);
+// s = z + beta s on all cores.
+void parallelDirection(const Eigen::VectorXd& z, double beta, Eigen::VectorXd& s);
 
 }  // namespace msim::numerics

@@ -15,14 +15,10 @@ namespace {
 
 // Iterations a solve needs before its convergence rate tells whether the multigrid hierarchy has aged.
 constexpr int kRateSample = 8;
-// applyTerms' chunks: a small cloth (a few thousand springs) runs in one, where the threads' start
+// applyElastic's chunks: a small cloth (a few thousand springs) runs in one, where the threads' start
 // would cost more than they save; the product is the same either way.
 constexpr std::size_t kTermGrain = 8192;
 
-struct JacobiPreconditioner {
-  const Eigen::VectorXd& inverseDiagonal;
-  void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const { z = inverseDiagonal.cwiseProduct(r); }
-};
 
 }  // namespace
 
@@ -35,9 +31,8 @@ struct JacobiPreconditioner {
 // c'_s = c T_s / L_s for a stretched edge spring with implicit springs, else 0; and
 // rhs = M v + h F(x_k) + h c K_k v_k, K_k the elastic part. Further Newton iterations
 // (`newtonIterations`) take the springs' directions and tensions where the last solve moves the
-// particles to. The terms are gathered once per iteration; with Jacobi preconditioning A is applied
-// term by term without being assembled, with multigrid it is assembled in 3 x 3 blocks
-// (newmark_matrix.hpp); nothing is allocated once the buffers have grown.
+// particles to. The terms are gathered, and A assembled in symmetric 3 x 3 blocks
+// (newmark_matrix.hpp), once per iteration; nothing is allocated once the buffers have grown.
 // Pinned particles keep `from`: their unknowns stay fixed, so their columns act through the start
 // residual and their rows drop out.
 void NewmarkStepper::gatherTerms(const MassSpringSystem& system, const std::vector<Vec3>& at, double h, double reach) {
@@ -83,16 +78,8 @@ void NewmarkStepper::gatherTerms(const MassSpringSystem& system, const std::vect
     addTerm(t.v.data(), choice.weights.data(), 4, choice.normal, t.damping, reach * t.stiffness / l0, 0.0);
   }
   gatherIncidence(system.size());
-  if (settings_.preconditioner != SolvePreconditioner::Jacobi) return;
-  inverseDiagonal_.resize(static_cast<Eigen::Index>(3 * system.size()));
-  for (std::size_t p = 0; p < system.size(); ++p) inverseDiagonal_.segment<3>(static_cast<Eigen::Index>(3 * p)).setConstant(system.mass[p]);
-  for (const SpringTerm& t : terms_)
-    for (int i = 0; i < t.count; ++i)
-      inverseDiagonal_.segment<3>(3 * static_cast<Eigen::Index>(t.node[i])) +=
-          t.weight[i] * t.weight[i] *
-          (t.coefficient * t.direction.cwiseProduct(t.direction) +
-           t.sideways * (Vec3::Ones() - t.direction.cwiseProduct(t.direction)));
-  inverseDiagonal_ = inverseDiagonal_.cwiseInverse();
+  matrix_.assemble(system, terms_, incidenceStart_, incidence_);
+  if (settings_.preconditioner == SolvePreconditioner::Jacobi) jacobi_.setup(matrix_.matrix());
 }
 
 void NewmarkStepper::gatherIncidence(std::size_t particles) {
@@ -109,17 +96,16 @@ void NewmarkStepper::gatherIncidence(std::size_t particles) {
   termForces_.resize(terms_.size());
 }
 
-// Two passes on all cores: each term's force from the particles it joins, then each particle's sum
-// over its terms in the terms' order (no two threads write one particle; the same sums whatever the
-// thread count).
-void NewmarkStepper::applyTerms(const double* u, double* y, bool elasticOnly) const {
+// Two passes on all cores: each term's elastic force from the particles it joins, then each
+// particle's sum over its terms in the terms' order (no two threads write one particle; the same
+// sums whatever the thread count).
+void NewmarkStepper::applyElastic(const double* u, double* y) const {
   parallelFor(0, terms_.size(), [&](std::size_t k) {
     const SpringTerm& t = terms_[k];
     Vec3 relative = Vec3::Zero();
     for (int i = 0; i < t.count; ++i) relative += t.weight[i] * Eigen::Map<const Vec3>(u + 3 * t.node[i]);
     const double along = relative.dot(t.direction);
-    termForces_[k] = (elasticOnly ? t.stiffness : t.coefficient) * along * t.direction +
-                     t.sideways * (relative - along * t.direction);
+    termForces_[k] = t.stiffness * along * t.direction + t.sideways * (relative - along * t.direction);
   }, kTermGrain);
   parallelFor(0, incidenceStart_.size() - 1, [&](std::size_t p) {
     Vec3 sum = Vec3::Zero();
@@ -137,7 +123,9 @@ NewmarkStats NewmarkStepper::solveHalfStep(const MassSpringSystem& system, const
   const double reach = settings_.implicitSprings ? 2.0 * h : 0.0;
   const int iterations = settings_.implicitSprings ? std::max(1, settings_.newtonIterations) : 1;
   NewmarkStats stats;
-  out = from;
+  out.resize(n);
+  for (std::size_t p = 0; p < n; ++p)
+    if (system.pinned[p]) out[p] = from[p];
   residual_.resize(n);
   product_.resize(n);
   linearisedAt_.resize(n);
@@ -148,15 +136,14 @@ NewmarkStats NewmarkStepper::solveHalfStep(const MassSpringSystem& system, const
     gatherTerms(system, linearisedAt_, h, reach);
     // rhs = M v + h F(x_k) + h c K_k v_k (product_ holds h c K_k v_k), residual = rhs - A out.
     for (Vec3& y : product_) y.setZero();
-    if (k > 0) applyTerms(out.data()->data(), product_.data()->data(), true);
+    if (k > 0) applyElastic(out.data()->data(), product_.data()->data());
     double rhsNorm2 = 0.0;
     for (std::size_t p = 0; p < n; ++p) {
       if (system.pinned[p]) continue;
       residual_[p] = system.mass[p] * from[p] + h * forces_[p] + product_[p];
       rhsNorm2 += residual_[p].squaredNorm();
     }
-    for (std::size_t p = 0; p < n; ++p) product_[p] = system.mass[p] * out[p];
-    applyTerms(out.data()->data(), product_.data()->data(), false);
+    matrix_.matrix().multiply(out.data()->data(), product_.data()->data());
     for (std::size_t p = 0; p < n; ++p) residual_[p] = system.pinned[p] ? Vec3::Zero() : Vec3(residual_[p] - product_[p]);
     if (k + 1 < iterations) previous_ = out;
     const NewmarkStats solve = conjugateGradients(system, h, rhsNorm2, out);
@@ -184,10 +171,9 @@ NewmarkStats NewmarkStepper::conjugateGradients(const MassSpringSystem& system, 
   const double target2 = settings_.cgTolerance * settings_.cgTolerance * rhsNorm2;
   NewmarkStats stats;
   numerics::SparseCgStats solve;
+  const numerics::SymmetricBlockMatrix& A = matrix_.matrix();
+  const auto product = [&A](const Eigen::VectorXd& u, Eigen::VectorXd& y) { A.multiply(u, y); };
   if (settings_.preconditioner == SolvePreconditioner::Multigrid) {
-    matrix_.assemble(system, terms_);
-    const numerics::SparseRowMatrix& A = matrix_.matrix();
-    const auto product = [&A](const Eigen::VectorXd& u, Eigen::VectorXd& y) { numerics::parallelMultiply(A, u, y); };
     const bool setup = stale_ || multigridParticles_ != system.size() || std::abs(h - multigridH_) > 0.25 * multigridH_;
     if (setup) {
       // The coarse levels carry each aggregate's rigid motions: translations, and rotations, which
@@ -195,7 +181,7 @@ NewmarkStats NewmarkStepper::conjugateGradients(const MassSpringSystem& system, 
       Vec3 center = Vec3::Zero();
       for (const Vec3& p : linearisedAt_) center += p;
       center /= static_cast<double>(std::max<std::size_t>(1, linearisedAt_.size()));
-      multigrid_.setup(A, numerics::rigidModes(linearisedAt_, center));
+      multigrid_.setup(A.expanded(), numerics::rigidModes(linearisedAt_, center));
       multigridParticles_ = system.size();
       multigridH_ = h;
       stale_ = false;
@@ -211,20 +197,7 @@ NewmarkStats NewmarkStepper::conjugateGradients(const MassSpringSystem& system, 
       else if (rate > 0.25 * multigridRate_) stale_ = true;
     }
   } else {
-    // y = A u on the free particles (pinned rows zero), term by term.
-    const auto product = [&](const Eigen::VectorXd& u, Eigen::VectorXd& y) {
-      y.resize(u.size());
-      parallelFor(0, system.size(), [&](std::size_t p) {
-        const auto row = static_cast<Eigen::Index>(3 * p);
-        y.segment<3>(row) = system.mass[p] * u.segment<3>(row);
-      }, 4096);
-      applyTerms(u.data(), y.data(), false);
-      parallelFor(0, system.size(), [&](std::size_t p) {
-        if (system.pinned[p]) y.segment<3>(static_cast<Eigen::Index>(3 * p)).setZero();
-      }, 4096);
-    };
-    const JacobiPreconditioner jacobi{inverseDiagonal_};
-    solve = numerics::preconditionedCg(product, jacobi, unknowns_, residualVector_, target2, settings_.cgMaxIterations, workspace_);
+    solve = numerics::preconditionedCg(product, jacobi_, unknowns_, residualVector_, target2, settings_.cgMaxIterations, workspace_);
   }
   Eigen::Map<Eigen::VectorXd>(out.data()->data(), unknowns) = unknowns_;
   stats.iterations = solve.iterations;
@@ -238,6 +211,7 @@ NewmarkStats NewmarkStepper::step(MassSpringSystem& system, double dt, const Bod
   const double h = 0.5 * dt;
   const std::size_t n = system.size();
   start_ = system.v;
+  half_ = start_;  // the first solve starts from v(n)
   NewmarkStats first = solveHalfStep(system, system.x, start_, h, half_);
   if (repulsion) {
     inverseMasses(system.mass, system.pinned, inverseMass_);
@@ -254,6 +228,7 @@ NewmarkStats NewmarkStepper::step(MassSpringSystem& system, double dt, const Bod
     mid_[p] = 0.5 * (system.x[p] + next);
     system.x[p] = next;
   }
+  // The second solve starts from the first one's answer: both approximate v(n+1/2).
   const NewmarkStats second = solveHalfStep(system, mid_, start_, h, half_);
   for (std::size_t p = 0; p < n; ++p) {
     system.v[p] = 2.0 * half_[p] - start_[p];

@@ -34,8 +34,8 @@
 
 namespace msim::solids {
 
-// How the solves are preconditioned: the inverse of the matrix's diagonal (Jacobi), the matrix
-// applied spring by spring, or a smoothed-aggregation multigrid V-cycle on the assembled matrix
+// How the solves are preconditioned: the inverse of each particle's 3 x 3 diagonal block
+// (block-Jacobi), or a smoothed-aggregation multigrid V-cycle on the matrix
 // (numerics/smoothed_aggregation.hpp, with the rigid motions as near-null space). Multigrid's
 // iteration counts stay nearly flat as a taut cloth at a large step is refined, where Jacobi's grow
 // with its width; at the small steps of colliding cloth the matrix is well conditioned and the
@@ -72,16 +72,17 @@ class NewmarkStepper {
 
  private:
   // Backward Euler over h from velocity `from`, the elasticity taken where the positions `base`
-  // move to with the answer (newmark.cpp), into `out`.
+  // move to with the answer (newmark.cpp), into `out`, whose free particles' values on entry are
+  // the solves' first guess (pinned ones keep `from`).
   NewmarkStats solveHalfStep(const MassSpringSystem& system, const std::vector<Vec3>& base,
                              const std::vector<Vec3>& from, double h, std::vector<Vec3>& out);
-  // The matrix's spring terms linearised at `at` (reach c = dt with implicit springs, else 0), and
-  // the inverse of its diagonal.
+  // The matrix's spring terms linearised at `at` (reach c = dt with implicit springs, else 0), the
+  // matrix, and with Jacobi its preconditioner.
   void gatherTerms(const MassSpringSystem& system, const std::vector<Vec3>& at, double h, double reach);
-  // The terms each particle takes part in (incidence_, CSR by particle) for applyTerms.
+  // The terms each particle takes part in (incidence_, CSR by particle) for the matrix and applyElastic.
   void gatherIncidence(std::size_t particles);
-  // y += (elasticOnly ? h c K : A - M) u, u and y 3 values per particle.
-  void applyTerms(const double* u, double* y, bool elasticOnly) const;
+  // y += h c K u, the terms' elastic part; u and y 3 values per particle.
+  void applyElastic(const double* u, double* y) const;
   NewmarkStats conjugateGradients(const MassSpringSystem& system, double h, double rhsNorm2, std::vector<Vec3>& out);
 
   NewmarkSettings settings_;
@@ -91,11 +92,11 @@ class NewmarkStepper {
   std::vector<SpringTerm> terms_;
   std::vector<int> incidenceStart_, incidenceFill_;      // per particle, into incidence_
   std::vector<std::pair<int, double>> incidence_;        // (term, the particle's weight in it)
-  mutable std::vector<Vec3> termForces_;                 // applyTerms' scratch, one per term
+  mutable std::vector<Vec3> termForces_;                 // applyElastic's scratch, one per term
   std::vector<Vec3> residual_, product_, linearisedAt_, previous_;
   double shortestSpring_ = 0.0;  // rest length, or altitude, over the last gathered terms
   NewmarkMatrix matrix_;
-  Eigen::VectorXd inverseDiagonal_;  // of the matrix, for Jacobi
+  numerics::SymmetricBlockJacobi jacobi_;
   // The multigrid hierarchy is built from one solve's matrix and kept while it serves: the matrices
   // of later solves differ little (springs turn slowly from step to step). A new one is built when
   // the half step h changes by more than a quarter (the stiffness terms scale with h^2), or when a

@@ -2,12 +2,13 @@
 
 #include <algorithm>
 
+#include "msim/core/parallel.hpp"
+
 namespace msim::solids {
 
 void NewmarkMatrix::buildPattern(const MassSpringSystem& system) {
   const std::size_t n = system.size();
   std::vector<std::vector<int>> adjacent(n);
-  for (std::size_t p = 0; p < n; ++p) adjacent[p].push_back(static_cast<int>(p));
   const auto link = [&](int a, int b) {
     adjacent[static_cast<std::size_t>(a)].push_back(b);
     adjacent[static_cast<std::size_t>(b)].push_back(a);
@@ -16,69 +17,56 @@ void NewmarkMatrix::buildPattern(const MassSpringSystem& system) {
   for (const TetrahedronSpring& t : system.tetrahedra)
     for (int i = 0; i < 4; ++i)
       for (int j = i + 1; j < 4; ++j) link(t.v[static_cast<std::size_t>(i)], t.v[static_cast<std::size_t>(j)]);
-  neighbourStart_.assign(n + 1, 0);
-  neighbours_.clear();
+  std::vector<int> rowStart(n + 1, 0), columns;
   for (std::size_t p = 0; p < n; ++p) {
     std::vector<int>& list = adjacent[p];
     std::sort(list.begin(), list.end());
     list.erase(std::unique(list.begin(), list.end()), list.end());
-    neighbours_.insert(neighbours_.end(), list.begin(), list.end());
-    neighbourStart_[p + 1] = static_cast<int>(neighbours_.size());
+    columns.insert(columns.end(), list.begin(), list.end());
+    rowStart[p + 1] = static_cast<int>(columns.size());
   }
-  // Row 3 p + k holds columns 3 q + l for each neighbour q of p (sorted), l = 0..2.
-  const auto rows = static_cast<Eigen::Index>(3 * n);
-  matrix_ = numerics::SparseRowMatrix(rows, rows);
-  matrix_.resizeNonZeros(static_cast<Eigen::Index>(9 * neighbours_.size()));
-  int* outer = matrix_.outerIndexPtr();
-  int* inner = matrix_.innerIndexPtr();
-  int entry = 0;
-  for (std::size_t p = 0; p < n; ++p)
-    for (int k = 0; k < 3; ++k) {
-      outer[3 * p + static_cast<std::size_t>(k)] = entry;
-      for (int e = neighbourStart_[p]; e < neighbourStart_[p + 1]; ++e)
-        for (int l = 0; l < 3; ++l) inner[entry++] = 3 * neighbours_[static_cast<std::size_t>(e)] + l;
-    }
-  outer[rows] = entry;
+  exact_.resize(columns.size());
+  matrix_.setPattern(std::move(rowStart), std::move(columns));
   particles_ = n;
   springs_ = system.springs.size();
   tetrahedra_ = system.tetrahedra.size();
 }
 
-int NewmarkMatrix::blockOffset(int i, int j) const {
-  const auto begin = neighbours_.begin() + neighbourStart_[static_cast<std::size_t>(i)];
-  const auto end = neighbours_.begin() + neighbourStart_[static_cast<std::size_t>(i) + 1];
-  return 3 * static_cast<int>(std::lower_bound(begin, end, j) - begin);
-}
-
-void NewmarkMatrix::assemble(const MassSpringSystem& system, const std::vector<SpringTerm>& terms) {
+void NewmarkMatrix::assemble(const MassSpringSystem& system, const std::vector<SpringTerm>& terms,
+                             std::span<const int> incidenceStart, std::span<const std::pair<int, double>> incidence) {
   if (particles_ != system.size() || springs_ != system.springs.size() || tetrahedra_ != system.tetrahedra.size())
     buildPattern(system);
-  const int* outer = matrix_.outerIndexPtr();
-  double* value = matrix_.valuePtr();
-  std::fill(value, value + matrix_.nonZeros(), 0.0);
-  for (std::size_t p = 0; p < system.size(); ++p) {
-    const int self = blockOffset(static_cast<int>(p), static_cast<int>(p));
-    for (int k = 0; k < 3; ++k) value[outer[3 * p + static_cast<std::size_t>(k)] + self + k] = system.pinned[p] ? 1.0 : system.mass[p];
-  }
-  for (const SpringTerm& t : terms) {
-    // c d d^T + c' (I - d d^T) = (c - c') d d^T + c' I
-    const Eigen::Matrix3d block =
-        (t.coefficient - t.sideways) * t.direction * t.direction.transpose() + t.sideways * Eigen::Matrix3d::Identity();
-    for (int a = 0; a < t.count; ++a) {
-      const int i = t.node[static_cast<std::size_t>(a)];
-      if (system.pinned[static_cast<std::size_t>(i)]) continue;
-      for (int b = 0; b < t.count; ++b) {
-        const int j = t.node[static_cast<std::size_t>(b)];
-        if (system.pinned[static_cast<std::size_t>(j)]) continue;
-        const double w = t.weight[static_cast<std::size_t>(a)] * t.weight[static_cast<std::size_t>(b)];
-        const int offset = blockOffset(i, j);
-        for (int k = 0; k < 3; ++k) {
-          double* row = value + outer[3 * i + k] + offset;
-          for (int l = 0; l < 3; ++l) row[l] += w * block(k, l);
-        }
+  const std::span<const int> rowStart = matrix_.rowStart();
+  parallelFor(0, system.size(), [&](std::size_t p) {
+    // The row in double (matrix_ rounds it): the diagonal, and each neighbour's block.
+    const std::span<Block> row(exact_.data() + rowStart[p], exact_.data() + rowStart[p + 1]);
+    std::fill(row.begin(), row.end(), Block{});
+    if (system.pinned[p]) {
+      matrix_.setRow(p, Block{1.0, 1.0, 1.0, 0.0, 0.0, 0.0}, row);
+      return;
+    }
+    Block diagonal{system.mass[p], system.mass[p], system.mass[p], 0.0, 0.0, 0.0};
+    const auto add = [](Block& to, double w, const Block& S) {
+      to.xx += w * S.xx, to.yy += w * S.yy, to.zz += w * S.zz, to.xy += w * S.xy, to.xz += w * S.xz, to.yz += w * S.yz;
+    };
+    for (int j = incidenceStart[p]; j < incidenceStart[p + 1]; ++j) {
+      const auto& [k, ownWeight] = incidence[static_cast<std::size_t>(j)];
+      const SpringTerm& t = terms[static_cast<std::size_t>(k)];
+      // c d d^T + c' (I - d d^T) = (c - c') d d^T + c' I
+      const Vec3& d = t.direction;
+      const double a = t.coefficient - t.sideways, b = t.sideways;
+      const Block S{a * d.x() * d.x() + b, a * d.y() * d.y() + b, a * d.z() * d.z() + b,
+                    a * d.x() * d.y(),     a * d.x() * d.z(),     a * d.y() * d.z()};
+      for (int i = 0; i < t.count; ++i) {
+        const int q = t.node[static_cast<std::size_t>(i)];
+        if (system.pinned[static_cast<std::size_t>(q)]) continue;
+        const double w = ownWeight * t.weight[static_cast<std::size_t>(i)];
+        if (q == static_cast<int>(p)) add(diagonal, w, S);
+        else add(exact_[static_cast<std::size_t>(matrix_.find(static_cast<int>(p), q))], w, S);
       }
     }
-  }
+    matrix_.setRow(p, diagonal, row);
+  }, 1024);
 }
 
 }  // namespace msim::solids

@@ -1,15 +1,18 @@
 #pragma once
-// The matrix of the Newmark step's linear solves (newmark.hpp), assembled in 3 x 3 blocks so that
-// conjugate gradients can run on all cores and be preconditioned by multigrid: the masses on the
-// diagonal plus, for each spring term, w_i w_j (c d d^T + c' (I - d d^T)) on its particles i, j.
-// Pinned particles' unknowns stay fixed, so their rows and columns become the identity. The
-// sparsity pattern (each particle with its springs' and tetrahedra's neighbours) is built once per
-// mesh; assembly then only writes values.
+// The matrix of the Newmark step's linear solves (newmark.hpp) in symmetric 3 x 3 blocks of floats
+// (numerics/symmetric_block_matrix.hpp, the off-diagonal ones rounded to float): the masses on the diagonal plus, for each spring term,
+// w_i w_j (c d d^T + c' (I - d d^T)) on its particles i, j. Conjugate gradients multiply by it on
+// all cores, block-Jacobi and multigrid are set up from it. Pinned particles' unknowns stay fixed,
+// so their rows become the identity and their columns drop out. The sparsity pattern (each
+// particle with its springs' and tetrahedra's neighbours) is built once per mesh; assembly then
+// only writes values, each particle's row from the terms it takes part in, in parallel.
 #include <array>
+#include <span>
+#include <utility>
 #include <vector>
 
 #include "msim/core/vec.hpp"
-#include "msim/numerics/sparse_ops.hpp"
+#include "msim/numerics/symmetric_block_matrix.hpp"
 #include "msim/solids/mass_spring.hpp"
 
 namespace msim::solids {
@@ -28,17 +31,19 @@ struct SpringTerm {
 
 class NewmarkMatrix {
  public:
-  // Writes M + the terms into the matrix (the pattern is rebuilt when the mesh changed).
-  void assemble(const MassSpringSystem& system, const std::vector<SpringTerm>& terms);
-  const numerics::SparseRowMatrix& matrix() const { return matrix_; }
+  // Writes M + the terms into the matrix (the pattern is rebuilt when the mesh changed). The terms
+  // each particle takes part in come as CSR by particle: incidence[incidenceStart[p] ..
+  // incidenceStart[p + 1]) = (term, the particle's weight in it).
+  void assemble(const MassSpringSystem& system, const std::vector<SpringTerm>& terms, std::span<const int> incidenceStart,
+                std::span<const std::pair<int, double>> incidence);
+  const numerics::SymmetricBlockMatrix& matrix() const { return matrix_; }
 
  private:
   void buildPattern(const MassSpringSystem& system);
-  // The position of block (i, j)'s first entry in row 3 i's values.
-  int blockOffset(int i, int j) const;
 
-  numerics::SparseRowMatrix matrix_;
-  std::vector<int> neighbourStart_, neighbours_;  // per particle, sorted, itself included
+  using Block = numerics::SymmetricBlock<double>;
+  numerics::SymmetricBlockMatrix matrix_;
+  std::vector<Block> exact_;  // the off-diagonal blocks before rounding, assemble's scratch
   std::size_t particles_ = 0, springs_ = 0, tetrahedra_ = 0;
 };
 

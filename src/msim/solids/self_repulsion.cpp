@@ -56,12 +56,17 @@ void SelfRepulsion::gatherContacts(const std::vector<Vec3>& x) {
   const auto& triangles = mesh_->triangles();
   const auto& edges = mesh_->edges();
   faceNormals_.resize(triangles.size());
+  faceCentroids_.resize(triangles.size());
+  faceRadii2_.resize(triangles.size());
   parallelFor(0, triangles.size(), [&](std::size_t i) {
     const auto& t = triangles[i];
-    const Vec3& a = x[static_cast<std::size_t>(t[0])];
-    const Vec3 normal = (x[static_cast<std::size_t>(t[1])] - a).cross(x[static_cast<std::size_t>(t[2])] - a);
+    const Vec3 &a = x[static_cast<std::size_t>(t[0])], &b = x[static_cast<std::size_t>(t[1])], &c = x[static_cast<std::size_t>(t[2])];
+    const Vec3 normal = (b - a).cross(c - a);
     const double length = normal.norm();
     faceNormals_[i] = length > 0.0 ? Vec3(normal / length) : Vec3::Zero();
+    const Vec3 centroid = (a + b + c) / 3.0;
+    faceCentroids_[i] = centroid;
+    faceRadii2_[i] = std::max({(a - centroid).squaredNorm(), (b - centroid).squaredNorm(), (c - centroid).squaredNorm()});
   });
   edgeMidpoints_.resize(edges.size());
   edgeHalfLengths_.resize(edges.size());
@@ -90,6 +95,10 @@ void SelfRepulsion::gatherContacts(const std::vector<Vec3>& x) {
         const double gap = (xp - a).dot(normal);  // the distance from the face along the remembered side
         if (!within(gap)) continue;
         // Only where the point lies over the face: near an edge or a corner the edge pairs act.
+        // The face lies within its farthest corner's distance of its centroid, so a point whose
+        // foot on the face's plane lies farther is not over it (most candidates of a flat cloth:
+        // neighbours beside the face).
+        if ((xp - faceCentroids_[triangle]).squaredNorm() - gap * gap > faceRadii2_[triangle]) continue;
         const std::optional<Vec3> weights =
             faceProjectionWeights(xp, a, x[static_cast<std::size_t>(t[1])], x[static_cast<std::size_t>(t[2])]);
         if (!weights || !(weights->minCoeff() > 0.0)) continue;

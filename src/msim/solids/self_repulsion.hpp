@@ -87,9 +87,10 @@ class SelfRepulsion {
   std::vector<EdgeEdgePair> foundEdgeEdge_;
   std::vector<std::vector<Contact>> blockContacts_;  // per block of pairs, joined into contacts_
   // Per pass of positions, shared by the many pairs of each face and edge: every triangle's unit
-  // normal (zero without area), every edge's midpoint and half length.
-  std::vector<Vec3> faceNormals_, edgeMidpoints_;
-  std::vector<double> edgeHalfLengths_;
+  // normal (zero without area), centroid and squared distance from it to its farthest corner,
+  // every edge's midpoint and half length.
+  std::vector<Vec3> faceNormals_, faceCentroids_, edgeMidpoints_;
+  std::vector<double> faceRadii2_, edgeHalfLengths_;
   std::vector<Contact> contacts_;
 };
 

@@ -1,0 +1,144 @@
+#include "msim/numerics/symmetric_block_matrix.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <stdexcept>
+
+#include <Eigen/Cholesky>
+
+#include "msim/core/parallel.hpp"
+
+namespace msim::numerics {
+
+namespace {
+
+// Rows per task: a few thousand particles' blocks, enough to hide the threads' start.
+constexpr std::size_t kRowGrain = 2048;
+
+}  // namespace
+
+void SymmetricBlockMatrix::setPattern(std::vector<int> rowStart, std::vector<int> columns) {
+  if (rowStart.empty() || rowStart.front() != 0 || static_cast<std::size_t>(rowStart.back()) != columns.size())
+    throw std::invalid_argument("SymmetricBlockMatrix: row starts do not span the columns");
+  const int n = static_cast<int>(rowStart.size()) - 1;
+  for (int r = 0; r < n; ++r) {
+    if (rowStart[r + 1] < rowStart[r]) throw std::invalid_argument("SymmetricBlockMatrix: row starts decrease");
+    for (int e = rowStart[r]; e < rowStart[r + 1]; ++e) {
+      if (columns[e] < 0 || columns[e] >= n || columns[e] == r)
+        throw std::invalid_argument("SymmetricBlockMatrix: an off-diagonal column lies outside or on the diagonal");
+      if (e > rowStart[r] && columns[e] <= columns[e - 1])
+        throw std::invalid_argument("SymmetricBlockMatrix: a row's columns are not sorted and distinct");
+    }
+  }
+  rowStart_ = std::move(rowStart);
+  columns_ = std::move(columns);
+  diagonal_.assign(static_cast<std::size_t>(n), SymmetricBlock<double>{});
+  blocks_.assign(columns_.size(), SymmetricBlock<float>{});
+}
+
+int SymmetricBlockMatrix::find(int row, int column) const {
+  const auto begin = columns_.begin() + rowStart_[static_cast<std::size_t>(row)];
+  const auto end = columns_.begin() + rowStart_[static_cast<std::size_t>(row) + 1];
+  const auto it = std::lower_bound(begin, end, column);
+  return it != end && *it == column ? static_cast<int>(it - columns_.begin()) : -1;
+}
+
+void SymmetricBlockMatrix::setRow(std::size_t r, const SymmetricBlock<double>& diagonal,
+                                  std::span<const SymmetricBlock<double>> offDiagonal) {
+  const std::span<SymmetricBlock<float>> rounded(blocks_.data() + rowStart_[r], offDiagonal.size());
+  for (std::size_t i = 0; i < offDiagonal.size(); ++i) {
+    const SymmetricBlock<double>& e = offDiagonal[i];
+    rounded[i] = {static_cast<float>(e.xx), static_cast<float>(e.yy), static_cast<float>(e.zz),
+                  static_cast<float>(e.xy), static_cast<float>(e.xz), static_cast<float>(e.yz)};
+  }
+  // The rounding is read back from memory: GCC 12's vectoriser folds double(float(x)) - x to zero
+  // with AVX when the stored value is forwarded (the fence keeps it from forwarding).
+  std::atomic_signal_fence(std::memory_order_seq_cst);
+  SymmetricBlock<double> d = diagonal;
+  for (std::size_t i = 0; i < offDiagonal.size(); ++i) {
+    const SymmetricBlock<double>& e = offDiagonal[i];
+    const SymmetricBlock<float>& f = rounded[i];
+    d.xx += e.xx - f.xx, d.yy += e.yy - f.yy, d.zz += e.zz - f.zz;
+    d.xy += e.xy - f.xy, d.xz += e.xz - f.xz, d.yz += e.yz - f.yz;
+  }
+  diagonal_[r] = d;
+}
+
+void SymmetricBlockMatrix::multiply(const Eigen::VectorXd& u, Eigen::VectorXd& y) const {
+  y.resize(static_cast<Eigen::Index>(3 * rows()));
+  multiply(u.data(), y.data());
+}
+
+void SymmetricBlockMatrix::multiply(const double* in, double* out) const {
+  parallelFor(0, rows(), [&](std::size_t r) {
+    const SymmetricBlock<double>& d = diagonal_[r];
+    const double* own = in + 3 * r;
+    double x = d.xx * own[0] + d.xy * own[1] + d.xz * own[2];
+    double y = d.xy * own[0] + d.yy * own[1] + d.yz * own[2];
+    double z = d.xz * own[0] + d.yz * own[1] + d.zz * own[2];
+    for (int e = rowStart_[r]; e < rowStart_[r + 1]; ++e) {
+      const SymmetricBlock<float>& b = blocks_[static_cast<std::size_t>(e)];
+      const double* v = in + 3 * static_cast<std::size_t>(columns_[static_cast<std::size_t>(e)]);
+      x += b.xx * v[0] + b.xy * v[1] + b.xz * v[2];
+      y += b.xy * v[0] + b.yy * v[1] + b.yz * v[2];
+      z += b.xz * v[0] + b.yz * v[1] + b.zz * v[2];
+    }
+    out[3 * r] = x, out[3 * r + 1] = y, out[3 * r + 2] = z;
+  }, kRowGrain);
+}
+
+SparseRowMatrix SymmetricBlockMatrix::expanded() const {
+  const auto n = static_cast<Eigen::Index>(3 * rows());
+  SparseRowMatrix A(n, n);
+  A.resizeNonZeros(static_cast<Eigen::Index>(9 * (columns_.size() + rows())));
+  int* outer = A.outerIndexPtr();
+  int* inner = A.innerIndexPtr();
+  double* value = A.valuePtr();
+  int entry = 0;
+  for (std::size_t r = 0; r < rows(); ++r) {
+    const Eigen::Matrix3d own = diagonal_[r].matrix();
+    for (int k = 0; k < 3; ++k) {
+      outer[3 * r + static_cast<std::size_t>(k)] = entry;
+      bool ownWritten = false;
+      const auto write = [&](int column, const Eigen::Matrix3d& m) {
+        for (int l = 0; l < 3; ++l) {
+          inner[entry] = 3 * column + l;
+          value[entry++] = m(k, l);
+        }
+      };
+      for (int e = rowStart_[r]; e < rowStart_[r + 1]; ++e) {
+        const int column = columns_[static_cast<std::size_t>(e)];
+        if (!ownWritten && column > static_cast<int>(r)) {
+          write(static_cast<int>(r), own);
+          ownWritten = true;
+        }
+        const SymmetricBlock<float>& b = blocks_[static_cast<std::size_t>(e)];
+        write(column, SymmetricBlock<double>{b.xx, b.yy, b.zz, b.xy, b.xz, b.yz}.matrix());
+      }
+      if (!ownWritten) write(static_cast<int>(r), own);
+    }
+  }
+  outer[n] = entry;
+  return A;
+}
+
+void SymmetricBlockJacobi::setup(const SymmetricBlockMatrix& A) {
+  inverse_.resize(A.rows());
+  std::atomic<bool> indefinite = false;
+  parallelFor(0, A.rows(), [&](std::size_t r) {
+    const Eigen::LLT<Eigen::Matrix3d> llt(A.diagonal(r).matrix());
+    if (llt.info() != Eigen::Success) indefinite = true;
+    else inverse_[r] = llt.solve(Eigen::Matrix3d::Identity());
+  }, kRowGrain);
+  if (indefinite) throw std::invalid_argument("SymmetricBlockJacobi: a diagonal block is not positive definite");
+}
+
+void SymmetricBlockJacobi::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const {
+  z.resize(r.size());
+  parallelFor(0, inverse_.size(), [&](std::size_t i) {
+    const auto row = static_cast<Eigen::Index>(3 * i);
+    z.segment<3>(row) = inverse_[i] * r.segment<3>(row);
+  }, kRowGrain);
+}
+
+}  // namespace msim::numerics
