@@ -5,7 +5,9 @@ scenes/cloth_leaves.json (a scaled-down Selle Fig. 6.9: 100 cloths in strong win
 Leaves are at least 0.14 m apart (centre to centre, more than a diagonal and a thickness),
 so none touches another at the start.
 
-Usage: python3 scripts/make_leaves_mesh.py [output.obj]
+Usage: python3 scripts/make_leaves_mesh.py [output.obj] [quads_u quads_v]
+The quads per leaf default to 6 x 4; 25 x 20 gives 100 leaves of 1000 triangles (100k in all),
+the resolution of docs/PERFORMANCE.md's leaves frame time.
 """
 import math
 import random
@@ -31,6 +33,7 @@ def rotation(rng):
 
 def main():
     out = sys.argv[1] if len(sys.argv) > 1 else "scenes/meshes/leaves.obj"
+    quads_u, quads_v = (int(sys.argv[2]), int(sys.argv[3])) if len(sys.argv) > 3 else (QUADS_U, QUADS_V)
     rng = random.Random(SEED)
     centres = []
     while len(centres) < COUNT:
@@ -41,20 +44,20 @@ def main():
         fh.write("# %d leaves for scenes/cloth_leaves.json (scripts/make_leaves_mesh.py)\n" % COUNT)
         for c in centres:
             r = rotation(rng)
-            for j in range(QUADS_V + 1):
-                for i in range(QUADS_U + 1):
-                    local = (LENGTH * (i / QUADS_U - 0.5), 0.0, WIDTH * (j / QUADS_V - 0.5))
+            for j in range(quads_v + 1):
+                for i in range(quads_u + 1):
+                    local = (LENGTH * (i / quads_u - 0.5), 0.0, WIDTH * (j / quads_v - 0.5))
                     p = [c[k] + sum(r[k][m] * local[m] for m in range(3)) for k in range(3)]
                     fh.write("v %.6f %.6f %.6f\n" % tuple(p))
-        per_leaf = (QUADS_U + 1) * (QUADS_V + 1)
+        per_leaf = (quads_u + 1) * (quads_v + 1)
         for leaf in range(COUNT):
             base = leaf * per_leaf + 1
-            for j in range(QUADS_V):
-                for i in range(QUADS_U):
-                    a = base + j * (QUADS_U + 1) + i
-                    b, c, d = a + 1, a + QUADS_U + 2, a + QUADS_U + 1
+            for j in range(quads_v):
+                for i in range(quads_u):
+                    a = base + j * (quads_u + 1) + i
+                    b, c, d = a + 1, a + quads_u + 2, a + quads_u + 1
                     fh.write("f %d %d %d\nf %d %d %d\n" % (a, b, c, a, c, d))
-    print("%s: %d vertices, %d triangles" % (out, COUNT * (QUADS_U + 1) * (QUADS_V + 1), COUNT * 2 * QUADS_U * QUADS_V))
+    print("%s: %d vertices, %d triangles" % (out, COUNT * (quads_u + 1) * (quads_v + 1), COUNT * 2 * quads_u * quads_v))
 
 
 if __name__ == "__main__":

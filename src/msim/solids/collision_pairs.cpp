@@ -19,16 +19,47 @@ bool sharesVertex(const std::array<int, 2>& e, const std::array<int, 2>& f) {
   return e[0] == f[0] || e[0] == f[1] || e[1] == f[0] || e[1] == f[1];
 }
 
-// Per-thread pair lists, concatenated and sorted: the same result whatever the thread count. The
-// lists are emptied for the next query, keeping their memory.
-template <typename Pair>
-void gather(tbb::enumerable_thread_specific<std::vector<Pair>>& local, std::vector<Pair>& out) {
-  out.clear();
-  for (auto& part : local) {
-    out.insert(out.end(), part.begin(), part.end());
-    part.clear();
+// Whether two groups of vertices (first `split` of `v`, then the rest), each moving on a straight
+// line from start to end, may come within 2 margin of each other, judged in the frame that moves
+// with their mean displacement (Selle ch. 6.3, step C.2): a distance is the same in every frame
+// moving uniformly, and in this one the boxes of a pair that moves together (a cloth's flap swinging
+// as a whole) stay small, where in the frame of the cloth's mean motion they sweep the flap's path.
+bool mayMeetInPairFrame(const std::vector<Vec3>& start, const std::vector<Vec3>& end, const std::array<int, 4>& v,
+                        int split, double margin) {
+  Vec3 mean = Vec3::Zero();
+  for (const int i : v) mean += end[static_cast<std::size_t>(i)] - start[static_cast<std::size_t>(i)];
+  mean /= 4.0;
+  numerics::Aabb a, b;
+  for (int k = 0; k < 4; ++k) {
+    const auto i = static_cast<std::size_t>(v[static_cast<std::size_t>(k)]);
+    numerics::Aabb& box = k < split ? a : b;
+    box.grow(start[i]);
+    box.grow(end[i] - mean);
   }
-  std::sort(out.begin(), out.end());
+  a.inflate(margin);
+  b.inflate(margin);
+  return a.overlaps(b);
+}
+
+// Queries per chunk: each chunk's finds go to its own list, and the lists are joined in the
+// chunks' order, so the pairs come out in the same order whatever the thread count (without the
+// cost of sorting millions of them). The lists keep their memory for the next query.
+constexpr std::size_t kChunk = 256;
+
+template <typename Pair, typename Query>
+void findInChunks(std::size_t count, std::vector<std::vector<Pair>>& chunks, std::vector<Pair>& out, Query&& query) {
+  const std::size_t chunkCount = (count + kChunk - 1) / kChunk;
+  if (chunks.size() < chunkCount) chunks.resize(chunkCount);
+  parallelFor(0, chunkCount, [&](std::size_t c) {
+    std::vector<Pair>& found = chunks[c];
+    found.clear();
+    for (std::size_t i = c * kChunk; i < std::min(count, (c + 1) * kChunk); ++i) query(i, found);
+  }, 1);
+  std::size_t total = 0;
+  for (std::size_t c = 0; c < chunkCount; ++c) total += chunks[c].size();
+  out.clear();
+  out.reserve(total);
+  for (std::size_t c = 0; c < chunkCount; ++c) out.insert(out.end(), chunks[c].begin(), chunks[c].end());
 }
 
 }  // namespace
@@ -82,36 +113,28 @@ void CollisionPairs::find(const std::vector<Vec3>& start, const std::vector<Vec3
   ++queries_;
   const auto isMoved = [&](int v) { return moved == nullptr || (*moved)[static_cast<std::size_t>(v)] != 0; };
 
-  parallelFor(
-      0, vertexCount_,
-      [&](std::size_t v) {
-        auto& out = localPointTriangle_.local();
+  findInChunks(vertexCount_, pointTriangleChunks_, pointTriangle, [&](std::size_t v, std::vector<PointTrianglePair>& out) {
         const int point = static_cast<int>(v);
         triangleTree_.forEachOverlap(vertexBoxes_[v], [&](int t) {
           const auto& tri = triangles_[static_cast<std::size_t>(t)];
           if (tri[0] == point || tri[1] == point || tri[2] == point) return;
           if (!isMoved(point) && !isMoved(tri[0]) && !isMoved(tri[1]) && !isMoved(tri[2])) return;
+          if (!mayMeetInPairFrame(start, end, {point, tri[0], tri[1], tri[2]}, 1, margin)) return;
           out.push_back({point, t});
         });
-      },
-      256);
-  gather(localPointTriangle_, pointTriangle);
+      });
 
-  parallelFor(
-      0, edges_.size(),
-      [&](std::size_t e) {
-        auto& out = localEdgeEdge_.local();
+  findInChunks(edges_.size(), edgeEdgeChunks_, edgeEdge, [&](std::size_t e, std::vector<EdgeEdgePair>& out) {
         const auto& edge = edges_[e];
         edgeTree_.forEachOverlap(edgeBoxes_[e], [&](int f) {
           if (f <= static_cast<int>(e)) return;  // each pair once
           const auto& other = edges_[static_cast<std::size_t>(f)];
           if (sharesVertex(edge, other)) return;
           if (!isMoved(edge[0]) && !isMoved(edge[1]) && !isMoved(other[0]) && !isMoved(other[1])) return;
+          if (!mayMeetInPairFrame(start, end, {edge[0], edge[1], other[0], other[1]}, 2, margin)) return;
           out.push_back({static_cast<int>(e), f});
         });
-      },
-      256);
-  gather(localEdgeEdge_, edgeEdge);
+      });
 }
 
 }  // namespace msim::solids

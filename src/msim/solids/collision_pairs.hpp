@@ -4,13 +4,13 @@
 // bounding-volume trees over the triangles' and the edges' boxes. A primitive's box spans its
 // vertices at the start and at the end of a motion, grown by a margin: for a mesh at rest
 // (start = end) the pairs within the margin (repulsions, step A), for a moving one the pairs
-// that may meet during the motion (continuous collision detection, step C). The pruning is loose
-// on purpose (ch. 6.2): the narrow phase decides. Pairs that share a vertex are never reported
+// that may meet during the motion (continuous collision detection, step C). The trees find the
+// overlaps in the frame of the positions given; each leaf pair is then tested again in the frame
+// that moves with its own mean displacement (ch. 6.3, step C.2). The pruning is loose on purpose
+// (ch. 6.2): the narrow phase decides. Pairs that share a vertex are never reported
 // (a triangle's own vertices, edges meeting at a vertex).
 #include <array>
 #include <vector>
-
-#include <tbb/enumerable_thread_specific.h>
 
 #include "msim/core/vec.hpp"
 #include "msim/numerics/bvh.hpp"
@@ -39,7 +39,7 @@ class CollisionPairs {
   const std::vector<std::array<int, 2>>& edges() const { return edges_; }
 
   // Pairs whose boxes over `start` and `end` (the same vector for a mesh at rest), each grown by
-  // `margin`, overlap; sorted, so the result does not depend on the thread count. `moved`, when
+  // `margin`, overlap; by point (edge), then in the trees' order: the same whatever the thread count. `moved`, when
   // given, keeps only pairs with at least one vertex flagged (the later passes of step C.5).
   void find(const std::vector<Vec3>& start, const std::vector<Vec3>& end, double margin,
             std::vector<PointTrianglePair>& pointTriangle, std::vector<EdgeEdgePair>& edgeEdge,
@@ -52,8 +52,8 @@ class CollisionPairs {
   std::vector<numerics::Aabb> vertexBoxes_, triangleBoxes_, edgeBoxes_;
   numerics::Bvh triangleTree_, edgeTree_;
   long queries_ = 0;
-  tbb::enumerable_thread_specific<std::vector<PointTrianglePair>> localPointTriangle_;  // per-thread finds
-  tbb::enumerable_thread_specific<std::vector<EdgeEdgePair>> localEdgeEdge_;
+  std::vector<std::vector<PointTrianglePair>> pointTriangleChunks_;  // per chunk of queries, joined in order
+  std::vector<std::vector<EdgeEdgePair>> edgeEdgeChunks_;
 };
 
 }  // namespace msim::solids

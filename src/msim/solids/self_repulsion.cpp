@@ -14,21 +14,44 @@ namespace msim::solids {
 void SelfRepulsion::findPairs(CollisionPairs& pairs, const std::vector<Vec3>& x, const std::vector<Vec3>& predicted) {
   mesh_ = &pairs;
   pairs.find(x, predicted, settings_.thickness, foundPointTriangle_, foundEdgeEdge_);
-  pointTriangle_.clear();
-  for (const PointTrianglePair& p : foundPointTriangle_) {
+  // Each pair's side in the collision-free state (eq. 6.2's history), on all cores.
+  pointTriangle_.resize(foundPointTriangle_.size());
+  parallelFor(0, foundPointTriangle_.size(), [&](std::size_t i) {
+    const PointTrianglePair& p = foundPointTriangle_[i];
     const auto& t = pairs.triangles()[static_cast<std::size_t>(p.triangle)];
     const Vec3& a = x[static_cast<std::size_t>(t[0])];
     const double side = (x[static_cast<std::size_t>(t[1])] - a).cross(x[static_cast<std::size_t>(t[2])] - a).dot(x[static_cast<std::size_t>(p.point)] - a);
-    pointTriangle_.push_back({p, side < 0.0});
-  }
-  edgeEdge_.clear();
-  for (const EdgeEdgePair& p : foundEdgeEdge_) {
+    pointTriangle_[i] = {p, side < 0.0};
+  });
+  edgeEdge_.resize(foundEdgeEdge_.size());
+  parallelFor(0, foundEdgeEdge_.size(), [&](std::size_t i) {
+    const EdgeEdgePair& p = foundEdgeEdge_[i];
     const auto& e = pairs.edges()[static_cast<std::size_t>(p.first)];
     const auto& f = pairs.edges()[static_cast<std::size_t>(p.second)];
     const EdgeEdgeProximity prox = edgeEdgeProximity(x[static_cast<std::size_t>(e[0])], x[static_cast<std::size_t>(e[1])],
                                                      x[static_cast<std::size_t>(f[0])], x[static_cast<std::size_t>(f[1])]);
-    edgeEdge_.push_back({p, prox.normal});
-  }
+    edgeEdge_[i] = {p, prox.normal};
+  });
+}
+
+double SelfRepulsion::approachSpeedBound(const std::vector<Vec3>& v) const {
+  if (mesh_ == nullptr) return 0.0;
+  const auto& triangles = mesh_->triangles();
+  const auto& edges = mesh_->edges();
+  const auto at = [&](int i) -> const Vec3& { return v[static_cast<std::size_t>(i)]; };
+  const double points = parallelMax(pointTriangle_.size(), [&](std::size_t i) {
+    const PointTrianglePair& p = pointTriangle_[i].pair;
+    const auto& t = triangles[static_cast<std::size_t>(p.triangle)];
+    const Vec3& vp = at(p.point);
+    return std::sqrt(std::max({(vp - at(t[0])).squaredNorm(), (vp - at(t[1])).squaredNorm(), (vp - at(t[2])).squaredNorm()}));
+  });
+  const double edgePairs = parallelMax(edgeEdge_.size(), [&](std::size_t i) {
+    const auto& e = edges[static_cast<std::size_t>(edgeEdge_[i].pair.first)];
+    const auto& f = edges[static_cast<std::size_t>(edgeEdge_[i].pair.second)];
+    return std::sqrt(std::max({(at(e[0]) - at(f[0])).squaredNorm(), (at(e[0]) - at(f[1])).squaredNorm(),
+                               (at(e[1]) - at(f[0])).squaredNorm(), (at(e[1]) - at(f[1])).squaredNorm()}));
+  });
+  return std::max(points, edgePairs);
 }
 
 int SelfRepulsion::repelPositionVelocity(const std::vector<Vec3>& x, std::vector<Vec3>& v,

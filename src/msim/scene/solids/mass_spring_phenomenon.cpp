@@ -43,6 +43,9 @@ constexpr double kExplodedStrain = 10.0;  // a spring stretched to 11 times its 
 // Symmetric Gauss-Seidel sweeps of strain limiting per step: a hanging chain of 10 springs at 49%
 // stretch comes to rest at the limit (tests/solids/strain_limit_test.cpp).
 constexpr int kStrainLimitSweeps = 50;
+// Linearisations per half step of a frame-sized step by default: a hanging cloth swinging at one
+// step per frame keeps its energy (docs/solids.md); the collision loop's small inner steps need one.
+constexpr int kFrameStepLinearisations = 4;
 
 // The keys cloth and solid share, in their object: gravity, the solver, outputs, pins.
 void declareMassSpringKeys(Schema& object, const char* what, double strainLimit) {
@@ -54,10 +57,11 @@ void declareMassSpringKeys(Schema& object, const char* what, double strainLimit)
   object.boolean("implicit_springs", true,
                  "springs implicit along themselves (Selle ch. 5.5) and, when stretched, across (their tension): stable "
                  "at one step per frame");
-  object.integer("newton_iterations", 4,
-                 "most linearisations of the springs per half step (the seed: 1); more keep a large step from "
-                 "gaining energy")
-      .min(1);
+  object.integer("newton_iterations", 0,
+                 "most linearisations of the springs per half step; more keep a large step from gaining energy. 0: "
+                 "1 (the seed's) in the self-collision loop's inner steps of at most a frame / inner_steps, 4 for "
+                 "frame-sized steps")
+      .min(0);
   object.number("newton_tolerance", "", 0.03,
                 "the linearisations stop once one moves no particle by this fraction of the shortest spring")
       .min(0.0, Bound::Exclusive);
@@ -219,13 +223,15 @@ class MassSpringPhenomenon final : public Phenomenon {
     solids::NewmarkSettings settings;
     settings.implicitSprings = c.at("implicit_springs").get<bool>();
     settings.cgTolerance = c.at("cg_tolerance").get<double>();
+    const bool collisionLoop = kind_ == "cloth" && c.at("self_collisions").get<bool>();
     settings.newtonIterations = static_cast<int>(c.at("newton_iterations").get<long long>());
+    if (settings.newtonIterations == 0) settings.newtonIterations = collisionLoop ? 1 : kFrameStepLinearisations;
     settings.newtonTolerance = c.at("newton_tolerance").get<double>();
     settings.preconditioner = c.at("preconditioner").get<std::string>() == "multigrid" ? solids::SolvePreconditioner::Multigrid
                                                                                      : solids::SolvePreconditioner::Jacobi;
     stepper_ = solids::NewmarkStepper(settings);
     strainLimit_ = c.at("strain_limit").get<double>();
-    if (kind_ == "cloth" && c.at("self_collisions").get<bool>()) buildCollisionLoop(c, settings);
+    if (collisionLoop) buildCollisionLoop(c, settings);
     implicitSprings_ = settings.implicitSprings;
     springMass_.resize(system_.springs.size());
     for (std::size_t i = 0; i < system_.springs.size(); ++i) {
@@ -259,11 +265,11 @@ class MassSpringPhenomenon final : public Phenomenon {
   // The explicit part's limit 2 / omega. Explicit springs: omega^2 = k / (l0 mu) along each.
   // Implicit springs (ch. 5.5, with their tension across them) have no limit, and a frame can be
   // one step; what stays explicit is the wind's drag, c A / m per particle (windForces). With
-  // self-collisions an inner step also moves no vertex further than the thickness relative to
-  // the cloth's mean motion: repulsion (step B) acts only on pairs closer than it, and a pair that
-  // crossed the band within one inner step is left to step C, whose impulse takes back the
-  // pair's whole approach over the outer step (an outer step of a frame would tear the cloth
-  // where pieces meet fast).
+  // self-collisions an inner step also moves the two sides of any pair that may meet by no more
+  // than the thickness relative to each other: repulsion (step B) acts only on pairs closer than it,
+  // and a pair that crossed the band within one inner step is left to step C, whose impulse takes
+  // back the pair's whole approach over the outer step (an outer step of a frame would tear the
+  // cloth where pieces meet fast). A flap that swings fast as a whole does not shorten the step.
   double innerStableTimestep() const {
     double step = std::numeric_limits<double>::infinity();
     if (!implicitSprings_)
@@ -274,10 +280,17 @@ class MassSpringPhenomenon final : public Phenomenon {
       }
     if (!winds_.empty() && windDrag_ > 0.0) step = std::min(step, 2.0 * massPerDragArea_ / windDrag_);
     if (loop_) {
-      const Vec3 mean = system_.meanVelocity();
+      // How fast the sides of a pair may approach: over the pairs of the last step A, whose swept
+      // boxes hold every pair that may meet within the outer step; before the first, any vertex
+      // against the cloth's mean motion.
       double fastest = 0.0;
-      for (std::size_t p = 0; p < system_.size(); ++p)
-        if (!system_.pinned[p]) fastest = std::max(fastest, (system_.v[p] - mean).norm());
+      if (const std::optional<double> pairs = loop_->pairApproachSpeed(system_)) {
+        fastest = *pairs;
+      } else {
+        const Vec3 mean = system_.meanVelocity();
+        for (std::size_t p = 0; p < system_.size(); ++p)
+          if (!system_.pinned[p]) fastest = std::max(fastest, 2.0 * (system_.v[p] - mean).norm());
+      }
       if (fastest > 0.0) step = std::min(step, loop_->settings().repulsion.thickness / fastest);
     }
     return cfl_ * step;
