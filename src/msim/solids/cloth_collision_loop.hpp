@@ -16,7 +16,6 @@
 // kept, for the seed's Table 6.3 split.
 #include <array>
 #include <functional>
-#include <optional>
 #include <vector>
 
 #include "msim/solids/body_contact.hpp"
@@ -61,13 +60,6 @@ class ClothCollisionLoop {
                            const BodyContact* bodies, const std::function<void(double)>& placeBodies = {});
 
   const ClothCollisionSettings& settings() const { return settings_; }
-  // After the first outer step: the fastest the two sides of any pair found in its step A approach
-  // each other (SelfRepulsion::approachSpeedBound); before it, nothing (the caller falls back on a
-  // bound of its own).
-  std::optional<double> pairApproachSpeed(const MassSpringSystem& system) const {
-    if (!repulsion_.hasPairs()) return std::nullopt;
-    return repulsion_.approachSpeedBound(system.v);
-  }
 
  private:
   ClothCollisionSettings settings_;

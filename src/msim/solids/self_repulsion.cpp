@@ -34,26 +34,6 @@ void SelfRepulsion::findPairs(CollisionPairs& pairs, const std::vector<Vec3>& x,
   });
 }
 
-double SelfRepulsion::approachSpeedBound(const std::vector<Vec3>& v) const {
-  if (mesh_ == nullptr) return 0.0;
-  const auto& triangles = mesh_->triangles();
-  const auto& edges = mesh_->edges();
-  const auto at = [&](int i) -> const Vec3& { return v[static_cast<std::size_t>(i)]; };
-  const double points = parallelMax(pointTriangle_.size(), [&](std::size_t i) {
-    const PointTrianglePair& p = pointTriangle_[i].pair;
-    const auto& t = triangles[static_cast<std::size_t>(p.triangle)];
-    const Vec3& vp = at(p.point);
-    return std::sqrt(std::max({(vp - at(t[0])).squaredNorm(), (vp - at(t[1])).squaredNorm(), (vp - at(t[2])).squaredNorm()}));
-  });
-  const double edgePairs = parallelMax(edgeEdge_.size(), [&](std::size_t i) {
-    const auto& e = edges[static_cast<std::size_t>(edgeEdge_[i].pair.first)];
-    const auto& f = edges[static_cast<std::size_t>(edgeEdge_[i].pair.second)];
-    return std::sqrt(std::max({(at(e[0]) - at(f[0])).squaredNorm(), (at(e[0]) - at(f[1])).squaredNorm(),
-                               (at(e[1]) - at(f[0])).squaredNorm(), (at(e[1]) - at(f[1])).squaredNorm()}));
-  });
-  return std::max(points, edgePairs);
-}
-
 int SelfRepulsion::repelPositionVelocity(const std::vector<Vec3>& x, std::vector<Vec3>& v,
                                          const std::vector<double>& inverseMass, double dt) {
   gatherContacts(x);

@@ -54,10 +54,6 @@ class SelfRepulsion {
   int repelEndVelocity(const std::vector<Vec3>& x, std::vector<Vec3>& v, const std::vector<double>& inverseMass);
 
   RepulsionStats stats() const { return {static_cast<int>(pointTriangle_.size()), static_cast<int>(edgeEdge_.size())}; }
-  bool hasPairs() const { return mesh_ != nullptr; }  // step A has run
-  // The fastest the two sides of any pair from step A move relative to each other at velocities v:
-  // the largest |v_i - v_j|, i of one side (a point, an edge) and j of the other (on all cores).
-  double approachSpeedBound(const std::vector<Vec3>& v) const;
 
  private:
   enum class Pass { Inelastic, Elastic, EndOfStep };

@@ -265,11 +265,14 @@ class MassSpringPhenomenon final : public Phenomenon {
   // The explicit part's limit 2 / omega. Explicit springs: omega^2 = k / (l0 mu) along each.
   // Implicit springs (ch. 5.5, with their tension across them) have no limit, and a frame can be
   // one step; what stays explicit is the wind's drag, c A / m per particle (windForces). With
-  // self-collisions an inner step also moves the two sides of any pair that may meet by no more
-  // than the thickness relative to each other: repulsion (step B) acts only on pairs closer than it,
-  // and a pair that crossed the band within one inner step is left to step C, whose impulse takes
-  // back the pair's whole approach over the outer step (an outer step of a frame would tear the
-  // cloth where pieces meet fast). A flap that swings fast as a whole does not shorten the step.
+  // self-collisions an inner step also moves no vertex further than the thickness relative to
+  // the cloth's mean motion: repulsion (step B) acts only on pairs closer than it, and a pair that
+  // crossed the band within one inner step is left to step C, whose impulse takes back the
+  // pair's whole approach over the outer step (an outer step of a frame would tear the cloth
+  // where pieces meet fast). The bound also keeps the outer step short enough for step A's
+  // straight-line prediction: pieces that speed up towards each other (leaves in a gust) are not
+  // among its pairs when it errs, and step C then pulls them back by their whole approach. Bounding
+  // only the approach of A's pairs let 100 leaves of 1000 triangles tear in their second frame.
   double innerStableTimestep() const {
     double step = std::numeric_limits<double>::infinity();
     if (!implicitSprings_)
@@ -280,17 +283,10 @@ class MassSpringPhenomenon final : public Phenomenon {
       }
     if (!winds_.empty() && windDrag_ > 0.0) step = std::min(step, 2.0 * massPerDragArea_ / windDrag_);
     if (loop_) {
-      // How fast the sides of a pair may approach: over the pairs of the last step A, whose swept
-      // boxes hold every pair that may meet within the outer step; before the first, any vertex
-      // against the cloth's mean motion.
+      const Vec3 mean = system_.meanVelocity();
       double fastest = 0.0;
-      if (const std::optional<double> pairs = loop_->pairApproachSpeed(system_)) {
-        fastest = *pairs;
-      } else {
-        const Vec3 mean = system_.meanVelocity();
-        for (std::size_t p = 0; p < system_.size(); ++p)
-          if (!system_.pinned[p]) fastest = std::max(fastest, 2.0 * (system_.v[p] - mean).norm());
-      }
+      for (std::size_t p = 0; p < system_.size(); ++p)
+        if (!system_.pinned[p]) fastest = std::max(fastest, (system_.v[p] - mean).norm());
       if (fastest > 0.0) step = std::min(step, loop_->settings().repulsion.thickness / fastest);
     }
     return cfl_ * step;
