@@ -1,7 +1,7 @@
 // The float-block matrix of mass-spring solves (symmetric_block_matrix.hpp) against the same matrix
 // held exactly in double: the product within float rounding, exactly symmetric, a uniform vector
-// (a rigid translation) applied as exactly as in double, block-Jacobi inverting the diagonal
-// blocks, the expanded CSR equal to the product, and patterns that are not sorted refused.
+// (a rigid translation) applied as exactly as in double, block-Jacobi (block_jacobi.hpp) inverting
+// its diagonal blocks, the expanded CSR equal to the product, and patterns that are not sorted refused.
 #include <gtest/gtest.h>
 
 #include <stdexcept>
@@ -10,6 +10,7 @@
 #include <Eigen/Dense>
 
 #include "msim/core/rng.hpp"
+#include "msim/numerics/block_jacobi.hpp"
 #include "msim/numerics/symmetric_block_matrix.hpp"
 
 using namespace msim;
@@ -101,7 +102,7 @@ TEST(SymmetricBlockMatrix, AppliesARigidTranslationAsTheExactMatrix) {
 TEST(SymmetricBlockMatrix, BlockJacobiInvertsTheDiagonalBlocks) {
   Rng rng(7);
   const Chain chain = springChain(50, rng);
-  SymmetricBlockJacobi jacobi;
+  BlockJacobi jacobi;
   jacobi.setup(chain.matrix);
   Eigen::VectorXd r(150), z;
   for (Eigen::Index i = 0; i < r.size(); ++i) r[i] = rng.normal();

@@ -6,6 +6,7 @@
 
 #include "msim/numerics/block_jacobi.hpp"
 
+#include <atomic>
 #include <stdexcept>
 #include <vector>
 
@@ -46,6 +47,18 @@ void BlockJacobi::setup(const SparseRowMatrix& A, int blockSize) {
     case 3: invertDiagonalBlocks<3>(A, inverse_); break;
     default: invertDiagonalBlocks<6>(A, inverse_); break;
   }
+}
+
+void BlockJacobi::setup(const SymmetricBlockMatrix& A) {
+  blockSize_ = 3;
+  inverse_.resize(9 * A.rows());
+  std::atomic<bool> indefinite = false;
+  parallelFor(0, A.rows(), [&](std::size_t r) {
+    const Eigen::LLT<Eigen::Matrix3d> llt(A.diagonal(r).matrix());
+    if (llt.info() != Eigen::Success) indefinite = true;
+    else Eigen::Map<Eigen::Matrix3d>(inverse_.data() + 9 * r) = llt.solve(Eigen::Matrix3d::Identity());
+  }, 2048);
+  if (indefinite) throw std::invalid_argument("block Jacobi: a diagonal block is not positive definite");
 }
 
 SparseRowMatrix BlockJacobi::inverseMatrix() const {

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "msim/numerics/sparse_ops.hpp"
+#include "msim/numerics/symmetric_block_matrix.hpp"
 
 namespace msim::numerics {
 
@@ -14,6 +15,8 @@ class BlockJacobi {
   // D^-1 of A's b x b diagonal blocks (b = 1-6); std::invalid_argument if one is not positive
   // definite.
   void setup(const SparseRowMatrix& A, int blockSize);
+  // The same with b = 3 from a symmetric block matrix's diagonal blocks (on all cores).
+  void setup(const SymmetricBlockMatrix& A);
   // z = D^-1 r (z resized; r and z must differ).
   void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
   int blockSize() const { return blockSize_; }

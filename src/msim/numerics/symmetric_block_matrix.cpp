@@ -1,10 +1,7 @@
 #include "msim/numerics/symmetric_block_matrix.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <stdexcept>
-
-#include <Eigen/Cholesky>
 
 #include "msim/core/parallel.hpp"
 
@@ -120,25 +117,6 @@ SparseRowMatrix SymmetricBlockMatrix::expanded() const {
   }
   outer[n] = entry;
   return A;
-}
-
-void SymmetricBlockJacobi::setup(const SymmetricBlockMatrix& A) {
-  inverse_.resize(A.rows());
-  std::atomic<bool> indefinite = false;
-  parallelFor(0, A.rows(), [&](std::size_t r) {
-    const Eigen::LLT<Eigen::Matrix3d> llt(A.diagonal(r).matrix());
-    if (llt.info() != Eigen::Success) indefinite = true;
-    else inverse_[r] = llt.solve(Eigen::Matrix3d::Identity());
-  }, kRowGrain);
-  if (indefinite) throw std::invalid_argument("SymmetricBlockJacobi: a diagonal block is not positive definite");
-}
-
-void SymmetricBlockJacobi::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const {
-  z.resize(r.size());
-  parallelFor(0, inverse_.size(), [&](std::size_t i) {
-    const auto row = static_cast<Eigen::Index>(3 * i);
-    z.segment<3>(row) = inverse_[i] * r.segment<3>(row);
-  }, kRowGrain);
 }
 
 }  // namespace msim::numerics

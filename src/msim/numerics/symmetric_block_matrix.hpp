@@ -5,8 +5,8 @@
 // 3 x 3 doubles in scalar CSR, which is what a memory-bound product over a cloth of 100k triangles
 // pays for; the diagonal blocks stay double and absorb the rounding of their row (setRow), so the
 // rounded matrix applies to a vector that is the same at every node (a rigid translation) exactly
-// as the exact one: a moving cloth is not damped by rounding. A row is one thread's in the product
-// and block-Jacobi, so both give the same result whatever the thread count.
+// as the exact one: a moving cloth is not damped by rounding. A row is one thread's in the product,
+// so it gives the same result whatever the thread count. block_jacobi.hpp preconditions it.
 #include <cstddef>
 #include <span>
 #include <vector>
@@ -57,17 +57,6 @@ class SymmetricBlockMatrix {
   std::vector<int> rowStart_, columns_;
   std::vector<SymmetricBlock<double>> diagonal_;
   std::vector<SymmetricBlock<float>> blocks_;
-};
-
-// Block-Jacobi with the inverse of each block row's diagonal block: z = D^-1 r.
-class SymmetricBlockJacobi {
- public:
-  // std::invalid_argument if a diagonal block is not positive definite.
-  void setup(const SymmetricBlockMatrix& A);
-  void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
-
- private:
-  std::vector<Eigen::Matrix3d> inverse_;
 };
 
 }  // namespace msim::numerics

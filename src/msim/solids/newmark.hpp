@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "msim/core/vec.hpp"
+#include "msim/numerics/block_jacobi.hpp"
 #include "msim/numerics/smoothed_aggregation.hpp"
 #include "msim/numerics/sparse_cg.hpp"
 #include "msim/solids/body_contact.hpp"
@@ -96,7 +97,7 @@ class NewmarkStepper {
   std::vector<Vec3> residual_, product_, linearisedAt_, previous_;
   double shortestSpring_ = 0.0;  // rest length, or altitude, over the last gathered terms
   NewmarkMatrix matrix_;
-  numerics::SymmetricBlockJacobi jacobi_;
+  numerics::BlockJacobi jacobi_;
   // The multigrid hierarchy is built from one solve's matrix and kept while it serves: the matrices
   // of later solves differ little (springs turn slowly from step to step). A new one is built when
   // the half step h changes by more than a quarter (the stiffness terms scale with h^2), or when a
