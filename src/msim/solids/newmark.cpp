@@ -129,6 +129,18 @@ NewmarkStats NewmarkStepper::solveHalfStep(const MassSpringSystem& system, const
   residual_.resize(n);
   product_.resize(n);
   linearisedAt_.resize(n);
+  // The solve's tolerance is relative to the right-hand side seen from the particles' mean motion:
+  // the scheme is unchanged by a uniform translation (springs act on differences), and a yardstick
+  // that grew with M v would let a fast-moving cloth stop short and lose speed with every step (a
+  // cloth sliding at 2.6 m/s slowed 5% more than friction does at 16 steps per frame).
+  Vec3 momentum = Vec3::Zero();
+  double freeMass = 0.0;
+  for (std::size_t p = 0; p < n; ++p)
+    if (!system.pinned[p]) {
+      momentum += system.mass[p] * from[p];
+      freeMass += system.mass[p];
+    }
+  const Vec3 meanVelocity = freeMass > 0.0 ? Vec3(momentum / freeMass) : Vec3::Zero();
   for (int k = 0; k < iterations; ++k) {
     // x_k = base + c v_k, with v_0 = 0 and v_k the last solve's answer.
     for (std::size_t p = 0; p < n; ++p) linearisedAt_[p] = k == 0 ? base[p] : base[p] + reach * out[p];
@@ -141,7 +153,7 @@ NewmarkStats NewmarkStepper::solveHalfStep(const MassSpringSystem& system, const
     for (std::size_t p = 0; p < n; ++p) {
       if (system.pinned[p]) continue;
       residual_[p] = system.mass[p] * from[p] + h * forces_[p] + product_[p];
-      rhsNorm2 += residual_[p].squaredNorm();
+      rhsNorm2 += (residual_[p] - system.mass[p] * meanVelocity).squaredNorm();
     }
     matrix_.matrix().multiply(out.data()->data(), product_.data()->data());
     for (std::size_t p = 0; p < n; ++p) residual_[p] = system.pinned[p] ? Vec3::Zero() : Vec3(residual_[p] - product_[p]);
