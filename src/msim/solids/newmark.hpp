@@ -88,6 +88,8 @@ class NewmarkStepper {
 
   NewmarkSettings settings_;
   std::vector<Vec3> forces_, start_, half_, mid_;
+  std::vector<Vec3> lastChange_;  // the last step's v(n + 1/2) - v(n), and its dt, for the next first guess
+  double lastDt_ = 0.0;
   std::vector<int> touched_;  // the body each particle met in the step, or -1
   std::vector<double> inverseMass_;
   std::vector<SpringTerm> terms_;
