@@ -68,6 +68,7 @@ CrowdSimulation::CrowdSimulation(const CrowdSettings& settings, std::vector<Poly
       obstacleReach_(obstacleReach(agents_, inflows_, settings.orca)),
       freeArea_(settings.grid),
       uic_(settings.grid, settings.uicSettings) {
+  lookahead_ = lookahead::AgentLookahead(settings.lookahead);
   goalSummaries_.reserve(goals_.size());
   for (const Goal& g : goals_)
     goalSummaries_.push_back(
@@ -241,7 +242,11 @@ void CrowdSimulation::moveScripted(double dt) {
 void CrowdSimulation::moveOrca(double dt) {
   if (stats_.orcaAgents == 0) return;
   orcaVelocity_.resize(agents_.size());
-  orca_.computeVelocities(agents_, obstacleIndex(), settings_.orca, static_cast<float>(dt), orcaVelocity_);
+  const lookahead::DiscreteLookahead* ahead =
+      settings_.lookahead.enabled()
+          ? &lookahead_.prepare(agents_, obstacleIndex(), settings_.orca.neighbourDist, maxSpeed())
+          : nullptr;
+  orca_.computeVelocities(agents_, obstacleIndex(), settings_.orca, static_cast<float>(dt), orcaVelocity_, ahead);
   const float h = static_cast<float>(dt);
   parallelFor(0, agents_.size(), [&](std::size_t i) {
     if (agents_.model[i] != AgentModel::Orca) return;
@@ -355,6 +360,7 @@ void CrowdSimulation::arriveAndSpawn(double dt) {
     for (std::size_t i = 0; i < agents_.size(); ++i)  // the events in agent order
       if (remove_[i]) exits_.push_back(ExitEvent{agents_.id[i], agents_.goal[i], time_});
     agents_.removeFlagged(remove_);
+    lookahead_.removeFlagged(remove_);
   }
   stats_.exited = exited;
 
@@ -412,6 +418,7 @@ void CrowdSimulation::step(double dt, StageTimers* timers) {
     ScopedStage s(t, "crowd: planning");
     plan();
   }
+  stepStartVelocity_ = agents_.velocity;
   {
     ScopedStage s(t, "crowd: scripted + orca");
     moveScripted(dt);
@@ -435,6 +442,10 @@ void CrowdSimulation::step(double dt, StageTimers* timers) {
     ScopedStage s(t, "crowd: collisions");
     resolver_.resolve(agents_, obstacleIndex(),
                       DomainBox{settings_.lo.cast<float>(), settings_.hi.cast<float>()}, settings_.collision);
+  }
+  {
+    ScopedStage s(t, "crowd: inconsistency");
+    lookahead_.record(stepStartVelocity_, agents_.velocity, dt);
   }
   time_ += dt;
   {

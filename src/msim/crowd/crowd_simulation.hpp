@@ -21,6 +21,7 @@
 #include "msim/crowd/collision_resolution.hpp"
 #include "msim/crowd/free_area.hpp"
 #include "msim/crowd/goal.hpp"
+#include "msim/crowd/lookahead/agent_lookahead.hpp"
 #include "msim/crowd/orca.hpp"
 #include "msim/crowd/planner.hpp"
 #include "msim/crowd/speed_distribution.hpp"
@@ -68,6 +69,7 @@ struct CrowdSettings {
   bool collisionResolution = true;            // off: Fig. 4.3c
   CollisionResolutionParams collision;
   OrcaParams orca;
+  lookahead::LookaheadSettings lookahead;     // long-range avoidance of the ORCA agents (Golas ch. 3)
   std::uint64_t seed = 1;                     // inflow positions (one stream per new agent id)
 };
 
@@ -105,6 +107,8 @@ class CrowdSimulation {
   std::vector<Polygon> movingObstaclesNow() const;
   const std::vector<Goal>& goals() const { return goals_; }
   const CrowdStepStats& lastStep() const { return stats_; }
+  // The inconsistency metric (Golas ch. 3.8): per agent at the last ORCA lookahead, and the scene's.
+  const lookahead::AgentLookahead& lookahead() const { return lookahead_; }
   const UicProjection& uic() const { return uic_; }
   const FreeArea& freeArea() const { return freeArea_; }
   // Exits since the start (kept for the whole run).
@@ -175,6 +179,8 @@ class CrowdSimulation {
   UicProjection uic_;
   std::optional<WalkingDensity> walkingDensity_;  // speeds when speedDensity.enabled; freeWalkers()
   OrcaSolver orca_;
+  lookahead::AgentLookahead lookahead_;   // and the inconsistency metric of every agent
+  std::vector<Vec2f> stepStartVelocity_;
   CollisionResolver resolver_;
   CrowdStepStats stats_;
   std::vector<ExitEvent> exits_;

@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 
 #include "msim/core/parallel.hpp"
+#include "msim/crowd/lookahead/discrete_lookahead.hpp"
 
 namespace msim::crowd {
 
@@ -95,6 +96,40 @@ void solveLeastPenetration(std::span<const HalfPlane> planes, std::size_t hard, 
 
 }  // namespace
 
+HalfPlane orcaHalfPlane(const Vec2f& p, const Vec2f& v, float r, float invTau, float invOverlap, const Vec2f& vi,
+                        float share, float tie) {
+  const float d2 = p.squaredNorm();
+  Vec2f u, normal;  // u: from v to the closest point of the VO boundary; normal: outward there
+  if (d2 > r * r) {
+    // VO^tau: the cone from the origin tangent to the disc D(p, r), cut off by D(p/tau, r/tau).
+    const Vec2f w = v - p * invTau;
+    const float wp = w.dot(p);
+    if (wp < 0.0f && wp * wp > r * r * w.squaredNorm()) {
+      const float wLen = w.norm();  // closest boundary point on the cut-off arc
+      normal = w / wLen;
+      u = (r * invTau - wLen) * normal;
+    } else {
+      const float leg = std::sqrt(d2 - r * r);  // closest point on a leg of the cone
+      if (det(p, w) > 0.0f) {
+        const Vec2f dir = Vec2f(p.x() * leg - p.y() * r, p.x() * r + p.y() * leg) / d2;
+        normal = Vec2f(-dir.y(), dir.x());
+        u = v.dot(dir) * dir - v;
+      } else {
+        const Vec2f dir = Vec2f(p.x() * leg + p.y() * r, -p.x() * r + p.y() * leg) / d2;
+        normal = Vec2f(dir.y(), -dir.x());
+        u = v.dot(dir) * dir - v;
+      }
+    }
+  } else {
+    // Overlapping: the VO for the horizon 1 / invOverlap, D(p invOverlap, r invOverlap) (sec. 5.1).
+    const Vec2f w = v - p * invOverlap;
+    const float wLen = w.norm();
+    normal = wLen > 1e-7f ? Vec2f(w / wLen) : Vec2f(tie, 0.0f);
+    u = (r * invOverlap - wLen) * normal;
+  }
+  return {vi + share * u, normal};
+}
+
 Vec2f solveOrcaProgram(std::span<const HalfPlane> planes, std::size_t hard, const Vec2f& preferred, float maxSpeed,
                        std::vector<HalfPlane>& scratch) {
   Vec2f v;
@@ -104,7 +139,7 @@ Vec2f solveOrcaProgram(std::span<const HalfPlane> planes, std::size_t hard, cons
 }
 
 void OrcaSolver::computeVelocities(const Agents& agents, const StaticObstacles& obstacles, const OrcaParams& params,
-                                   float dt, std::span<Vec2f> out) {
+                                   float dt, std::span<Vec2f> out, const lookahead::DiscreteLookahead* lookahead) {
   const std::size_t n = agents.size();
   if (n == 0) return;
   grid_.build(agents.position, params.neighbourDist);
@@ -180,42 +215,12 @@ void OrcaSolver::computeVelocities(const Agents& agents, const StaticObstacles& 
             }
 
             for (const Neighbour& nb : s.nearest) {
-              const float d2 = nb.d2;
-              const std::size_t j = nb.id;
-              const Vec2f p = pos[nb.slot] - xi;            // relative position
-              const Vec2f v = vi - slot[nb.slot].velocity;  // relative velocity
-              const float r = ri + slot[nb.slot].radius;
-              Vec2f u, normal;  // u: from v to the closest point of the VO boundary; normal: outward there
-              if (d2 > r * r) {
-                // VO^tau: the cone from the origin tangent to the disc D(p, r), cut off by D(p/tau, r/tau).
-                const Vec2f w = v - p * invTau;
-                const float wp = w.dot(p);
-                if (wp < 0.0f && wp * wp > r * r * w.squaredNorm()) {
-                  const float wLen = w.norm();  // closest boundary point on the cut-off arc
-                  normal = w / wLen;
-                  u = (r * invTau - wLen) * normal;
-                } else {
-                  const float leg = std::sqrt(d2 - r * r);  // closest point on a leg of the cone
-                  if (det(p, w) > 0.0f) {
-                    const Vec2f dir = Vec2f(p.x() * leg - p.y() * r, p.x() * r + p.y() * leg) / d2;
-                    normal = Vec2f(-dir.y(), dir.x());
-                    u = v.dot(dir) * dir - v;
-                  } else {
-                    const Vec2f dir = Vec2f(p.x() * leg + p.y() * r, -p.x() * r + p.y() * leg) / d2;
-                    normal = Vec2f(dir.y(), -dir.x());
-                    u = v.dot(dir) * dir - v;
-                  }
-                }
-              } else {
-                // Overlapping: the VO for a horizon of one step, D(p/dt, r/dt) (sec. 5.1).
-                const Vec2f w = v - p * invDt;
-                const float wLen = w.norm();
-                normal = wLen > 1e-7f ? Vec2f(w / wLen) : Vec2f(i < j ? -1.0f : 1.0f, 0.0f);
-                u = (r * invDt - wLen) * normal;
-              }
               // Reciprocity: half the avoidance each; all of it towards agents that do not run ORCA.
-              s.planes.push_back({vi + slot[nb.slot].share * u, normal});
+              s.planes.push_back(orcaHalfPlane(pos[nb.slot] - xi, vi - slot[nb.slot].velocity, ri + slot[nb.slot].radius,
+                                               invTau, invDt, vi, slot[nb.slot].share, i < nb.id ? -1.0f : 1.0f));
             }
+            if (lookahead != nullptr && lookahead->depth[i] > 0)
+              lookahead::appendLookaheadPlanes(*lookahead, static_cast<std::uint32_t>(i), xi, vi, ri, invTau, s.planes);
 
             out[i] = solveOrcaProgram(s.planes, hard, agents.preferredVelocity[i], maxSpeed, s.projected);
           }

@@ -16,6 +16,10 @@
 
 namespace msim::crowd {
 
+namespace lookahead {
+struct DiscreteLookahead;
+}
+
 struct OrcaParams {
   float neighbourDist = 3.0f;    // agents farther than this (centre to centre) are ignored [m]
   int maxNeighbours = 10;        // only the closest ones within neighbourDist count
@@ -27,6 +31,13 @@ struct OrcaParams {
 struct HalfPlane {
   Vec2f point, normal;
 };
+
+// ORCA_{i|j} (sec. 5.1): the half-plane of velocities for agent i (velocity vi) that avoids,
+// within the horizon 1 / invTau, a disc of combined radius r at relative position p moving with
+// relative velocity v = v_i - v_j, taking `share` of the avoidance (1/2: reciprocal). Overlapping
+// discs separate within 1 / invOverlap; `tie` (+-1) orders the normal when they coincide.
+HalfPlane orcaHalfPlane(const Vec2f& p, const Vec2f& v, float r, float invTau, float invOverlap, const Vec2f& vi,
+                        float share, float tie);
 
 // The incremental linear programs of the paper (sec. 5.2), exposed for testing. Velocity closest
 // to `preferred` within |v| <= maxSpeed and all half-planes; when they have no common point, the
@@ -43,8 +54,10 @@ class OrcaSolver {
   // it (paper sec. 5.1). Parallel over agents; reads only old state, so the result does not depend
   // on the thread count. `obstacles` must have been built with reach >= the largest
   // maxSpeed * timeHorizonObst + radius. No allocation per agent (thread-local scratch).
+  // With `lookahead` (Golas ch. 3.6) each agent also avoids the crowd as it will be at the
+  // lookahead's horizons, in the same linear program.
   void computeVelocities(const Agents& agents, const StaticObstacles& obstacles, const OrcaParams& params, float dt,
-                         std::span<Vec2f> out);
+                         std::span<Vec2f> out, const lookahead::DiscreteLookahead* lookahead = nullptr);
 
  private:
   struct Neighbour {

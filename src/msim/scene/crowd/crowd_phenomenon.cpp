@@ -224,7 +224,9 @@ class CrowdPhenomenon final : public Phenomenon {
               {"nn_min_ratio", std::isfinite(nn_.minRatio) ? nn_.minRatio : 0.0},
               {"free_walkers", freeWalkers_.count},
               {"free_walkers_mean_speed_mps", freeWalkers_.meanSpeed},
-              {"stalled", stalledNow_ ? 1 : 0}};
+              {"stalled", stalledNow_ ? 1 : 0},
+              // The scene's inconsistency metric (Golas ch. 3.8) over the last metric window.
+              {"inconsistency", sim_->lookahead().sceneInconsistency()}};
     for (std::size_t k = 0; k < setup_.lines.size(); ++k)
       s["line_" + setup_.lines[k].name + "_crossings"] = lineCrossings_[k];
     return s;

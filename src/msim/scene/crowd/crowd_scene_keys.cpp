@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -102,6 +103,24 @@ Schema crowdKeys() {
   orca.number("time_horizon", "s", 2.0, "avoid agents this far ahead in time").min(0.0, Bound::Exclusive);
   orca.number("time_horizon_obstacles", "s", 1.0, "avoid obstacles this far ahead in time").min(0.0, Bound::Exclusive);
   c.field("orca", orca);
+  Schema ahead = Schema::object("long-range collision avoidance of the ORCA agents (Golas ch. 3, docs/crowd.md#lookahead)");
+  ahead.integer("levels", 0, "i_max: look dt_i = 2^(i-1) base_step ahead for i = 1..levels (the seed: 8); 0: off")
+      .min(0)
+      .max(16);
+  ahead.number("base_step", "s", 0.01, "dt of the horizons (the seed's 0.01 s: 8 levels reach 1.28 s)")
+      .min(0.0, Bound::Exclusive)
+      .max(1.0);
+  ahead.number("coarsening", "", 2.0, "c: the effective radius of agents seen at level i is r / c^i").min(1.0).max(4.0);
+  ahead.number("sigma_max", "m/s^2", 0.0,
+               "curtailing: the depth falls linearly with the local inconsistency metric to 0 at this value (eq. 3.10); "
+               "0: no curtailing (constant lookahead)")
+      .min(0.0);
+  ahead.number("metric_window", "s", 0.4, "tau_w: the inconsistency metric's samples halve their weight every tau_w / 2")
+      .min(0.0, Bound::Exclusive);
+  ahead.string("metric_mode", "sqrt_eigenvalue_sum",
+               "sigma = sum of the square roots of C's eigenvalues (eq. 3.9) or its trace (Fig. 3.7's caption)")
+      .choices({"sqrt_eigenvalue_sum", "trace"});
+  c.field("lookahead", ahead);
   Schema planner = Schema::object("global planning (ch. 4.3.1)");
   planner.string("type", "auto",
                  "auto: direct without obstacles, else navigation_field; roadmap: the seed's CDT roadmap (in builds "
@@ -224,6 +243,16 @@ struct Builder {
     out.settings.orca.maxNeighbours = o.at("max_neighbours").get<int>();
     out.settings.orca.timeHorizon = o.at("time_horizon").get<float>();
     out.settings.orca.timeHorizonObst = o.at("time_horizon_obstacles").get<float>();
+    const json& la = c.at("lookahead");
+    out.settings.lookahead.levels = la.at("levels").get<int>();
+    out.settings.lookahead.baseStep = la.at("base_step").get<double>();
+    out.settings.lookahead.coarsening = la.at("coarsening").get<double>();
+    const double sigmaMax = la.at("sigma_max").get<double>();
+    out.settings.lookahead.sigmaMax = sigmaMax > 0.0 ? sigmaMax : std::numeric_limits<double>::infinity();
+    out.settings.lookahead.metricWindow = la.at("metric_window").get<double>();
+    out.settings.lookahead.metricMode = la.at("metric_mode").get<std::string>() == "trace"
+                                            ? crowd::lookahead::MetricMode::Trace
+                                            : crowd::lookahead::MetricMode::SqrtEigenvalueSum;
     out.settings.seed = c.at("seed").get<std::uint64_t>();
     out.maxStep = c.at("max_step").get<double>();
     out.gridCfl = c.at("grid_cfl").get<double>();

@@ -1,0 +1,69 @@
+#pragma once
+// Long-range avoidance for the crowd's ORCA agents (Golas ch. 3.6-3.8), the state it keeps from
+// step to step: each agent's deviation samples (v(n) - v(n-1)) / dt, forgotten exponentially with
+// a half-life of half the metric window tau_w (the seed's optional down-weighting of older
+// samples), from which each step takes
+//   - the local inconsistency metric sigma_j: the moments of the agents within about R of j
+//     pooled (on a grid of cells R wide, the agent's cell and its eight neighbours: the seed
+//     samples the smooth metric on a grid too),
+//   - the depth L_j = min(L(sigma_j), the deepest level whose extrapolated position j sees without
+//     an obstacle in between) (curtailing.hpp),
+//   - and the agent tree of the clusters;
+// and the scene's metric, every agent's samples pooled.
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <vector>
+
+#include "msim/crowd/agents.hpp"
+#include "msim/crowd/lookahead/discrete_lookahead.hpp"
+#include "msim/crowd/lookahead/inconsistency.hpp"
+#include "msim/crowd/obstacle_index.hpp"
+
+namespace msim::crowd::lookahead {
+
+struct LookaheadSettings {
+  int levels = 0;             // i_max; 0: no lookahead
+  double baseStep = 0.01;     // dt of the horizons dt_i = 2^(i-1) dt [s] (the seed's step)
+  double coarsening = 2.0;    // c: effective radii r / c^i
+  double sigmaMax = std::numeric_limits<double>::infinity();  // curtailing; infinity: constant lookahead
+  double metricWindow = 0.4;  // tau_w [s]
+  MetricMode metricMode = MetricMode::SqrtEigenvalueSum;
+  bool enabled() const { return levels > 0; }
+};
+
+class AgentLookahead {
+ public:
+  explicit AgentLookahead(const LookaheadSettings& settings = {}) : settings_(settings) {}
+  const LookaheadSettings& settings() const { return settings_; }
+
+  // Before ORCA: depths and the tree for the agents as they stand. neighbourDist is ORCA's R,
+  // maxSpeed the fastest any agent walks.
+  const DiscreteLookahead& prepare(const Agents& agents, const StaticObstacles& obstacles, double neighbourDist,
+                                   double maxSpeed);
+  // After a step of dt that took every agent from `previous` to `current` velocities (the same
+  // agents in the same order): the samples (current - previous) / dt. Every agent's: the metric
+  // describes the crowd whichever model moves it.
+  void record(std::span<const Vec2f> previous, std::span<const Vec2f> current, double dt);
+  // The agent list changed: removed ones (flags as Agents::removeFlagged) and new ones appended
+  // (no samples yet). Call before prepare() whenever agents come or go.
+  void removeFlagged(const std::vector<std::uint8_t>& remove);
+  void resize(std::size_t agents);
+
+  std::span<const float> inconsistency() const { return sigma_; }  // sigma_j at the last prepare()
+  std::span<const std::uint8_t> depth() const { return depth_; }    // L_j at the last prepare()
+  // Every agent's samples in the window pooled [m/s^2 or m^2/s^4 by the metric mode].
+  double sceneInconsistency() const;
+
+ private:
+  void localMetric(const Agents& agents, double cell);
+
+  LookaheadSettings settings_;
+  std::vector<DeviationMoment> moments_;
+  std::vector<float> sigma_;
+  std::vector<std::uint8_t> depth_;
+  std::vector<DeviationMoment> cells_;
+  DiscreteLookahead lookahead_;
+};
+
+}  // namespace msim::crowd::lookahead

@@ -1,0 +1,63 @@
+#include "msim/crowd/lookahead/discrete_lookahead.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace msim::crowd::lookahead {
+
+namespace {
+
+// Nearest and farthest distances from x to the points of a box.
+float nearestInBox(const Vec2f& x, const Vec2f& lo, const Vec2f& hi) {
+  return (lo - x).cwiseMax(x - hi).cwiseMax(0.0f).norm();
+}
+float farthestInBox(const Vec2f& x, const Vec2f& lo, const Vec2f& hi) {
+  return (x - lo).cwiseAbs().cwiseMax((hi - x).cwiseAbs()).norm();
+}
+
+}  // namespace
+
+void appendLookaheadPlanes(const DiscreteLookahead& l, std::uint32_t self, const Vec2f& x, const Vec2f& v, float r,
+                           float invTau, std::vector<HalfPlane>& planes) {
+  const HorizonSchedule& s = l.schedule;
+  const int depth = std::min<int>(l.depth[self], s.levels);
+  if (depth <= 0 || l.tree.empty()) return;
+  const float reach = static_cast<float>(s.bandStart(depth + 1)), near = static_cast<float>(s.neighbourDist);
+  // Constraint against a blocker at position xc moving at vc, of radius rc, seen at `level`.
+  const auto avoid = [&](const Vec2f& xc, const Vec2f& vc, float rc, int level) {
+    const float horizon = static_cast<float>(s.horizon(level));
+    planes.push_back(orcaHalfPlane(xc - x + (vc - v) * horizon, v - vc, r + rc, invTau, invTau, v, 0.5f, 1.0f));
+  };
+  // Depth-first; a binary tree over n agents is at most about log2(n) + 1 deep, and the stack holds
+  // at most one pending sibling per level.
+  std::array<std::int32_t, 96> stack;
+  std::size_t top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const AgentTree::Node& n = l.tree.node(stack[--top]);
+    const float nearest = nearestInBox(x, n.lo, n.hi);
+    if (nearest >= reach || farthestInBox(x, n.lo, n.hi) < near) continue;  // beyond every band, or all at level 0
+    if (n.left < 0) {
+      const std::uint32_t j = l.tree.agents()[n.first];
+      if (j == self) continue;
+      const int level = s.levelOfDistance((l.positions[j] - x).norm());
+      if (level >= 1 && level <= depth)
+        avoid(l.positions[j], l.velocities[j], static_cast<float>(s.effectiveRadius(l.radii[j], level)), level);
+      continue;
+    }
+    const int level = s.levelOfDistance(nearest);
+    const bool containsSelf = x.x() >= n.lo.x() && x.x() <= n.hi.x() && x.y() >= n.lo.y() && x.y() <= n.hi.y();
+    if (level >= 1 && level <= depth && !containsSelf && n.count <= (1u << (level - 1))) {
+      const float walked = static_cast<float>(s.maxSpeed * s.horizon(level));
+      if (n.separation <= std::max(walked, 2.0f * n.radius)) {
+        avoid(n.mean, n.velocity, static_cast<float>(s.effectiveRadius(n.radius, level)) + n.spread, level);
+        continue;
+      }
+    }
+    stack[top++] = n.right;
+    stack[top++] = n.left;
+  }
+}
+
+}  // namespace msim::crowd::lookahead

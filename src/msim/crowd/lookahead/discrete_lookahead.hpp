@@ -1,0 +1,35 @@
+#pragma once
+// The discrete lookahead of Golas ch. 3.6 on ORCA: besides its neighbours within R (level 0, plain
+// ORCA), an agent avoids the agents of band i (horizons.hpp) as they will be dt_i ahead: each
+// extrapolated in a straight line, x_j + v_j dt_i, with the effective radius r_j / c^i, and the
+// agent's own position extrapolated likewise, all in the one linear program of the agent's ORCA
+// step. Far agents are grouped (Fig. 3.5): a node of the agent tree whose nearest possible member
+// lies in band i stands for its members as one cluster (eqs. 3.3-3.5) when it holds at most
+// 2^(i-1) agents (the seed's target size dt_i / dt) and no gap inside it is wider than the
+// distance an agent walks within dt_i (nor 2 r) [assumption: the seed leaves the quality threshold
+// open; a gap nobody can reach within the horizon is of no use to plan through]. A node that fails
+// is opened. Deeper levels are cut per agent (curtailing.hpp): `depth` holds each agent's L_j.
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "msim/crowd/lookahead/agent_tree.hpp"
+#include "msim/crowd/lookahead/horizons.hpp"
+#include "msim/crowd/orca.hpp"
+
+namespace msim::crowd::lookahead {
+
+struct DiscreteLookahead {
+  HorizonSchedule schedule;
+  AgentTree tree;  // over `positions`
+  std::span<const Vec2f> positions, velocities;
+  std::span<const float> radii;
+  std::span<const std::uint8_t> depth;  // L_j: the deepest level agent j looks at (0: plain ORCA)
+};
+
+// Appends to `planes` the lookahead constraints of agent `self` at x with velocity v and radius r,
+// for its levels 1..depth[self], ORCA's time horizon 1 / invTau.
+void appendLookaheadPlanes(const DiscreteLookahead& lookahead, std::uint32_t self, const Vec2f& x, const Vec2f& v, float r,
+                           float invTau, std::vector<HalfPlane>& planes);
+
+}  // namespace msim::crowd::lookahead

@@ -1,0 +1,121 @@
+// The discrete lookahead on ORCA (Golas ch. 3.6): level 0 keeps ORCA's guarantee (the seed notes'
+// check L2), and agents walking at each other turn aside from further away than plain ORCA lets
+// them.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "msim/crowd/lookahead/agent_lookahead.hpp"
+#include "msim/crowd/orca.hpp"
+
+namespace {
+
+using namespace msim::crowd;
+
+Agents orcaAgents(const std::vector<Vec2f>& starts, float radius) {
+  Agents a;
+  for (const Vec2f& x : starts) {
+    AgentSpec s;
+    s.position = x;
+    s.radius = radius;
+    s.maxSpeed = 1.4f;
+    s.model = AgentModel::Orca;
+    a.add(s);
+  }
+  return a;
+}
+
+// Steps the agents towards their goals with ORCA, with the lookahead when `ahead` is given;
+// calls observe(step, agents) after each step.
+template <typename Observe>
+void walk(Agents& a, const std::vector<Vec2f>& goals, int steps, float dt, lookahead::AgentLookahead* ahead,
+          Observe&& observe) {
+  OrcaParams params;
+  params.maxNeighbours = 1000;  // the seed removes RVO2's cap, so that every agent within R counts
+  OrcaSolver solver;
+  const StaticObstacles none;
+  std::vector<Vec2f> v(a.size());
+  for (int s = 0; s < steps; ++s) {
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      const Vec2f d = goals[i] - a.position[i];
+      const float len = d.norm();
+      a.preferredVelocity[i] = len > 1e-6f ? Vec2f(d * std::min(a.maxSpeed[i], len / dt) / len) : Vec2f::Zero();
+    }
+    const lookahead::DiscreteLookahead* la =
+        ahead ? &ahead->prepare(a, none, params.neighbourDist, 1.4) : nullptr;
+    solver.computeVelocities(a, none, params, dt, v, la);
+    std::vector<Vec2f> previous = a.velocity;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      a.velocity[i] = v[i];
+      a.position[i] += dt * v[i];
+    }
+    if (ahead) ahead->record(previous, a.velocity, dt);
+    observe(s, a);
+  }
+}
+
+}  // namespace
+
+TEST(DiscreteLookahead, KeepsOrcasLevelZeroGuaranteeInDenseRandomCrowds) {
+  // L2: 80 agents of radius 0.25 m at random in a 12 x 12 m square walk to random goals in it for
+  // 10 s. The seed expects no two closer than r_i + r_j - 1 mm with and without the lookahead; this
+  // ORCA (float positions, the least-penetration program where the half-planes leave no velocity)
+  // lets pairs overlap by up to about 1 cm here. The lookahead, whose constraints join the same
+  // program, must overlap no more than plain ORCA does (1 mm slack), and neither by more than a
+  // tenth of a radius.
+  float closest[2] = {1e9f, 1e9f};
+  for (const int levels : {0, 8}) {
+    std::mt19937 random(17);
+    const std::size_t kAgents = 80;
+    std::uniform_real_distribution<float> u(0.0f, 12.0f);
+    std::vector<Vec2f> starts, goals;
+    while (starts.size() < kAgents) {
+      const Vec2f x(u(random), u(random));
+      if (std::all_of(starts.begin(), starts.end(), [&](const Vec2f& y) { return (x - y).norm() > 0.55f; }))
+        starts.push_back(x);
+    }
+    for (std::size_t i = 0; i < starts.size(); ++i) goals.emplace_back(u(random), u(random));
+    Agents a = orcaAgents(starts, 0.25f);
+    lookahead::AgentLookahead ahead(lookahead::LookaheadSettings{.levels = levels, .baseStep = 0.05});
+    float& c = closest[levels > 0 ? 1 : 0];
+    walk(a, goals, 200, 0.05f, levels > 0 ? &ahead : nullptr, [&](int, const Agents& agents) {
+      for (std::size_t i = 0; i < agents.size(); ++i)
+        for (std::size_t j = i + 1; j < agents.size(); ++j)
+          c = std::min(c, (agents.position[i] - agents.position[j]).norm() - agents.radius[i] - agents.radius[j]);
+    });
+  }
+  testing::Test::RecordProperty("plain_orca_overlap_m", std::to_string(-closest[0]));
+  testing::Test::RecordProperty("lookahead_overlap_m", std::to_string(-closest[1]));
+  EXPECT_GE(closest[1], closest[0] - 1e-3f);
+  EXPECT_GE(closest[0], -0.025f);
+  EXPECT_GE(closest[1], -0.025f);
+}
+
+TEST(DiscreteLookahead, AgentsWalkingAtEachOtherTurnAsideFromFurtherAway) {
+  // Two agents 20 m apart walk at each other at 1.4 m/s, 0.1 m off the same line. Plain ORCA (R = 3 m,
+  // tau = 2 s) sees the other only within R; with 8 levels of 0.05 s (horizons to 6.4 s, bands to
+  // R + 2 v_max 6.4 s) the lookahead sees it from the start and the agents turn aside while still
+  // far apart.
+  const auto turnDistance = [](lookahead::AgentLookahead* ahead) {
+    Agents a = orcaAgents({Vec2f(0.0f, 0.05f), Vec2f(20.0f, -0.05f)}, 0.25f);
+    a.velocity[0] = Vec2f(1.4f, 0.0f);
+    a.velocity[1] = Vec2f(-1.4f, 0.0f);
+    float distance = 0.0f;
+    walk(a, {Vec2f(40.0f, 0.05f), Vec2f(-20.0f, -0.05f)}, 200, 0.05f, ahead, [&](int, const Agents& agents) {
+      if (distance == 0.0f && std::abs(agents.velocity[0].y()) > 0.05f)
+        distance = (agents.position[1] - agents.position[0]).norm();
+    });
+    return distance;
+  };
+  const float plain = turnDistance(nullptr);
+  lookahead::AgentLookahead ahead(lookahead::LookaheadSettings{.levels = 8, .baseStep = 0.05});
+  const float early = turnDistance(&ahead);
+  EXPECT_GT(plain, 0.0f);
+  EXPECT_LT(plain, 7.0f) << "plain ORCA reacts within its horizon";
+  testing::Test::RecordProperty("plain_turn_distance_m", std::to_string(plain));
+  testing::Test::RecordProperty("lookahead_turn_distance_m", std::to_string(early));
+  EXPECT_GT(early, 1.5f * plain) << "plain " << plain << " m";
+}
