@@ -60,7 +60,10 @@ std::int32_t AgentTree::buildNode(std::uint32_t first, std::uint32_t count, std:
     n.velocity = velocities[*begin];
     n.radius = radii[*begin];
   }
-  for (auto it = begin; it != end; ++it) n.spread = std::max(n.spread, (positions[*it] - n.mean).norm());
+  for (auto it = begin; it != end; ++it) {
+    n.spread = std::max(n.spread, (positions[*it] - n.mean).norm());
+    n.velocitySpread = std::max(n.velocitySpread, (velocities[*it] - n.velocity).norm());
+  }
   nodes_[static_cast<std::size_t>(index)] = n;
   return index;
 }

@@ -1,7 +1,8 @@
 #pragma once
 // A k-d tree over agents whose nodes carry their members' aggregates, the cluster candidates of
 // the discrete lookahead (Golas ch. 3.6, Fig. 3.5): member count, mean position and velocity
-// (eqs. 3.3-3.4), the largest member distance from the mean (for r_C, eq. 3.5), and the maximal
+// (eqs. 3.3-3.4), the largest member distance from the mean (for r_C, eq. 3.5) and velocity
+// from the mean velocity, and the maximal
 // separation, the largest gap between a member and its nearest fellow member, approximated as the
 // seed does while building: the larger of the children's values and the gap between the children's
 // bounding boxes. Leaves are single agents. Built in O(n log n) by median splits along the longer
@@ -21,6 +22,7 @@ class AgentTree {
     Vec2f velocity = Vec2f::Zero();  // v_C
     Vec2f lo = Vec2f::Zero(), hi = Vec2f::Zero();  // the members' bounding box
     float spread = 0.0f;             // max_j |x_j - x_C|
+    float velocitySpread = 0.0f;     // max_j |v_j - v_C|
     float radius = 0.0f;             // the largest member's radius
     float separation = 0.0f;         // the approximate maximal separation
     std::uint32_t count = 0;

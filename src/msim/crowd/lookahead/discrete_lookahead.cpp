@@ -49,9 +49,10 @@ void appendLookaheadPlanes(const DiscreteLookahead& l, std::uint32_t self, const
     const int level = s.levelOfDistance(nearest);
     const bool containsSelf = x.x() >= n.lo.x() && x.x() <= n.hi.x() && x.y() >= n.lo.y() && x.y() <= n.hi.y();
     if (level >= 1 && level <= depth && !containsSelf && n.count <= (1u << (level - 1))) {
-      const float walked = static_cast<float>(s.maxSpeed * s.horizon(level));
-      if (n.separation <= std::max(walked, 2.0f * n.radius)) {
-        avoid(n.mean, n.velocity, static_cast<float>(s.effectiveRadius(n.radius, level)) + n.spread, level);
+      const float horizon = static_cast<float>(s.horizon(level));
+      const float walked = static_cast<float>(s.maxSpeed) * horizon, drift = n.velocitySpread * horizon;
+      if (n.separation <= std::max(walked, 2.0f * n.radius) && drift <= 2.0f * n.radius) {
+        avoid(n.mean, n.velocity, static_cast<float>(s.effectiveRadius(n.radius, level)) + n.spread + drift, level);
         continue;
       }
     }
