@@ -11,6 +11,7 @@
 #include <tbb/global_control.h>
 
 #include "msim/crowd/collision_resolution.hpp"
+#include "msim/crowd/lookahead/agent_lookahead.hpp"
 #include "msim/crowd/orca.hpp"
 #include "msim/crowd/walking_density.hpp"
 
@@ -111,6 +112,44 @@ void BM_OrcaStep(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(n));
 }
+// The discrete lookahead (Golas ch. 3.6) in a four-way crossing of 4 x n/4 ORCA agents: four
+// blocks of 25 x 10 m at the sides of a 60 m square walking at 1.4 m/s towards the opposite
+// side, met halfway; range(1) levels of 0.01 s (0: plain ORCA). A step is the depths, the cluster
+// tree and the velocities; the seed (Table 3.1, one 2008 core): 21 steps/s with 2000 agents.
+void BM_OrcaLookahead(benchmark::State& state) {
+  const std::size_t n = static_cast<std::size_t>(state.range(0));
+  const int levels = static_cast<int>(state.range(1));
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  Agents a;
+  a.reserve(n);
+  const Vec2f centre(30.0f, 30.0f);
+  for (std::size_t i = 0; i < n; ++i) {
+    const int side = static_cast<int>(i % 4);
+    const Vec2f across = side % 2 == 0 ? Vec2f(1.0f, 0.0f) : Vec2f(0.0f, 1.0f);
+    const Vec2f along = side % 2 == 0 ? Vec2f(0.0f, 1.0f) : Vec2f(1.0f, 0.0f);
+    const float sign = side < 2 ? -1.0f : 1.0f;
+    AgentSpec spec;
+    spec.model = AgentModel::Orca;
+    spec.position = centre + sign * (7.0f + 10.0f * u(rng)) * across + (25.0f * u(rng) - 12.5f) * along;
+    const std::size_t k = a.add(spec);
+    a.preferredVelocity[k] = -sign * 1.4f * across;
+    a.velocity[k] = a.preferredVelocity[k];
+  }
+  OrcaSolver solver;
+  OrcaParams params;
+  lookahead::AgentLookahead ahead(lookahead::LookaheadSettings{.levels = levels, .baseStep = 0.01});
+  const StaticObstacles none;
+  std::vector<Vec2f> v(n);
+  for (auto _ : state) {
+    const lookahead::DiscreteLookahead* la = levels > 0 ? &ahead.prepare(a, none, params.neighbourDist, 1.4) : nullptr;
+    solver.computeVelocities(a, none, params, 0.01f, v, la);
+    benchmark::DoNotOptimize(v.data());
+  }
+  state.counters["steps_per_s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_OrcaLookahead)->Args({2000, 0})->Args({2000, 8})->Unit(benchmark::kMillisecond)->UseRealTime();
+
 // The default model's walking speeds (walking_density.hpp): the neighbour grid of everyone and the
 // count of the others in each agent's square ahead, at 2 agents/m^2.
 void BM_WalkingSpeeds(benchmark::State& state) {
