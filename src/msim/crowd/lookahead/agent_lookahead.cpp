@@ -89,6 +89,7 @@ const DiscreteLookahead& AgentLookahead::prepare(const Agents& agents, const Sta
   const std::size_t n = agents.size();
   moments_.resize(n);
   lookahead_.schedule = HorizonSchedule{settings_.baseStep, settings_.levels, settings_.coarsening, neighbourDist, maxSpeed};
+  lookahead_.tabulate();
   depth_.assign(n, 0);
   if (n > 0) {
     localMetric(agents, neighbourDist);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <stdexcept>
 
 namespace msim::crowd::lookahead {
 
@@ -18,15 +19,31 @@ float farthestInBox(const Vec2f& x, const Vec2f& lo, const Vec2f& hi) {
 
 }  // namespace
 
+void DiscreteLookahead::tabulate() {
+  if (schedule.levels > kMaxLevels) throw std::invalid_argument("lookahead: at most 16 levels");
+  for (int i = 0; i <= schedule.levels + 1; ++i) {
+    horizon[static_cast<std::size_t>(i)] = static_cast<float>(schedule.horizon(i));
+    bandStart[static_cast<std::size_t>(i)] = static_cast<float>(schedule.bandStart(i));
+    shrink[static_cast<std::size_t>(i)] = static_cast<float>(schedule.effectiveRadius(1.0, i));
+  }
+}
+
+int DiscreteLookahead::levelOfDistance(float distance) const {
+  if (distance < bandStart[1]) return 0;
+  for (int i = 1; i <= schedule.levels; ++i)
+    if (distance < bandStart[static_cast<std::size_t>(i) + 1]) return i;
+  return -1;
+}
+
 void appendLookaheadPlanes(const DiscreteLookahead& l, std::uint32_t self, const Vec2f& x, const Vec2f& v, float r,
                            float invTau, std::vector<HalfPlane>& planes) {
   const HorizonSchedule& s = l.schedule;
   const int depth = std::min<int>(l.depth[self], s.levels);
   if (depth <= 0 || l.tree.empty()) return;
-  const float reach = static_cast<float>(s.bandStart(depth + 1)), near = static_cast<float>(s.neighbourDist);
+  const float reach = l.bandStart[static_cast<std::size_t>(depth) + 1], near = l.bandStart[1];
   // Constraint against a blocker at position xc moving at vc, of radius rc, seen at `level`.
   const auto avoid = [&](const Vec2f& xc, const Vec2f& vc, float rc, int level) {
-    const float horizon = static_cast<float>(s.horizon(level));
+    const float horizon = l.horizon[static_cast<std::size_t>(level)];
     planes.push_back(orcaHalfPlane(xc - x + (vc - v) * horizon, v - vc, r + rc, invTau, invTau, v, 0.5f, 1.0f));
   };
   // Depth-first; a binary tree over n agents is at most about log2(n) + 1 deep, and the stack holds
@@ -41,18 +58,17 @@ void appendLookaheadPlanes(const DiscreteLookahead& l, std::uint32_t self, const
     if (n.left < 0) {
       const std::uint32_t j = l.tree.agents()[n.first];
       if (j == self) continue;
-      const int level = s.levelOfDistance((l.positions[j] - x).norm());
-      if (level >= 1 && level <= depth)
-        avoid(l.positions[j], l.velocities[j], static_cast<float>(s.effectiveRadius(l.radii[j], level)), level);
+      const int level = l.levelOfDistance((l.positions[j] - x).norm());
+      if (level >= 1 && level <= depth) avoid(l.positions[j], l.velocities[j], l.radii[j] * l.shrink[static_cast<std::size_t>(level)], level);
       continue;
     }
-    const int level = s.levelOfDistance(nearest);
+    const int level = l.levelOfDistance(nearest);
     const bool containsSelf = x.x() >= n.lo.x() && x.x() <= n.hi.x() && x.y() >= n.lo.y() && x.y() <= n.hi.y();
     if (level >= 1 && level <= depth && !containsSelf && n.count <= (1u << (level - 1))) {
-      const float horizon = static_cast<float>(s.horizon(level));
+      const float horizon = l.horizon[static_cast<std::size_t>(level)];
       const float walked = static_cast<float>(s.maxSpeed) * horizon, drift = n.velocitySpread * horizon;
       if (n.separation <= std::max(walked, 2.0f * n.radius) && drift <= 2.0f * n.radius) {
-        avoid(n.mean, n.velocity, static_cast<float>(s.effectiveRadius(n.radius, level)) + n.spread + drift, level);
+        avoid(n.mean, n.velocity, n.radius * l.shrink[static_cast<std::size_t>(level)] + n.spread + drift, level);
         continue;
       }
     }

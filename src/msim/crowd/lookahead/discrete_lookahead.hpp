@@ -11,6 +11,7 @@
 // can reach within the horizon is of no use to plan through, and a cluster of agents walking
 // different ways, two crossing streams, would stand for neither]. Its radius covers the members'
 // extrapolated discs: r_f + max |x_j - x_C| + max |v_j - v_C| dt_i. A node that fails is opened. Deeper levels are cut per agent (curtailing.hpp): `depth` holds each agent's L_j.
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -22,7 +23,15 @@
 namespace msim::crowd::lookahead {
 
 struct DiscreteLookahead {
+  // The schedule and, tabulated from it by tabulate() for the per-agent traversals, each level's
+  // horizon dt_i, band start and radius factor 1 / c^i (levels <= kMaxLevels).
+  static constexpr int kMaxLevels = 16;
   HorizonSchedule schedule;
+  std::array<float, kMaxLevels + 2> horizon{}, bandStart{}, shrink{};
+  void tabulate();
+  // The level whose band holds `distance` (0 within R; tabulated levelOfDistance), -1 beyond.
+  int levelOfDistance(float distance) const;
+
   AgentTree tree;  // over `positions`
   std::span<const Vec2f> positions, velocities;
   std::span<const float> radii;
