@@ -20,6 +20,7 @@ json run(const std::string& name, const std::string& sets) {
   const Result r = runMsim("run " + kScene + " -q --out " + (dir / "out").string() +
                            " --set outputs.png=false --set outputs.mp4=false --set outputs.vdb=false" + sets);
   EXPECT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_TRUE(fs::exists(dir / "out" / "inconsistency.png"));
   return r.exitCode == 0 ? readJson(dir / "out" / "run.json") : json::object();
 }
 
@@ -49,4 +50,5 @@ TEST(CrowdLookahead, CurtailingBeatsConstantLookaheadOnTheSwap) {
   testing::Test::RecordProperty("t100_plain_s", std::to_string(completion(plain)));
   EXPECT_LE(completion(curtailed), 0.9 * completion(constant));
   EXPECT_GT(meanInconsistency(plain), 0.0);
+  EXPECT_DOUBLE_EQ(plain.at("results").at("inconsistency").at("mean").get<double>(), meanInconsistency(plain));
 }

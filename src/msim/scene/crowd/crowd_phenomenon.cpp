@@ -287,6 +287,8 @@ class CrowdPhenomenon final : public Phenomenon {
     results["measurement_lines"] = flows;
     writeFundamentalDiagram(runDir / "fundamental_diagram.png");
     writeTimeSeries(runDir / "time_series.png", frames);
+    results["inconsistency"] = inconsistencySummary(frames);
+    writeInconsistency(runDir / "inconsistency.png", frames);
     results["fundamental_diagram"] = crowd::toJson(std::span<const crowd::FdBin>(fdBins_));
     return results;
   }
@@ -405,6 +407,32 @@ class CrowdPhenomenon final : public Phenomenon {
       n.push_back(f.at("agents").get<double>());
     }
     io::writePng(file, render::renderPlot(crowd::timeSeriesPlot("agents in the scene", "agents", t, n)));
+  }
+
+  // The scene's inconsistency metric over the run (Golas ch. 3.8): its mean and largest frame
+  // value, and the unit of the metric mode.
+  json inconsistencySummary(const json& frames) const {
+    double sum = 0.0, largest = 0.0;
+    for (const json& f : frames) {
+      const double s = f.at("inconsistency").get<double>();
+      sum += s;
+      largest = std::max(largest, s);
+    }
+    const bool trace = setup_.settings.lookahead.metricMode == crowd::lookahead::MetricMode::Trace;
+    return {{"mean", frames.empty() ? 0.0 : sum / static_cast<double>(frames.size())},
+            {"max", largest},
+            {"unit", trace ? "m^2/s^4" : "m/s^2"}};
+  }
+
+  void writeInconsistency(const fs::path& file, const json& frames) const {
+    std::vector<double> t, s;
+    for (const json& f : frames) {
+      t.push_back(f.at("time_s").get<double>());
+      s.push_back(f.at("inconsistency").get<double>());
+    }
+    const bool trace = setup_.settings.lookahead.metricMode == crowd::lookahead::MetricMode::Trace;
+    io::writePng(file, render::renderPlot(crowd::timeSeriesPlot("inconsistency metric of the crowd",
+                                                                trace ? "sigma (m^2/s^4)" : "sigma (m/s^2)", t, s)));
   }
 
   std::string source_;
