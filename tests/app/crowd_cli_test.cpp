@@ -50,7 +50,7 @@ double doorwayOverlapFraction(const std::string& name, const std::string& varian
 // trajectories.csv of a run folder holds one row per agent and frame of its run.json.
 void expectOneTrajectoryRowPerAgentFrame(const fs::path& out, const json& run) {
   const auto table = msim::io::readCsv(out / "trajectories.csv");
-  EXPECT_EQ(table.columns, (std::vector<std::string>{"frame", "id", "x", "y", "vx", "vy"}));
+  EXPECT_EQ(table.columns, (std::vector<std::string>{"frame", "id", "x", "y", "vx", "vy", "inconsistency"}));
   double agentFrames = 0;
   for (const json& f : run.at("frames")) agentFrames += f.at("agents").get<double>();
   EXPECT_EQ(static_cast<double>(table.rows.size()), agentFrames);

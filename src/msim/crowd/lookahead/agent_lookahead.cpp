@@ -53,8 +53,11 @@ void AgentLookahead::record(std::span<const Vec2f> previous, std::span<const Vec
   });
 }
 
-void AgentLookahead::localMetric(const Agents& agents, double cell) {
+void AgentLookahead::localInconsistency(const Agents& agents, double cell, std::vector<DeviationMoment>& cells,
+                                        std::vector<float>& sigma) const {
   const std::size_t n = agents.size();
+  sigma.resize(n);
+  if (n == 0) return;
   Vec2f lo = agents.position.front(), hi = lo;
   for (const Vec2f& x : agents.position) {
     lo = lo.cwiseMin(x);
@@ -62,7 +65,7 @@ void AgentLookahead::localMetric(const Agents& agents, double cell) {
   }
   const float size = static_cast<float>(cell);
   const int nx = static_cast<int>((hi.x() - lo.x()) / size) + 1, ny = static_cast<int>((hi.y() - lo.y()) / size) + 1;
-  cells_.assign(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny), DeviationMoment());
+  cells.assign(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny), DeviationMoment());
   const auto cellOf = [&](const Vec2f& x, int& cx, int& cy) {
     cx = std::min(nx - 1, static_cast<int>((x.x() - lo.x()) / size));
     cy = std::min(ny - 1, static_cast<int>((x.y() - lo.y()) / size));
@@ -70,17 +73,17 @@ void AgentLookahead::localMetric(const Agents& agents, double cell) {
   for (std::size_t i = 0; i < n; ++i) {
     int cx = 0, cy = 0;
     cellOf(agents.position[i], cx, cy);
-    cells_[static_cast<std::size_t>(cy) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(cx)].add(moments_[i]);
+    if (i < moments_.size())
+      cells[static_cast<std::size_t>(cy) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(cx)].add(moments_[i]);
   }
-  sigma_.resize(n);
   parallelFor(0, n, [&](std::size_t i) {
     int cx = 0, cy = 0;
     cellOf(agents.position[i], cx, cy);
     DeviationMoment pooled;
     for (int y = std::max(0, cy - 1); y <= std::min(ny - 1, cy + 1); ++y)
       for (int x = std::max(0, cx - 1); x <= std::min(nx - 1, cx + 1); ++x)
-        pooled.add(cells_[static_cast<std::size_t>(y) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(x)]);
-    sigma_[i] = static_cast<float>(pooled.sigma(settings_.metricMode));
+        pooled.add(cells[static_cast<std::size_t>(y) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(x)]);
+    sigma[i] = static_cast<float>(pooled.sigma(settings_.metricMode));
   });
 }
 
@@ -92,7 +95,7 @@ const DiscreteLookahead& AgentLookahead::prepare(const Agents& agents, const Sta
   lookahead_.tabulate();
   depth_.assign(n, 0);
   if (n > 0) {
-    localMetric(agents, neighbourDist);
+    localInconsistency(agents, neighbourDist, cells_, sigma_);
     const HorizonSchedule& s = lookahead_.schedule;
     parallelFor(0, n, [&](std::size_t i) {
       if (agents.model[i] != AgentModel::Orca) return;

@@ -237,10 +237,14 @@ class CrowdPhenomenon final : public Phenomenon {
     const fs::path dir = runDir / "trajectories";
     fs::create_directories(dir);
     const crowd::Agents& a = sim_->agents();
-    io::CsvWriter csv(dir / fmt::format("frame_{:05d}.csv", frame), {"frame", "id", "x", "y", "vx", "vy"});
+    // Each agent's local inconsistency metric (Golas ch. 3.8) over the agents within about R.
+    std::vector<crowd::lookahead::DeviationMoment> cells;
+    std::vector<float> sigma;
+    sim_->lookahead().localInconsistency(a, setup_.settings.orca.neighbourDist, cells, sigma);
+    io::CsvWriter csv(dir / fmt::format("frame_{:05d}.csv", frame), {"frame", "id", "x", "y", "vx", "vy", "inconsistency"});
     for (std::size_t i = 0; i < a.size(); ++i)
       csv.addRow({double(frame), double(a.id[i]), a.position[i].x(), a.position[i].y(), a.velocity[i].x(),
-                  a.velocity[i].y()});
+                  a.velocity[i].y(), sigma[i]});
     csv.commit();
   }
 
@@ -382,7 +386,7 @@ class CrowdPhenomenon final : public Phenomenon {
     const fs::path dir = runDir / "trajectories";
     io::writeFileAtomically(runDir / "trajectories.csv", [&](const fs::path& tmp) {
       std::ofstream out(tmp, std::ios::binary);
-      out << "frame,id,x,y,vx,vy\n";
+      out << "frame,id,x,y,vx,vy,inconsistency\n";
       for (int f = 1; f <= lastFrame; ++f) {
         std::ifstream in(dir / fmt::format("frame_{:05d}.csv", f), std::ios::binary);
         if (!in) throw std::runtime_error(fmt::format("trajectory part of frame {} is missing in {}", f, dir.string()));

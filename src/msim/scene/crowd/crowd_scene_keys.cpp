@@ -133,7 +133,7 @@ Schema crowdKeys() {
       .min(0.0, Bound::Exclusive);
   c.integer("seed", 1, "random placement of agents (groups, inflows)").min(0);
   c.string("colour_by", "speed", "colour of the agents in the pictures").choices({"speed", "density", "group"});
-  c.boolean("trajectories", true, "write trajectories.csv (frame,id,x,y,vx,vy)");
+  c.boolean("trajectories", true, "write trajectories.csv (frame,id,x,y,vx,vy,inconsistency)");
   c.number("dense_fraction", "", 0.8, "'densest regions' of the nearest-neighbour metric: density >= this x rho_max")
       .min(0.0)
       .max(1.0);
