@@ -3,6 +3,8 @@
 // would have passed, and curtailing it where the crowd moves inconsistently wins the time back.
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -51,4 +53,20 @@ TEST(CrowdLookahead, CurtailingBeatsConstantLookaheadOnTheSwap) {
   EXPECT_LE(completion(curtailed), 0.9 * completion(constant));
   EXPECT_GT(meanInconsistency(plain), 0.0);
   EXPECT_DOUBLE_EQ(plain.at("results").at("inconsistency").at("mean").get<double>(), meanInconsistency(plain));
+}
+
+TEST(CrowdLookahead, BadSettingsNameTheirKey) {
+  // Levels beyond 16, a base step of 0 and a coarsening below 1: exit 2 naming the key, no frames.
+  std::string scene;
+  {
+    std::ifstream in(kScene);
+    scene.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  const std::string lookahead = R"("lookahead": {"levels": 8, "sigma_max": 2.0})";
+  ASSERT_NE(scene.find(lookahead), std::string::npos);
+  expectInputError("lookahead_levels", replaced(scene, lookahead, R"("lookahead": {"levels": 17})"), {"crowd.lookahead.levels"});
+  expectInputError("lookahead_base_step", replaced(scene, lookahead, R"("lookahead": {"levels": 8, "base_step": 0})"),
+                   {"crowd.lookahead.base_step"});
+  expectInputError("lookahead_coarsening", replaced(scene, lookahead, R"("lookahead": {"levels": 8, "coarsening": 0.5})"),
+                   {"crowd.lookahead.coarsening"});
 }
