@@ -38,7 +38,7 @@ double meanInconsistency(const json& run) {
 
 TEST(CrowdLookahead, CurtailingBeatsConstantLookaheadOnTheSwap) {
   // L15: some sigma_max gives a completion time at most 0.9 of constant lookahead's; the scene's
-  // sigma_max = 2 m/s^2. Every agent arrives in all three runs, and the scene's metric is
+  // sigma_max = 3 m/s^2. Every agent arrives in all three runs, and the scene's metric is
   // measured in each frame.
   const json constant = run("lookahead_constant", " --set crowd.lookahead.sigma_max=0");
   const json curtailed = run("lookahead_curtailed", "");
@@ -62,7 +62,7 @@ TEST(CrowdLookahead, BadSettingsNameTheirKey) {
     std::ifstream in(kScene);
     scene.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
-  const std::string lookahead = R"("lookahead": {"levels": 8, "sigma_max": 2.0})";
+  const std::string lookahead = R"("lookahead": {"levels": 8, "sigma_max": 3.0})";
   ASSERT_NE(scene.find(lookahead), std::string::npos);
   expectInputError("lookahead_levels", replaced(scene, lookahead, R"("lookahead": {"levels": 17})"), {"crowd.lookahead.levels"});
   expectInputError("lookahead_base_step", replaced(scene, lookahead, R"("lookahead": {"levels": 8, "base_step": 0})"),

@@ -34,20 +34,29 @@ float clearDistance(const StaticObstacles& obstacles, const Vec2f& x, const Vec2
 
 void AgentLookahead::resize(std::size_t agents) {
   moments_.resize(agents);
+  walked_.resize(agents, 0);
 }
 
 void AgentLookahead::removeFlagged(const std::vector<std::uint8_t>& remove) {
   std::size_t kept = 0;
   for (std::size_t i = 0; i < moments_.size(); ++i)
-    if (i >= remove.size() || remove[i] == 0) moments_[kept++] = moments_[i];
+    if (i >= remove.size() || remove[i] == 0) {
+      moments_[kept] = moments_[i];
+      walked_[kept++] = walked_[i];
+    }
   moments_.resize(kept);
+  walked_.resize(kept);
 }
 
 void AgentLookahead::record(std::span<const Vec2f> previous, std::span<const Vec2f> current, double dt) {
-  moments_.resize(current.size());
+  resize(current.size());
   // Weights halve every tau_w / 2.
   const double forget = std::exp(-std::log(2.0) * dt / (0.5 * settings_.metricWindow));
   parallelFor(0, current.size(), [&](std::size_t i) {
+    if (!walked_[i]) {
+      walked_[i] = 1;
+      return;
+    }
     moments_[i].scale(forget);
     moments_[i].add(((current[i] - previous[i]) / static_cast<float>(dt)).cast<double>());
   });
@@ -90,7 +99,7 @@ void AgentLookahead::localInconsistency(const Agents& agents, double cell, std::
 const DiscreteLookahead& AgentLookahead::prepare(const Agents& agents, const StaticObstacles& obstacles,
                                                  double neighbourDist, double maxSpeed) {
   const std::size_t n = agents.size();
-  moments_.resize(n);
+  resize(n);
   lookahead_.schedule = HorizonSchedule{settings_.baseStep, settings_.levels, settings_.coarsening, neighbourDist, maxSpeed};
   lookahead_.tabulate();
   depth_.assign(n, 0);

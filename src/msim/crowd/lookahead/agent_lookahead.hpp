@@ -42,8 +42,8 @@ class AgentLookahead {
   const DiscreteLookahead& prepare(const Agents& agents, const StaticObstacles& obstacles, double neighbourDist,
                                    double maxSpeed);
   // After a step of dt that took every agent from `previous` to `current` velocities (the same
-  // agents in the same order): the samples (current - previous) / dt. Every agent's: the metric
-  // describes the crowd whichever model moves it.
+  // agents in the same order): the samples (current - previous) / dt, except each agent's first.
+  // Every agent's: the metric describes the crowd whichever model moves it.
   void record(std::span<const Vec2f> previous, std::span<const Vec2f> current, double dt);
   // The agent list changed: removed ones (flags as Agents::removeFlagged) and new ones appended
   // (no samples yet). Call before prepare() whenever agents come or go.
@@ -62,6 +62,9 @@ class AgentLookahead {
  private:
   LookaheadSettings settings_;
   std::vector<DeviationMoment> moments_;
+  // Whether the agent has walked a step: its first velocity comes from rest (a new agent's 0),
+  // which is the scene's start rather than a turn or a stop of its walk, and is not sampled.
+  std::vector<std::uint8_t> walked_;
   std::vector<float> sigma_;
   std::vector<std::uint8_t> depth_;
   std::vector<DeviationMoment> cells_;
