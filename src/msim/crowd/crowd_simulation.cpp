@@ -67,8 +67,8 @@ CrowdSimulation::CrowdSimulation(const CrowdSettings& settings, std::vector<Poly
       moving_(std::move(moving)),
       obstacleReach_(obstacleReach(agents_, inflows_, settings.orca)),
       freeArea_(settings.grid),
-      uic_(settings.grid, settings.uicSettings) {
-  lookahead_ = lookahead::AgentLookahead(settings.lookahead);
+      uic_(settings.grid, settings.uicSettings),
+      lookahead_(settings.lookahead) {
   goalSummaries_.reserve(goals_.size());
   for (const Goal& g : goals_)
     goalSummaries_.push_back(

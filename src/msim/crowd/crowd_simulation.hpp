@@ -107,7 +107,7 @@ class CrowdSimulation {
   std::vector<Polygon> movingObstaclesNow() const;
   const std::vector<Goal>& goals() const { return goals_; }
   const CrowdStepStats& lastStep() const { return stats_; }
-  // The inconsistency metric (Golas ch. 3.8): per agent at the last ORCA lookahead, and the scene's.
+  // The inconsistency metric (Golas ch. 3.8): per agent (localInconsistency) and the scene's.
   const lookahead::AgentLookahead& lookahead() const { return lookahead_; }
   const UicProjection& uic() const { return uic_; }
   const FreeArea& freeArea() const { return freeArea_; }

@@ -124,13 +124,11 @@ double parallelStep(double alpha, const Eigen::VectorXd& s, const Eigen::VectorX
 }
 
 void parallelDirection(const Eigen::VectorXd& z, double beta, Eigen::VectorXd& s) {
-  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, (s.size() + kBlock - 1) / kBlock, 1),
-                    [&](const tbb::blocked_range<Eigen::Index>& r) {
-                      for (Eigen::Index block = r.begin(); block != r.end(); ++block) {
-                        const Eigen::Index first = block * kBlock, length = std::min(kBlock, s.size() - first);
-                        s.segment(first, length) = z.segment(first, length) + beta * s.segment(first, length);
-                      }
-                    });
+  parallelFor(0, static_cast<std::size_t>((s.size() + kBlock - 1) / kBlock), [&](std::size_t block) {
+    const auto first = static_cast<Eigen::Index>(block) * kBlock;
+    const Eigen::Index length = std::min(kBlock, s.size() - first);
+    s.segment(first, length) = z.segment(first, length) + beta * s.segment(first, length);
+  }, 1);
 }
 
 }  // namespace msim::numerics

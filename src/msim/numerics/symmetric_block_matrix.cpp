@@ -1,6 +1,7 @@
 #include "msim/numerics/symmetric_block_matrix.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <stdexcept>
 
 #include "msim/core/parallel.hpp"

@@ -45,7 +45,6 @@ class SymmetricBlockMatrix {
   // matrix the rounded one stays symmetric when each pair (r, c), (c, r) is given the same block.
   void setRow(std::size_t r, const SymmetricBlock<double>& diagonal, std::span<const SymmetricBlock<double>> offDiagonal);
   const SymmetricBlock<double>& diagonal(std::size_t r) const { return diagonal_[r]; }
-  const SymmetricBlock<float>& block(std::size_t entry) const { return blocks_[entry]; }
 
   // y = A u; u and y hold 3 values per block row and must differ (y resized).
   void multiply(const Eigen::VectorXd& u, Eigen::VectorXd& y) const;

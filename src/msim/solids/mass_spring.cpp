@@ -69,11 +69,13 @@ void MassSpringSystem::explicitForces(const std::vector<Vec3>& at, std::vector<V
   }
 }
 
-Vec3 MassSpringSystem::meanVelocity() const {
+Vec3 MassSpringSystem::meanVelocity() const { return meanVelocity(v); }
+
+Vec3 MassSpringSystem::meanVelocity(const std::vector<Vec3>& velocities) const {
   Vec3 momentum = Vec3::Zero();
   double total = 0.0;
   for (std::size_t p = 0; p < size(); ++p) {
-    momentum += mass[p] * v[p];
+    momentum += mass[p] * velocities[p];
     total += mass[p];
   }
   return total > 0.0 ? Vec3(momentum / total) : Vec3(Vec3::Zero());

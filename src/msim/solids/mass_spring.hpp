@@ -64,6 +64,8 @@ struct MassSpringSystem {
   double kineticEnergy() const;
   // The mass-weighted mean velocity (the centre of mass's) [m/s].
   Vec3 meanVelocity() const;
+  // The mass-weighted mean of a velocity per particle (`velocities`, size() of them).
+  Vec3 meanVelocity(const std::vector<Vec3>& velocities) const;
   // Elastic energy: for eq. 5.1, k l0 (s^2 / 2) per spring with strain s = |x2 - x1| / l0 - 1, plus
   // the gravitational energy -m g . x [J].
   double potentialEnergy() const;

@@ -3,10 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <random>
 #include <vector>
 
-#include "msim/crowd/lookahead/cluster.hpp"
+#include "msim/crowd/lookahead/discrete_lookahead.hpp"
 #include "msim/crowd/lookahead/horizons.hpp"
 
 namespace {
@@ -95,27 +96,43 @@ TEST(LookaheadHorizons, EffectiveRadiiShrinkByTheCoarseningAndTheGaussianRuleVan
 }
 
 TEST(LookaheadClusters, CoverEveryMemberAndTheirMeanMotion) {
-  // L4: x_C and v_C the means, r_C = r_f + the largest member distance: every member's disc of
-  // radius r_f lies inside the cluster's, and r_C >= r_f.
+  // L4 on every node of the agent tree (the clusters the lookahead uses): x_C and v_C the
+  // members' means (eqs. 3.3-3.4), r_C = r_f + the largest member distance (+ the velocity
+  // spread times the horizon, eq. 3.5 extrapolated): every member's disc of radius r_f lies inside
+  // the cluster's, now and dt_i ahead, and r_C >= r_f.
   std::mt19937 random(7);
   std::uniform_real_distribution<float> u(-5.0f, 5.0f);
-  for (int trial = 0; trial < 200; ++trial) {
-    const int m = 1 + trial % 17;
-    std::vector<Vec2f> x(static_cast<std::size_t>(m)), v(static_cast<std::size_t>(m));
-    Vec2f meanX = Vec2f::Zero(), meanV = Vec2f::Zero();
-    for (int j = 0; j < m; ++j) {
-      x[static_cast<std::size_t>(j)] = Vec2f(u(random), u(random));
-      v[static_cast<std::size_t>(j)] = Vec2f(0.3f * u(random), 0.3f * u(random));
-      meanX += x[static_cast<std::size_t>(j)] / static_cast<float>(m);
-      meanV += v[static_cast<std::size_t>(j)] / static_cast<float>(m);
+  for (int trial = 0; trial < 20; ++trial) {
+    const std::size_t n = 1 + static_cast<std::size_t>(trial) * 7;
+    std::vector<Vec2f> x(n), v(n);
+    std::vector<float> radii(n, 0.25f);
+    for (std::size_t j = 0; j < n; ++j) {
+      x[j] = Vec2f(u(random), u(random));
+      v[j] = Vec2f(0.3f * u(random), 0.3f * u(random));
     }
-    const float rf = 0.25f / static_cast<float>(1 + trial % 4);
-    const Cluster c = clusterOf(x, v, rf);
-    EXPECT_EQ(c.members, m);
-    EXPECT_LT((c.position - meanX).norm(), 1e-5f);
-    EXPECT_LT((c.velocity - meanV).norm(), 1e-5f);
-    EXPECT_GE(c.radius, rf);
-    for (const Vec2f& p : x) EXPECT_LE((p - c.position).norm() + rf, c.radius + 1e-5f);
+    msim::crowd::lookahead::AgentTree tree;
+    tree.build(x, v, radii);
+    const float rf = 0.25f / static_cast<float>(1 + trial % 4), horizon = 0.08f * static_cast<float>(trial % 5);
+    for (std::size_t k = 0; k < tree.size(); ++k) {
+      const auto& node = tree.node(static_cast<std::int32_t>(k));
+      Vec2f meanX = Vec2f::Zero(), meanV = Vec2f::Zero();
+      const auto members = tree.agents().subspan(node.first, node.count);
+      for (const std::uint32_t j : members) {
+        meanX += x[j] / static_cast<float>(node.count);
+        meanV += v[j] / static_cast<float>(node.count);
+      }
+      EXPECT_LT((node.mean - meanX).norm(), 1e-4f);
+      EXPECT_LT((node.velocity - meanV).norm(), 1e-4f);
+      const float rc = clusterRadius(node, rf, horizon);
+      EXPECT_GE(rc, rf);
+      for (const std::uint32_t j : members) {
+        EXPECT_LE((x[j] - node.mean).norm() + rf, rc + 1e-4f);
+        EXPECT_LE((x[j] + horizon * v[j] - (node.mean + horizon * node.velocity)).norm() + rf, rc + 1e-4f);
+      }
+    }
   }
-  EXPECT_THROW(clusterOf({}, {}, 0.1f), std::invalid_argument);
+  msim::crowd::lookahead::AgentTree tree;
+  const std::vector<Vec2f> one(1, Vec2f::Zero()), none;
+  const std::vector<float> radius(1, 0.25f);
+  EXPECT_THROW(tree.build(one, none, radius), std::invalid_argument);
 }

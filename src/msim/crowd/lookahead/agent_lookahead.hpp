@@ -50,12 +50,10 @@ class AgentLookahead {
   void removeFlagged(const std::vector<std::uint8_t>& remove);
   void resize(std::size_t agents);
 
-  std::span<const float> inconsistency() const { return sigma_; }  // sigma_j at the last prepare()
   // Each agent's local metric now: the samples of the agents in its cell (side `cell`, R in
   // prepare()) and the eight around it pooled; `cells` is scratch.
   void localInconsistency(const Agents& agents, double cell, std::vector<DeviationMoment>& cells,
                           std::vector<float>& sigma) const;
-  std::span<const std::uint8_t> depth() const { return depth_; }    // L_j at the last prepare()
   // Every agent's samples in the window pooled [m/s^2 or m^2/s^4 by the metric mode].
   double sceneInconsistency() const;
 

@@ -34,6 +34,7 @@ class AgentTree {
   void build(std::span<const Vec2f> positions, std::span<const Vec2f> velocities, std::span<const float> radii);
 
   bool empty() const { return nodes_.empty(); }
+  std::size_t size() const { return nodes_.size(); }
   const Node& root() const { return nodes_.front(); }
   const Node& node(std::int32_t index) const { return nodes_[static_cast<std::size_t>(index)]; }
   // Agent indices in tree order (each node's members contiguous).

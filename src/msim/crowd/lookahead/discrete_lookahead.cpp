@@ -29,10 +29,7 @@ void DiscreteLookahead::tabulate() {
 }
 
 int DiscreteLookahead::levelOfDistance(float distance) const {
-  if (distance < bandStart[1]) return 0;
-  for (int i = 1; i <= schedule.levels; ++i)
-    if (distance < bandStart[static_cast<std::size_t>(i) + 1]) return i;
-  return -1;
+  return levelInBands(distance, schedule.levels, [this](int i) { return bandStart[static_cast<std::size_t>(i)]; });
 }
 
 void appendLookaheadPlanes(const DiscreteLookahead& l, std::uint32_t self, const Vec2f& x, const Vec2f& v, float r,
@@ -68,7 +65,7 @@ void appendLookaheadPlanes(const DiscreteLookahead& l, std::uint32_t self, const
       const float horizon = l.horizon[static_cast<std::size_t>(level)];
       const float walked = static_cast<float>(s.maxSpeed) * horizon, drift = n.velocitySpread * horizon;
       if (n.separation <= std::max(walked, 2.0f * n.radius) && drift <= 2.0f * n.radius) {
-        avoid(n.mean, n.velocity, n.radius * l.shrink[static_cast<std::size_t>(level)] + n.spread + drift, level);
+        avoid(n.mean, n.velocity, clusterRadius(n, n.radius * l.shrink[static_cast<std::size_t>(level)], horizon), level);
         continue;
       }
     }

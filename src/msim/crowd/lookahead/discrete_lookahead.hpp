@@ -38,6 +38,12 @@ struct DiscreteLookahead {
   std::span<const std::uint8_t> depth;  // L_j: the deepest level agent j looks at (0: plain ORCA)
 };
 
+// r_C (eq. 3.5) of a tree node seen `horizon` ahead with the members' effective radius r_f:
+// r_f + max |x_j - x_C| + max |v_j - v_C| horizon, which covers every member's extrapolated disc.
+inline float clusterRadius(const AgentTree::Node& node, float effectiveRadius, float horizon) {
+  return effectiveRadius + node.spread + node.velocitySpread * horizon;
+}
+
 // Appends to `planes` the lookahead constraints of agent `self` at x with velocity v and radius r,
 // for its levels 1..depth[self], ORCA's time horizon 1 / invTau.
 void appendLookaheadPlanes(const DiscreteLookahead& lookahead, std::uint32_t self, const Vec2f& x, const Vec2f& v, float r,

@@ -12,10 +12,7 @@ double HorizonSchedule::bandStart(int level) const {
 }
 
 int HorizonSchedule::levelOfDistance(double distance) const {
-  if (distance < neighbourDist) return 0;
-  for (int i = 1; i <= levels; ++i)
-    if (distance < bandStart(i + 1)) return i;
-  return -1;
+  return levelInBands(distance, levels, [this](int i) { return bandStart(i); });
 }
 
 double HorizonSchedule::effectiveRadius(double radius, int level) const { return radius / std::pow(coarsening, level); }

@@ -26,6 +26,16 @@ struct HorizonSchedule {
   double effectiveRadius(double radius, int level) const;
 };
 
+// The level whose band holds `distance`: 0 below bandStart(1) = R, i for bandStart(i) <= distance
+// < bandStart(i + 1), -1 beyond the last band. bandStart(i) gives band i's start (any precision).
+template <typename T, typename BandStart>
+int levelInBands(T distance, int levels, BandStart&& bandStart) {
+  if (distance < bandStart(1)) return 0;
+  for (int i = 1; i <= levels; ++i)
+    if (distance < bandStart(i + 1)) return i;
+  return -1;
+}
+
 // The radius within which a disc of radius r whose centre is uncertain, an isotropic Gaussian of
 // standard deviation sigma per axis about its predicted position, covers a point with probability
 // at least p (Fig. 3.2: 0.4): r while sigma is 0, and 0 once even the predicted centre is covered

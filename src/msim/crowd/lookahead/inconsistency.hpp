@@ -29,7 +29,6 @@ class DeviationMoment {
     sum_ += other.sum_;
     weight_ += other.weight_;
   }
-  double weight() const { return weight_; }
   // sigma of the samples added (0 without any).
   double sigma(MetricMode mode = MetricMode::SqrtEigenvalueSum) const;
   // C's eigenvectors as columns, the principal directions of the deviations (Fig. 3.7).

@@ -291,8 +291,7 @@ class CrowdPhenomenon final : public Phenomenon {
     results["measurement_lines"] = flows;
     writeFundamentalDiagram(runDir / "fundamental_diagram.png");
     writeTimeSeries(runDir / "time_series.png", frames);
-    results["inconsistency"] = inconsistencySummary(frames);
-    writeInconsistency(runDir / "inconsistency.png", frames);
+    results["inconsistency"] = writeInconsistency(runDir / "inconsistency.png", frames);
     results["fundamental_diagram"] = crowd::toJson(std::span<const crowd::FdBin>(fdBins_));
     return results;
   }
@@ -404,39 +403,34 @@ class CrowdPhenomenon final : public Phenomenon {
     io::writePng(file, render::renderPlot(crowd::speedDensityPlot(fdScatter_, fdBins_)));
   }
 
-  void writeTimeSeries(const fs::path& file, const json& frames) const {
-    std::vector<double> t, n;
+  // A per-frame statistic over the run: the frames' times and values of `key`.
+  static std::pair<std::vector<double>, std::vector<double>> series(const json& frames, const char* key) {
+    std::pair<std::vector<double>, std::vector<double>> out;
     for (const json& f : frames) {
-      t.push_back(f.at("time_s").get<double>());
-      n.push_back(f.at("agents").get<double>());
+      out.first.push_back(f.at("time_s").get<double>());
+      out.second.push_back(f.at(key).get<double>());
     }
+    return out;
+  }
+
+  void writeTimeSeries(const fs::path& file, const json& frames) const {
+    const auto [t, n] = series(frames, "agents");
     io::writePng(file, render::renderPlot(crowd::timeSeriesPlot("agents in the scene", "agents", t, n)));
   }
 
   // The scene's inconsistency metric over the run (Golas ch. 3.8): its mean and largest frame
-  // value, and the unit of the metric mode.
-  json inconsistencySummary(const json& frames) const {
+  // value, and the unit of the metric mode; and its course as a plot.
+  json writeInconsistency(const fs::path& file, const json& frames) const {
+    const auto [t, sigma] = series(frames, "inconsistency");
+    const bool trace = setup_.settings.lookahead.metricMode == crowd::lookahead::MetricMode::Trace;
+    const std::string unit = trace ? "m^2/s^4" : "m/s^2";
+    io::writePng(file, render::renderPlot(crowd::timeSeriesPlot("inconsistency metric of the crowd", "sigma (" + unit + ")", t, sigma)));
     double sum = 0.0, largest = 0.0;
-    for (const json& f : frames) {
-      const double s = f.at("inconsistency").get<double>();
-      sum += s;
-      largest = std::max(largest, s);
+    for (const double x : sigma) {
+      sum += x;
+      largest = std::max(largest, x);
     }
-    const bool trace = setup_.settings.lookahead.metricMode == crowd::lookahead::MetricMode::Trace;
-    return {{"mean", frames.empty() ? 0.0 : sum / static_cast<double>(frames.size())},
-            {"max", largest},
-            {"unit", trace ? "m^2/s^4" : "m/s^2"}};
-  }
-
-  void writeInconsistency(const fs::path& file, const json& frames) const {
-    std::vector<double> t, s;
-    for (const json& f : frames) {
-      t.push_back(f.at("time_s").get<double>());
-      s.push_back(f.at("inconsistency").get<double>());
-    }
-    const bool trace = setup_.settings.lookahead.metricMode == crowd::lookahead::MetricMode::Trace;
-    io::writePng(file, render::renderPlot(crowd::timeSeriesPlot("inconsistency metric of the crowd",
-                                                                trace ? "sigma (m^2/s^4)" : "sigma (m/s^2)", t, s)));
+    return {{"mean", sigma.empty() ? 0.0 : sum / static_cast<double>(sigma.size())}, {"max", largest}, {"unit", unit}};
   }
 
   std::string source_;
