@@ -76,28 +76,63 @@ std::vector<std::string> scaledCircle(const benchmark::State& state) {
 
 void BM_CircleScaling(benchmark::State& state) { stepScene(state, scenePath("crowd_circle"), scaledCircle(state), 2); }
 
-// The same circle timed over its first 200 steps (20 s: the disc closes in and the crowd packs to
-// rho_max), one run per iteration, the average per step reported; range as above.
-void BM_CircleScalingRun(benchmark::State& state) {
-  const scene::Scene s = scene::loadScene(scenePath("crowd_circle"), scaledCircle(state));
-  constexpr int kSteps = 200;
+// Runs the first `steps` steps of `s` from its start once per iteration; counters: each stage's
+// seconds per step and the time per step.
+void runFromStart(benchmark::State& state, const scene::Scene& s, int steps) {
   for (auto _ : state) {
     state.PauseTiming();
     StageTimers timers;
     auto phenomenon = s.type->create(s, timers);
     timers.reset();  // the stage counters per step, without the first frame's metrics
     state.ResumeTiming();
-    for (int k = 0; k < kSteps; ++k) phenomenon->step(phenomenon->stableTimestep());
+    for (int k = 0; k < steps; ++k) phenomenon->step(phenomenon->stableTimestep());
     state.PauseTiming();
-    for (const auto& stage : timers.table()) state.counters[stage.name] = stage.seconds / kSteps;
+    for (const auto& stage : timers.table()) state.counters[stage.name] = stage.seconds / steps;
     state.ResumeTiming();
   }
-  state.counters["per_step"] = benchmark::Counter(kSteps, benchmark::Counter::kIsIterationInvariantRate |
-                                                              benchmark::Counter::kInvert);
+  state.counters["per_step"] = benchmark::Counter(steps, benchmark::Counter::kIsIterationInvariantRate |
+                                                             benchmark::Counter::kInvert);
+}
+
+// The same circle timed over its first 200 steps (20 s: the disc closes in and the crowd packs to
+// rho_max), one run per iteration, the average per step reported; range as above.
+void BM_CircleScalingRun(benchmark::State& state) {
+  runFromStart(state, scene::loadScene(scenePath("crowd_circle"), scaledCircle(state)), 200);
+}
+
+// Golas Table 3.1's four-way crossing (2000 ORCA agents) while the four groups meet (after 20 s),
+// by method: range 0 plain ORCA (Disc), 1 discrete lookahead (Disc LA), 2 continuum (Cont LA),
+// 3 hybrid (Hyb LA); 8 levels.
+void BM_LookaheadFourWay(benchmark::State& state) {
+  static const char* kMethods[] = {"discrete", "discrete", "continuum", "hybrid"};
+  const auto method = static_cast<std::size_t>(state.range(0));
+  stepScene(state, scenePath("crowd_lookahead_four_way"),
+            {fmt::format("crowd.lookahead.levels={}", method == 0 ? 0 : 8), std::string("crowd.lookahead.method=") + kMethods[method]},
+            400);
+}
+// Table 3.1's four groups (2000 UIC agents) while they meet (after 30 s): range 0 the continuum
+// alone (Cont), 1 with the continuum lookahead (Cont LA), its far levels asked every 0.5 s.
+void BM_LookaheadFourGroups(benchmark::State& state) {
+  stepScene(state, scenePath("crowd_lookahead_four_groups"),
+            {fmt::format("crowd.lookahead.levels={}", state.range(0) == 0 ? 0 : 8)}, 600);
+}
+// The circle of Fig. 4.11 at 100k UIC agents (as BM_CircleScalingRun), with the continuum
+// lookahead of crowd_lookahead_four_groups (range 1) or without (0): its first 200 steps.
+void BM_LookaheadCircle100k(benchmark::State& state) {
+  std::vector<std::string> overrides = {"domain.max=[316.2,316.2]", "domain.resolution=126", "groups[0].count=100000",
+                                        "groups[0].region.center=[158.1,158.1]", "groups[0].region.radius=126.5"};
+  if (state.range(0) == 1)
+    for (const char* o : {"crowd.lookahead.levels=8", "crowd.lookahead.base_step=0.2", "crowd.lookahead.coarsening=1.414",
+                          "crowd.lookahead.cell=0.5"})
+      overrides.emplace_back(o);
+  runFromStart(state, scene::loadScene(scenePath("crowd_circle"), overrides), 200);
 }
 
 }  // namespace
 
+BENCHMARK(BM_LookaheadFourWay)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->Iterations(100);
+BENCHMARK(BM_LookaheadFourGroups)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->Iterations(200);
+BENCHMARK(BM_LookaheadCircle100k)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_Circle10k)->Unit(benchmark::kMillisecond)->Iterations(100);
 BENCHMARK(BM_Crossing)->Unit(benchmark::kMillisecond)->Iterations(50);
 BENCHMARK(BM_Building2k)->Unit(benchmark::kMillisecond)->Iterations(50);

@@ -138,11 +138,14 @@ void BM_OrcaLookahead(benchmark::State& state) {
   }
   OrcaSolver solver;
   OrcaParams params;
-  lookahead::AgentLookahead ahead(lookahead::LookaheadSettings{.levels = levels, .baseStep = 0.01});
+  lookahead::LookaheadSettings settings;
+  settings.levels = levels;
+  settings.baseStep = 0.01;
+  lookahead::AgentLookahead ahead(settings);
   const StaticObstacles none;
   std::vector<Vec2f> v(n);
   for (auto _ : state) {
-    const lookahead::DiscreteLookahead* la = levels > 0 ? &ahead.prepare(a, none, params.neighbourDist, 1.4) : nullptr;
+    const lookahead::DiscreteLookahead* la = levels > 0 ? &ahead.prepare(a, none, params.neighbourDist, 1.4, msim::Vec2::Zero(), msim::Vec2::Zero(), {.tree = true}) : nullptr;
     solver.computeVelocities(a, none, params, 0.01f, v, la);
     benchmark::DoNotOptimize(v.data());
   }

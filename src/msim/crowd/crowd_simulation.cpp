@@ -239,19 +239,122 @@ void CrowdSimulation::moveScripted(double dt) {
   }
 }
 
+void CrowdSimulation::prepareLookahead(double dt) {
+  using lookahead::LookaheadMethod;
+  const lookahead::LookaheadSettings& la = settings_.lookahead;
+  const std::size_t n = agents_.size();
+  const bool orca = stats_.orcaAgents > 0;
+  // The far levels' suggested directions follow the agents (arrivals compact them, new agents
+  // have none until the next refresh).
+  farDirection_.resize(n, Vec2f::Zero());
+  lookahead::AgentLookahead::Needs needs;
+  needs.tree = orca && la.method != LookaheadMethod::Continuum;
+  needs.densities.now = orca && la.method != LookaheadMethod::Discrete;
+  const bool farWanted = stats_.uicAgents > 0 || needs.densities.now;
+  sinceRefresh_ += dt;
+  needs.densities.far = farWanted && (!refreshed_ || sinceRefresh_ >= la.refresh - 1e-9);
+  stats_.lookahead = {};
+  if (!needs.tree && !needs.densities.now && !needs.densities.far) {
+    applyFarDirections();
+    return;
+  }
+  ahead_ = &lookahead_.prepare(agents_, obstacleIndex(), settings_.orca.neighbourDist, maxSpeed(), settings_.lo,
+                               settings_.hi, needs);
+  if (needs.densities.far) {
+    refreshed_ = true;
+    sinceRefresh_ = 0.0;
+  }
+  continuumVelocity_.resize(n);
+  blendWeight_.assign(n, 0.0f);
+  skipOrca_.assign(n, 0);
+  continuumIterations_.assign(n, 0);
+  continuumSolves_.assign(n, 0);
+  const lookahead::FutureDensity& future = lookahead_.future();
+  const bool far = needs.densities.far;
+  parallelFor(0, n, [&](std::size_t i) {
+    const AgentModel model = agents_.model[i];
+    if (model == AgentModel::Scripted || (model == AgentModel::Orca && !needs.densities.now)) return;
+    const Vec2f& x = agents_.position[i];
+    const Vec2f& preferred = agents_.preferredVelocity[i];
+    int iterations = 0, solves = 0;
+    // Levels L..1: the direction they suggest, kept until the next refresh.
+    if (far) {
+      const lookahead::CascadeResult r = lookahead::continuumLookahead(future, la.continuum, x, agents_.velocity[i], preferred,
+                                                                       agents_.maxSpeed[i], lookahead_.depth(i), 1);
+      iterations += r.iterations;
+      solves += r.solves;
+      const double speed = r.velocity.norm();
+      farDirection_[i] = r.solves > 0 && speed > 0.0 ? Vec2f((r.velocity / speed).cast<float>()) : Vec2f::Zero();
+    }
+    const float wanted = preferred.norm();
+    const Vec2f suggested = farDirection_[i].squaredNorm() > 0.0f ? Vec2f(wanted * farDirection_[i]) : preferred;
+    if (model == AgentModel::Uic) {
+      agents_.preferredVelocity[i] = suggested;  // the UIC decides at level 0
+    } else {
+      if (la.method == LookaheadMethod::Hybrid) {
+        const lookahead::FutureDensity::Flow flow = future.flow(x.cast<double>());
+        const double w = lookahead::blendWeight(flow.density, flow.speedDeviation, flow.meanVelocity.norm(), la.blend);
+        blendWeight_[i] = static_cast<float>(w);
+        skipOrca_[i] = w >= 1.0;
+      }
+      if (la.method == LookaheadMethod::Continuum || blendWeight_[i] > 0.0f) {
+        // Level 0: eq. 3.2 on the crowd now, towards the far levels' suggestion.
+        const lookahead::CascadeResult r = lookahead::continuumLookahead(future, la.continuum, x, agents_.velocity[i],
+                                                                         suggested, agents_.maxSpeed[i], 0, 0);
+        iterations += r.iterations;
+        solves += r.solves;
+        continuumVelocity_[i] = r.velocity.cast<float>();
+      }
+    }
+    continuumIterations_[i] = iterations;
+    continuumSolves_[i] = solves;
+  });
+  LookaheadStepStats st;
+  double weights = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    st.iterations += static_cast<std::size_t>(continuumIterations_[i]);
+    st.solves += static_cast<std::size_t>(continuumSolves_[i]);
+    if (agents_.model[i] == AgentModel::Orca && la.method == LookaheadMethod::Hybrid) {
+      ++st.blended;
+      weights += blendWeight_[i];
+    }
+  }
+  st.meanWeight = st.blended > 0 ? weights / double(st.blended) : 0.0;
+  stats_.lookahead = st;
+}
+
+// Between refreshes the UIC agents walk towards the far levels' last suggestion.
+void CrowdSimulation::applyFarDirections() {
+  parallelFor(0, agents_.size(), [&](std::size_t i) {
+    if (agents_.model[i] != AgentModel::Uic || farDirection_[i].squaredNorm() == 0.0f) return;
+    agents_.preferredVelocity[i] = agents_.preferredVelocity[i].norm() * farDirection_[i];
+  });
+}
+
 void CrowdSimulation::moveOrca(double dt) {
   if (stats_.orcaAgents == 0) return;
+  using lookahead::LookaheadMethod;
   orcaVelocity_.resize(agents_.size());
-  const lookahead::DiscreteLookahead* ahead =
-      settings_.lookahead.enabled()
-          ? &lookahead_.prepare(agents_, obstacleIndex(), settings_.orca.neighbourDist, maxSpeed())
-          : nullptr;
-  orca_.computeVelocities(agents_, obstacleIndex(), settings_.orca, static_cast<float>(dt), orcaVelocity_, ahead);
+  const bool ahead = settings_.lookahead.enabled();
+  const LookaheadMethod method = ahead ? settings_.lookahead.method : LookaheadMethod::Discrete;
+  if (method != LookaheadMethod::Continuum)
+    orca_.computeVelocities(agents_, obstacleIndex(), settings_.orca, static_cast<float>(dt), orcaVelocity_,
+                            ahead ? ahead_ : nullptr, method == LookaheadMethod::Hybrid ? std::span<const std::uint8_t>(skipOrca_)
+                                                                                        : std::span<const std::uint8_t>());
   const float h = static_cast<float>(dt);
   parallelFor(0, agents_.size(), [&](std::size_t i) {
     if (agents_.model[i] != AgentModel::Orca) return;
-    agents_.velocity[i] = orcaVelocity_[i];
-    agents_.position[i] += h * orcaVelocity_[i];
+    // ORCA's answers and the continuum's keep within the agent's maximum speed, and so does their
+    // blend (eq. 3.11, each part computed only where its weight is not zero).
+    Vec2f v = orcaVelocity_[i];
+    if (method == LookaheadMethod::Continuum) {
+      v = continuumVelocity_[i];
+    } else if (method == LookaheadMethod::Hybrid) {
+      const float w = blendWeight_[i];
+      v = w >= 1.0f ? continuumVelocity_[i] : (w > 0.0f ? Vec2f((1.0f - w) * v + w * continuumVelocity_[i]) : v);
+    }
+    agents_.velocity[i] = v;
+    agents_.position[i] += h * v;
   });
 }
 
@@ -361,6 +464,12 @@ void CrowdSimulation::arriveAndSpawn(double dt) {
       if (remove_[i]) exits_.push_back(ExitEvent{agents_.id[i], agents_.goal[i], time_});
     agents_.removeFlagged(remove_);
     lookahead_.removeFlagged(remove_);
+    if (!farDirection_.empty()) {
+      std::size_t kept = 0;
+      for (std::size_t i = 0; i < farDirection_.size(); ++i)
+        if (i >= remove_.size() || remove_[i] == 0) farDirection_[kept++] = farDirection_[i];
+      farDirection_.resize(kept);
+    }
   }
   stats_.exited = exited;
 
@@ -417,6 +526,10 @@ void CrowdSimulation::step(double dt, StageTimers* timers) {
   {
     ScopedStage s(t, "crowd: planning");
     plan();
+  }
+  if (settings_.lookahead.enabled()) {
+    ScopedStage s(t, "crowd: lookahead");
+    prepareLookahead(dt);
   }
   stepStartVelocity_ = agents_.velocity;
   {

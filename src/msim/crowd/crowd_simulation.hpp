@@ -69,14 +69,22 @@ struct CrowdSettings {
   bool collisionResolution = true;            // off: Fig. 4.3c
   CollisionResolutionParams collision;
   OrcaParams orca;
-  lookahead::LookaheadSettings lookahead;     // long-range avoidance of the ORCA agents (Golas ch. 3)
+  lookahead::LookaheadSettings lookahead;     // long-range avoidance (Golas ch. 3)
   std::uint64_t seed = 1;                     // inflow positions (one stream per new agent id)
+};
+
+// The continuum lookahead's work in a step: eq. 3.2's solves (agents x levels) and their
+// gradient-ascent iterations; the hybrid's ORCA agents and their mean blend weight w (eq. 3.11).
+struct LookaheadStepStats {
+  std::size_t solves = 0, iterations = 0, blended = 0;
+  double meanWeight = 0.0;
 };
 
 struct CrowdStepStats {
   std::size_t agents = 0, uicAgents = 0, orcaAgents = 0, scriptedAgents = 0;
   std::size_t spawned = 0, exited = 0;  // this step
   UicStats uic;                         // the last projection (zeros when off or no UIC agents)
+  LookaheadStepStats lookahead;         // zeros without continuum lookahead
 };
 
 // An agent that left through an exit: the evacuation-time metrics read these.
@@ -140,6 +148,10 @@ class CrowdSimulation {
   std::size_t indexOfId(std::uint64_t id) const;
   void plan();
   void moveScripted(double dt);
+  // Depths, the agent tree and the future densities; the continuum lookahead's velocities (UIC
+  // agents: their preferred velocity) and the hybrid's weights.
+  void prepareLookahead(double dt);
+  void applyFarDirections();
   void moveOrca(double dt);
   void walkingSpeeds();
   void moveUic(double dt);
@@ -180,14 +192,20 @@ class CrowdSimulation {
   std::optional<WalkingDensity> walkingDensity_;  // speeds when speedDensity.enabled; freeWalkers()
   OrcaSolver orca_;
   lookahead::AgentLookahead lookahead_;   // and the inconsistency metric of every agent
+  const lookahead::DiscreteLookahead* ahead_ = nullptr;  // this step's, from prepareLookahead()
+  std::vector<Vec2f> farDirection_;  // per agent: the continuum lookahead's far levels' direction (0: none)
+  double sinceRefresh_ = 0.0;        // [s] since the far levels were last asked
+  bool refreshed_ = false;
   std::vector<Vec2f> stepStartVelocity_;
   CollisionResolver resolver_;
   CrowdStepStats stats_;
   std::vector<ExitEvent> exits_;
 
   // Per-step scratch, kept to avoid allocation.
-  std::vector<Vec2f> orcaVelocity_, discCentres_, uicPosition_, uicPreferred_, uicVelocity_;
-  std::vector<float> discRadii_, uicSpeed_, walkDensity_, walkSpeed_;
+  std::vector<Vec2f> orcaVelocity_, continuumVelocity_, discCentres_, uicPosition_, uicPreferred_, uicVelocity_;
+  std::vector<float> discRadii_, uicSpeed_, walkDensity_, walkSpeed_, blendWeight_;
+  std::vector<std::uint8_t> skipOrca_;
+  std::vector<int> continuumIterations_, continuumSolves_;
   std::vector<std::uint32_t> uicIndex_;
   std::vector<std::uint8_t> remove_;
 };

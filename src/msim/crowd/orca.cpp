@@ -139,7 +139,8 @@ Vec2f solveOrcaProgram(std::span<const HalfPlane> planes, std::size_t hard, cons
 }
 
 void OrcaSolver::computeVelocities(const Agents& agents, const StaticObstacles& obstacles, const OrcaParams& params,
-                                   float dt, std::span<Vec2f> out, const lookahead::DiscreteLookahead* lookahead) {
+                                   float dt, std::span<Vec2f> out, const lookahead::DiscreteLookahead* lookahead,
+                                   std::span<const std::uint8_t> skip) {
   const std::size_t n = agents.size();
   if (n == 0) return;
   grid_.build(agents.position, params.neighbourDist);
@@ -170,6 +171,7 @@ void OrcaSolver::computeVelocities(const Agents& agents, const StaticObstacles& 
           for (std::uint32_t k = first; k < last; ++k) {
             if (slot[k].share != 0.5f) continue;  // not an ORCA agent
             const std::size_t i = order[k];
+            if (!skip.empty() && skip[i]) continue;
             const Vec2f xi = pos[k], vi = slot[k].velocity;
             const float ri = slot[k].radius, maxSpeed = agents.maxSpeed[i];
             s.planes.clear();

@@ -55,9 +55,11 @@ class OrcaSolver {
   // on the thread count. `obstacles` must have been built with reach >= the largest
   // maxSpeed * timeHorizonObst + radius. No allocation per agent (thread-local scratch).
   // With `lookahead` (Golas ch. 3.6) each agent also avoids the crowd as it will be at the
-  // lookahead's horizons, in the same linear program.
+  // lookahead's horizons, in the same linear program. Agents flagged in `skip` (empty: none) are
+  // left out (their out[i] untouched): the hybrid lookahead needs no ORCA answer for them.
   void computeVelocities(const Agents& agents, const StaticObstacles& obstacles, const OrcaParams& params, float dt,
-                         std::span<Vec2f> out, const lookahead::DiscreteLookahead* lookahead = nullptr);
+                         std::span<Vec2f> out, const lookahead::DiscreteLookahead* lookahead = nullptr,
+                         std::span<const std::uint8_t> skip = {});
 
  private:
   struct Neighbour {

@@ -45,7 +45,7 @@ void walk(Agents& a, const std::vector<Vec2f>& goals, int steps, float dt, looka
       a.preferredVelocity[i] = len > 1e-6f ? Vec2f(d * std::min(a.maxSpeed[i], len / dt) / len) : Vec2f::Zero();
     }
     const lookahead::DiscreteLookahead* la =
-        ahead ? &ahead->prepare(a, none, params.neighbourDist, 1.4) : nullptr;
+        ahead ? &ahead->prepare(a, none, params.neighbourDist, 1.4, msim::Vec2::Zero(), msim::Vec2::Zero(), {.tree = true}) : nullptr;
     solver.computeVelocities(a, none, params, dt, v, la);
     std::vector<Vec2f> previous = a.velocity;
     for (std::size_t i = 0; i < a.size(); ++i) {
@@ -79,7 +79,10 @@ TEST(DiscreteLookahead, KeepsOrcasLevelZeroGuaranteeInDenseRandomCrowds) {
     }
     for (std::size_t i = 0; i < starts.size(); ++i) goals.emplace_back(u(random), u(random));
     Agents a = orcaAgents(starts, 0.25f);
-    lookahead::AgentLookahead ahead(lookahead::LookaheadSettings{.levels = levels, .baseStep = 0.05});
+    lookahead::LookaheadSettings settings;
+    settings.levels = levels;
+    settings.baseStep = 0.05;
+    lookahead::AgentLookahead ahead(settings);
     float& c = closest[levels > 0 ? 1 : 0];
     walk(a, goals, 200, 0.05f, levels > 0 ? &ahead : nullptr, [&](int, const Agents& agents) {
       for (std::size_t i = 0; i < agents.size(); ++i)
@@ -110,7 +113,10 @@ TEST(DiscreteLookahead, AgentsWalkingAtEachOtherTurnAsideFromFurtherAway) {
     return distance;
   };
   const float plain = turnDistance(nullptr);
-  lookahead::AgentLookahead ahead(lookahead::LookaheadSettings{.levels = 8, .baseStep = 0.05});
+  lookahead::LookaheadSettings settings;
+  settings.levels = 8;
+  settings.baseStep = 0.05;
+  lookahead::AgentLookahead ahead(settings);
   const float early = turnDistance(&ahead);
   EXPECT_GT(plain, 0.0f);
   EXPECT_LT(plain, 7.0f) << "plain ORCA reacts within its horizon";

@@ -97,7 +97,8 @@ void AgentLookahead::localInconsistency(const Agents& agents, double cell, std::
 }
 
 const DiscreteLookahead& AgentLookahead::prepare(const Agents& agents, const StaticObstacles& obstacles,
-                                                 double neighbourDist, double maxSpeed) {
+                                                 double neighbourDist, double maxSpeed, const Vec2& lo, const Vec2& hi,
+                                                 const Needs& needs) {
   const std::size_t n = agents.size();
   resize(n);
   lookahead_.schedule = HorizonSchedule{settings_.baseStep, settings_.levels, settings_.coarsening, neighbourDist, maxSpeed};
@@ -107,7 +108,7 @@ const DiscreteLookahead& AgentLookahead::prepare(const Agents& agents, const Sta
     localInconsistency(agents, neighbourDist, cells_, sigma_);
     const HorizonSchedule& s = lookahead_.schedule;
     parallelFor(0, n, [&](std::size_t i) {
-      if (agents.model[i] != AgentModel::Orca) return;
+      if (agents.model[i] == AgentModel::Scripted) return;
       int depth = depthForInconsistency(sigma_[i], settings_.sigmaMax, s.levels);
       const float speed = agents.velocity[i].norm();
       if (depth > 0 && speed > 1e-6f) {
@@ -118,7 +119,9 @@ const DiscreteLookahead& AgentLookahead::prepare(const Agents& agents, const Sta
       depth_[i] = static_cast<std::uint8_t>(depth);
     });
   }
-  lookahead_.tree.build(agents.position, agents.velocity, agents.radius);
+  if (needs.tree) lookahead_.tree.build(agents.position, agents.velocity, agents.radius);
+  if (needs.densities.now || needs.densities.far)
+    future_.build(lookahead_.schedule, settings_.cell, lo, hi, agents.position, agents.velocity, needs.densities);
   lookahead_.positions = agents.position;
   lookahead_.velocities = agents.velocity;
   lookahead_.radii = agents.radius;

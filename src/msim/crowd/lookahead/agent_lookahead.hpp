@@ -1,6 +1,6 @@
 #pragma once
-// Long-range avoidance for the crowd's ORCA agents (Golas ch. 3.6-3.8), the state it keeps from
-// step to step: each agent's deviation samples (v(n) - v(n-1)) / dt, forgotten exponentially with
+// Long-range avoidance for the crowd's agents (Golas ch. 3.5-3.9), the state it keeps from step to
+// step: each agent's deviation samples (v(n) - v(n-1)) / dt, forgotten exponentially with
 // a half-life of half the metric window tau_w (the seed's optional down-weighting of older
 // samples), from which each step takes
 //   - the local inconsistency metric sigma_j: the moments of the agents within about R of j
@@ -8,7 +8,9 @@
 //     samples the smooth metric on a grid too),
 //   - the depth L_j = min(L(sigma_j), the deepest level whose extrapolated position j sees without
 //     an obstacle in between) (curtailing.hpp),
-//   - and the agent tree of the clusters;
+//   - the agent tree of the clusters (discrete lookahead, ORCA agents),
+//   - and the pyramid of future densities (continuum lookahead: the UIC agents, and the ORCA
+//     agents in the continuum and hybrid methods);
 // and the scene's metric, every agent's samples pooled.
 #include <cstdint>
 #include <limits>
@@ -16,11 +18,20 @@
 #include <vector>
 
 #include "msim/crowd/agents.hpp"
+#include "msim/crowd/lookahead/blending.hpp"
+#include "msim/crowd/lookahead/continuum_lookahead.hpp"
 #include "msim/crowd/lookahead/discrete_lookahead.hpp"
+#include "msim/crowd/lookahead/future_density.hpp"
 #include "msim/crowd/lookahead/inconsistency.hpp"
 #include "msim/crowd/obstacle_index.hpp"
 
 namespace msim::crowd::lookahead {
+
+// How ORCA agents look ahead: the discrete lookahead in their linear program (ch. 3.6), the
+// continuum one instead of ORCA (ch. 3.5, "Cont LA"), or the two blended per agent by the local
+// density and velocity spread (ch. 3.9, "Hyb LA"). UIC agents always take the continuum lookahead
+// as their preferred velocity (the UIC then decides at level 0).
+enum class LookaheadMethod { Discrete, Continuum, Hybrid };
 
 struct LookaheadSettings {
   int levels = 0;             // i_max; 0: no lookahead
@@ -29,6 +40,14 @@ struct LookaheadSettings {
   double sigmaMax = std::numeric_limits<double>::infinity();  // curtailing; infinity: constant lookahead
   double metricWindow = 0.4;  // tau_w [s]
   MetricMode metricMode = MetricMode::SqrtEigenvalueSum;
+  LookaheadMethod method = LookaheadMethod::Discrete;
+  double cell = 1.0;          // h_0: level 0's cell in the future-density pyramid [m]
+  // How often the continuum lookahead's far levels (1..L) are asked again [s]; in between each
+  // agent keeps the direction they suggested (0: every step, as the seed). Their horizons are
+  // seconds, and asking them every step cost as much as the UIC step itself.
+  double refresh = 0.5;
+  ContinuumSettings continuum;
+  BlendThresholds blend;
   bool enabled() const { return levels > 0; }
 };
 
@@ -37,10 +56,21 @@ class AgentLookahead {
   explicit AgentLookahead(const LookaheadSettings& settings = {}) : settings_(settings) {}
   const LookaheadSettings& settings() const { return settings_; }
 
-  // Before ORCA: depths and the tree for the agents as they stand. neighbourDist is ORCA's R,
-  // maxSpeed the fastest any agent walks.
+  // What prepare() builds besides the depths: the agent tree (discrete lookahead) and the future
+  // densities (continuum lookahead): level 0 (the crowd now: the hybrid's weights and the
+  // continuum's last word; the UIC agents have their own) and the far levels.
+  struct Needs {
+    bool tree = false;
+    DensityLevels densities{false, false};
+  };
+  // Before the agents move: depths for the agents as they stand and what `needs` asks for, the
+  // future densities over the walkable box [lo, hi]. neighbourDist is ORCA's R, maxSpeed the
+  // fastest any agent walks.
   const DiscreteLookahead& prepare(const Agents& agents, const StaticObstacles& obstacles, double neighbourDist,
-                                   double maxSpeed);
+                                   double maxSpeed, const Vec2& lo, const Vec2& hi, const Needs& needs);
+  const FutureDensity& future() const { return future_; }
+  // L_j of the last prepare().
+  int depth(std::size_t agent) const { return depth_[agent]; }
   // After a step of dt that took every agent from `previous` to `current` velocities (the same
   // agents in the same order): the samples (current - previous) / dt, except each agent's first.
   // Every agent's: the metric describes the crowd whichever model moves it.
@@ -67,6 +97,7 @@ class AgentLookahead {
   std::vector<std::uint8_t> depth_;
   std::vector<DeviationMoment> cells_;
   DiscreteLookahead lookahead_;
+  FutureDensity future_;
 };
 
 }  // namespace msim::crowd::lookahead

@@ -64,6 +64,10 @@ class CrowdPhenomenon final : public Phenomenon {
     ++stepsThisFrame_;
     uicIterations_ += sim_->lastStep().uic.innerIterations + sim_->lastStep().uic.outerIterations;
     uicSolveSeconds_ += sim_->lastStep().uic.solveSeconds;
+    const crowd::LookaheadStepStats& la = sim_->lastStep().lookahead;
+    lookaheadSolves_ += la.solves;
+    lookaheadIterations_ += la.iterations;
+    blendWeightSum_ += la.meanWeight;
     // Flow through the measurement lines, step by step (crossings between frames would be missed).
     if (!lines_.empty()) {
       ScopedStage stage(timers_, "crowd: metrics");
@@ -78,6 +82,10 @@ class CrowdPhenomenon final : public Phenomenon {
   void endFrame() override {
     iterationsPerStep_ = stepsThisFrame_ > 0 ? double(uicIterations_) / stepsThisFrame_ : 0.0;
     solveMsPerStep_ = stepsThisFrame_ > 0 ? 1e3 * uicSolveSeconds_ / stepsThisFrame_ : 0.0;
+    iterationsPerSolve_ = lookaheadSolves_ > 0 ? double(lookaheadIterations_) / double(lookaheadSolves_) : 0.0;
+    meanBlendWeight_ = stepsThisFrame_ > 0 ? blendWeightSum_ / stepsThisFrame_ : 0.0;
+    lookaheadSolves_ = lookaheadIterations_ = 0;
+    blendWeightSum_ = 0.0;
     stepsThisFrame_ = 0;
     uicIterations_ = 0;
     uicSolveSeconds_ = 0.0;
@@ -209,6 +217,7 @@ class CrowdPhenomenon final : public Phenomenon {
               {"exited_total", sim_->exits().size()},
               {"spawned_total", a.nextId - initialIds_.size()},
               {"evacuated_fraction", evacuatedFraction()},
+              {"arrived_fraction", arrivedFraction()},
               {"mean_speed_mps", speed_.mean},
               {"p95_speed_mps", speed_.p95},
               {"max_density_per_m2", maxDensity_},
@@ -226,7 +235,11 @@ class CrowdPhenomenon final : public Phenomenon {
               {"free_walkers_mean_speed_mps", freeWalkers_.meanSpeed},
               {"stalled", stalledNow_ ? 1 : 0},
               // The scene's inconsistency metric (Golas ch. 3.8) over the last metric window.
-              {"inconsistency", sim_->lookahead().sceneInconsistency()}};
+              {"inconsistency", sim_->lookahead().sceneInconsistency()},
+              // The continuum lookahead's ascent (eq. 3.2; the seed: fewer than 10 iterations on
+              // average) and the hybrid's mean blend weight w (eq. 3.11; 0 all discrete, 1 all continuum).
+              {"lookahead_iterations_per_solve", iterationsPerSolve_},
+              {"lookahead_blend_weight", meanBlendWeight_}};
     for (std::size_t k = 0; k < setup_.lines.size(); ++k)
       s["line_" + setup_.lines[k].name + "_crossings"] = lineCrossings_[k];
     return s;
@@ -280,6 +293,16 @@ class CrowdPhenomenon final : public Phenomenon {
         }
     }
     results["evacuation"] = evacuation;
+    // Golas ch. 3's "simulation duration": when every agent of the start has reached its goal
+    // (left through an exit or stands at its goal), and when half and nine tenths had.
+    json completion = json::object();
+    for (double q : {0.5, 0.9, 1.0})
+      for (const json& f : frames)
+        if (!initialIds_.empty() && f.value("arrived_fraction", 0.0) >= q - 1e-12) {
+          completion[fmt::format("t{:.0f}_s", 100 * q)] = f.at("time_s").get<double>();
+          break;
+        }
+    results["completion"] = completion;
     json flows = json::object();
     const double duration = frames.back().at("time_s").get<double>();
     for (const auto& l : setup_.lines) {
@@ -308,6 +331,19 @@ class CrowdPhenomenon final : public Phenomenon {
     for (const auto& e : sim_->exits())
       if (std::binary_search(initialIds_.begin(), initialIds_.end(), e.agentId)) ++initialExited;
     return double(initialExited) / double(initialIds_.size());
+  }
+
+  // The agents of the start that have arrived: left through an exit, or standing at their goal.
+  double arrivedFraction() const {
+    if (initialIds_.empty()) return 0.0;
+    const crowd::Agents& a = sim_->agents();
+    const auto& goals = sim_->goals();
+    std::size_t standing = 0;
+    for (std::size_t i = 0; i < a.size(); ++i)
+      if (a.model[i] != crowd::AgentModel::Scripted && std::binary_search(initialIds_.begin(), initialIds_.end(), a.id[i]) &&
+          goals[a.goal[i]].reached(a.position[i].cast<double>()))
+        ++standing;
+    return evacuatedFraction() + double(standing) / double(initialIds_.size());
   }
 
   // Frame metrics, measured once per frame (every step would cost a Voronoi diagram per step).
@@ -454,6 +490,9 @@ class CrowdPhenomenon final : public Phenomenon {
   double uicSolveSeconds_ = 0.0;  // QP solve time of those steps (Fig. 4.10)
   double iterationsPerStep_ = 0.0;  // of the last complete frame
   double solveMsPerStep_ = 0.0;     // of the last complete frame
+  std::size_t lookaheadSolves_ = 0, lookaheadIterations_ = 0;  // of the frame being simulated
+  double blendWeightSum_ = 0.0;                                 // the steps' mean weights summed
+  double iterationsPerSolve_ = 0.0, meanBlendWeight_ = 0.0;     // of the last complete frame
   crowd::CrowdSimulation::FreeWalkers freeWalkers_;
   bool stalledNow_ = false;  // this frame
   bool warnedStall_ = false;

@@ -103,14 +103,17 @@ Schema crowdKeys() {
   orca.number("time_horizon", "s", 2.0, "avoid agents this far ahead in time").min(0.0, Bound::Exclusive);
   orca.number("time_horizon_obstacles", "s", 1.0, "avoid obstacles this far ahead in time").min(0.0, Bound::Exclusive);
   c.field("orca", orca);
-  Schema ahead = Schema::object("long-range collision avoidance of the ORCA agents (Golas ch. 3, docs/crowd.md#lookahead)");
+  Schema ahead = Schema::object("long-range collision avoidance (Golas ch. 3, docs/crowd.md#lookahead)");
   ahead.integer("levels", 0, "i_max: look dt_i = 2^(i-1) base_step ahead for i = 1..levels (the seed: 8); 0: off")
       .min(0)
       .max(16);
   ahead.number("base_step", "s", 0.01, "dt of the horizons (the seed's 0.01 s: 8 levels reach 1.28 s)")
       .min(0.0, Bound::Exclusive)
       .max(1.0);
-  ahead.number("coarsening", "", 2.0, "c: the effective radius of agents seen at level i is r / c^i").min(1.0).max(4.0);
+  ahead.number("coarsening", "", 2.0,
+               "c: level i sees agents with the effective radius r / c^i (discrete) and on cells h_0 c^i (continuum)")
+      .min(1.0)
+      .max(4.0);
   ahead.number("sigma_max", "m/s^2", 0.0,
                "curtailing: the depth falls linearly with the local inconsistency metric to 0 at this value (eq. 3.10); "
                "0: no curtailing (constant lookahead)")
@@ -120,6 +123,28 @@ Schema crowdKeys() {
   ahead.string("metric_mode", "sqrt_eigenvalue_sum",
                "sigma = sum of the square roots of C's eigenvalues (eq. 3.9) or its trace (Fig. 3.7's caption)")
       .choices({"sqrt_eigenvalue_sum", "trace"});
+  ahead.string("method", "discrete",
+               "how ORCA agents look ahead: discrete (levels in ORCA's linear program, ch. 3.6), continuum (eq. 3.2 on the "
+               "future densities instead of ORCA, ch. 3.5) or hybrid (the two blended by density and velocity spread, ch. 3.9); "
+               "UIC agents always take the continuum lookahead as their preferred velocity")
+      .choices({"discrete", "continuum", "hybrid"});
+  ahead.number("cell", "m", 1.0, "h_0: the future-density pyramid's finest cell (level i: h_0 c^i)")
+      .min(0.0, Bound::Exclusive);
+  ahead.number("refresh", "s", 0.5,
+               "the continuum lookahead asks its far levels (1..levels) again this often, each agent keeping their "
+               "suggested direction in between; 0: every step (the seed)")
+      .min(0.0);
+  ahead.number("plan_horizon", "s", 1.0, "T: how far ahead eq. 3.1 weighs the density change along a direction")
+      .min(0.0, Bound::Exclusive);
+  ahead.number("max_density", "1/m^2", 5.5, "rho_max of the continuum's walking speed f(rho) = v_max (1 - rho / rho_max)")
+      .min(0.0, Bound::Exclusive);
+  Schema blend = Schema::object("the hybrid's weights (eqs. 3.12-3.13)");
+  blend.number("density_min", "1/m^2", 2.0, "rho_cmin: pure discrete below").min(0.0);
+  blend.number("density_max", "1/m^2", 4.0, "rho_dmax: pure continuum above (more than density_min)").min(0.0);
+  blend.number("variance_low", "", 1.0, "c_1: continuum while the velocity spread is below c_1 x the mean speed").min(0.0);
+  blend.number("variance_high", "", 2.0, "c_2: discrete once the spread reaches c_2 x the mean speed (more than variance_low)")
+      .min(0.0);
+  ahead.field("blend", blend);
   c.field("lookahead", ahead);
   Schema planner = Schema::object("global planning (ch. 4.3.1)");
   planner.string("type", "auto",
@@ -143,7 +168,11 @@ Schema crowdKeys() {
 Schema groupSchema() {
   Schema g = Schema::object("agents placed at the start");
   g.integer("count", "number of agents").min(1).required();
-  g.field("region", regionSchema("where they stand (uniformly at random, then relaxed apart)", false).required());
+  g.field("region", regionSchema("where they stand (see placement)", false).required());
+  g.string("placement", "random",
+           "random: uniformly at random in the region, then relaxed apart; outline: evenly spaced along its outline "
+           "(a circle's circumference: the ring of Golas Fig. 3.1)")
+      .choices({"random", "outline"});
   agentKeys(g, true);
   g.array("waypoints", Schema::vectorItem("m", 2, "waypoint"),
           "scripted agents: the path, relative to the region centre (each agent keeps its offset)");
@@ -176,6 +205,46 @@ Vec2 regionCentre(const json& shape, const Polygon& polygon) {
   Vec2 lo, hi;
   crowd::bounds(polygon, lo, hi);
   return 0.5 * (lo + hi);
+}
+
+// `count` points evenly spaced along the region's outline: a circle's own circumference, else the
+// polygon's edges by arc length (Golas Fig. 3.1's circle: agents on a ring, each walking to the
+// opposite point).
+std::vector<Vec2> outlinePoints(const json& shape, const Polygon& polygon, std::size_t count) {
+  std::vector<Vec2> points(count);
+  if (shape.at("type").get<std::string>() == "circle") {
+    const Vec2 centre = sceneVector<2>(shape.at("center"));
+    const double radius = shape.at("radius").get<double>();
+    for (std::size_t k = 0; k < count; ++k) {
+      const double angle = 2.0 * M_PI * double(k) / double(count);
+      points[k] = centre + radius * Vec2(std::cos(angle), std::sin(angle));
+    }
+    return points;
+  }
+  const std::size_t n = polygon.vertices.size();
+  double perimeter = 0.0;
+  for (std::size_t e = 0; e < n; ++e) perimeter += (polygon.vertices[(e + 1) % n] - polygon.vertices[e]).norm();
+  std::size_t edge = 0;
+  double edgeStart = 0.0;  // arc length where `edge` begins
+  for (std::size_t k = 0; k < count; ++k) {
+    const double s = perimeter * double(k) / double(count);
+    while (edge + 1 < n && edgeStart + (polygon.vertices[edge + 1] - polygon.vertices[edge]).norm() <= s) {
+      edgeStart += (polygon.vertices[edge + 1] - polygon.vertices[edge]).norm();
+      ++edge;
+    }
+    const Vec2 a = polygon.vertices[edge], b = polygon.vertices[(edge + 1) % n];
+    const double length = (b - a).norm();
+    points[k] = length > 0.0 ? Vec2(a + (s - edgeStart) / length * (b - a)) : a;
+  }
+  return points;
+}
+
+double outlineLength(const json& shape, const Polygon& polygon) {
+  if (shape.at("type").get<std::string>() == "circle") return 2.0 * M_PI * shape.at("radius").get<double>();
+  double perimeter = 0.0;
+  for (std::size_t e = 0; e < polygon.vertices.size(); ++e)
+    perimeter += (polygon.vertices[(e + 1) % polygon.vertices.size()] - polygon.vertices[e]).norm();
+  return perimeter;
 }
 
 crowd::AgentModel modelOf(const std::string& name) {
@@ -253,6 +322,26 @@ struct Builder {
     out.settings.lookahead.metricMode = la.at("metric_mode").get<std::string>() == "trace"
                                             ? crowd::lookahead::MetricMode::Trace
                                             : crowd::lookahead::MetricMode::SqrtEigenvalueSum;
+    const std::string method = la.at("method").get<std::string>();
+    out.settings.lookahead.method = method == "continuum" ? crowd::lookahead::LookaheadMethod::Continuum
+                                    : method == "hybrid"  ? crowd::lookahead::LookaheadMethod::Hybrid
+                                                          : crowd::lookahead::LookaheadMethod::Discrete;
+    out.settings.lookahead.cell = la.at("cell").get<double>();
+    out.settings.lookahead.refresh = la.at("refresh").get<double>();
+    out.settings.lookahead.continuum.planHorizon = la.at("plan_horizon").get<double>();
+    out.settings.lookahead.continuum.maxDensity = la.at("max_density").get<double>();
+    const json& b = la.at("blend");
+    crowd::lookahead::BlendThresholds& t = out.settings.lookahead.blend;
+    t.continuumFrom = b.at("density_min").get<double>();
+    t.discreteUpTo = b.at("density_max").get<double>();
+    t.uniformBelow = b.at("variance_low").get<double>();
+    t.disorderedFrom = b.at("variance_high").get<double>();
+    if (!(t.discreteUpTo > t.continuumFrom))
+      fail("crowd.lookahead.blend.density_max", fmt::format("= {} must be more than crowd.lookahead.blend.density_min = {} "
+                                                            "(eq. 3.12 blends between them)", t.discreteUpTo, t.continuumFrom));
+    if (!(t.disorderedFrom > t.uniformBelow))
+      fail("crowd.lookahead.blend.variance_high", fmt::format("= {} must be more than crowd.lookahead.blend.variance_low = {} "
+                                                              "(eq. 3.13 blends between them)", t.disorderedFrom, t.uniformBelow));
     out.settings.seed = c.at("seed").get<std::uint64_t>();
     out.maxStep = c.at("max_step").get<double>();
     out.gridCfl = c.at("grid_cfl").get<double>();
@@ -455,7 +544,15 @@ struct Builder {
       const crowd::SpeedDistribution speeds = speedDistribution(g, base, key);
       Rng groupRng = rng.split(k);
       std::vector<Vec2> points(static_cast<std::size_t>(count));
-      for (Vec2& x : points) x = randomPoint(groupRng, region, base.radius, key + ".region");
+      if (g.at("placement").get<std::string>() == "outline") {
+        const double spacing = outlineLength(g.at("region"), region) / double(count);
+        if (spacing < 2.0 * base.radius)
+          fail(key + ".count", fmt::format("= {} agents of radius {} m do not fit along the region's outline ({:.4g} m "
+                                           "apart, less than a diameter)", count, base.radius, spacing));
+        points = outlinePoints(g.at("region"), region, points.size());
+      } else {
+        for (Vec2& x : points) x = randomPoint(groupRng, region, base.radius, key + ".region");
+      }
       crowd::sortSpatially(points);
       Rng speedRng = rng.split(list.size() + k);  // apart from the positions': adding spread moves no one
       for (const Vec2& x : points) {
