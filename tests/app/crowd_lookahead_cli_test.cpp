@@ -91,13 +91,14 @@ TEST(CrowdLookahead, HybridBlendsDiscreteAndContinuumAnswers) {
   // The four-way crossing's first 45 s with the hybrid: where the groups meet the crowd is dense
   // and uniform enough for continuum answers (mean weight w above 0) but not everywhere (below 1).
   // The continuum's answers carry no pairwise guarantee (collision resolution separates agents):
-  // no two come closer than half a diameter (plain ORCA itself comes to 0.75 of one here).
+  // no two come closer than 0.4 of a diameter (measured 0.55; plain ORCA itself comes to 0.75 of
+  // one here).
   const std::string scene = std::string(MSIM_SOURCE_DIR) + "/scenes/crowd_lookahead_four_way.json";
   const json r = run("four_way_hybrid", " --set time.duration=45", scene);
   ASSERT_FALSE(r.empty());
   double largest = 0.0;
   for (const json& f : r.at("frames")) {
-    if (f.at("nn_agents").get<double>() > 0) EXPECT_GT(f.at("nn_min_ratio").get<double>(), 0.5) << f.at("time_s");
+    if (f.at("nn_agents").get<double>() > 0) EXPECT_GT(f.at("nn_min_ratio").get<double>(), 0.4) << f.at("time_s");
     const double w = f.at("lookahead_blend_weight").get<double>();
     EXPECT_GE(w, 0.0);
     EXPECT_LE(w, 1.0);

@@ -45,7 +45,7 @@ struct LookaheadSettings {
   // How often the continuum lookahead's far levels (1..L) are asked again [s]; in between each
   // agent keeps the direction they suggested (0: every step, as the seed). Their horizons are
   // seconds, and asking them every step cost as much as the UIC step itself.
-  double refresh = 0.5;
+  double refresh = 1.0;
   ContinuumSettings continuum;
   BlendThresholds blend;
   bool enabled() const { return levels > 0; }

@@ -33,6 +33,13 @@ DirectionChoice bestDirection(const Vec2& preferred, const Vec2& densityGradient
   const double k = 0.5 * speedSlope * settings.planHorizon;
   const Vec2& p = preferred;
   const Vec2& g = densityGradient;
+  // Without a density change along the way (empty or uniform surroundings, or a speed the
+  // density does not change) J = p.v, maximal along p: most far levels of a sparse crowd.
+  if (k == 0.0 || g.squaredNorm() == 0.0) {
+    out.direction = preferred / speed;
+    out.converged = true;
+    return out;
+  }
   Vec2 v = start.squaredNorm() > 0.0 ? Vec2(start.normalized()) : Vec2(preferred / speed);
   for (int it = 0; it < settings.maxIterations; ++it) {
     const Vec2 turned(-v.y(), v.x());

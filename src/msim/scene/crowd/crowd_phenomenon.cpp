@@ -82,7 +82,8 @@ class CrowdPhenomenon final : public Phenomenon {
   void endFrame() override {
     iterationsPerStep_ = stepsThisFrame_ > 0 ? double(uicIterations_) / stepsThisFrame_ : 0.0;
     solveMsPerStep_ = stepsThisFrame_ > 0 ? 1e3 * uicSolveSeconds_ / stepsThisFrame_ : 0.0;
-    iterationsPerSolve_ = lookaheadSolves_ > 0 ? double(lookaheadIterations_) / double(lookaheadSolves_) : 0.0;
+    // A frame between two refreshes of the far levels keeps the last one's figure.
+    if (lookaheadSolves_ > 0) iterationsPerSolve_ = double(lookaheadIterations_) / double(lookaheadSolves_);
     meanBlendWeight_ = stepsThisFrame_ > 0 ? blendWeightSum_ / stepsThisFrame_ : 0.0;
     lookaheadSolves_ = lookaheadIterations_ = 0;
     blendWeightSum_ = 0.0;

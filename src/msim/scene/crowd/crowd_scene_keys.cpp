@@ -130,7 +130,7 @@ Schema crowdKeys() {
       .choices({"discrete", "continuum", "hybrid"});
   ahead.number("cell", "m", 1.0, "h_0: the future-density pyramid's finest cell (level i: h_0 c^i)")
       .min(0.0, Bound::Exclusive);
-  ahead.number("refresh", "s", 0.5,
+  ahead.number("refresh", "s", 1.0,
                "the continuum lookahead asks its far levels (1..levels) again this often, each agent keeping their "
                "suggested direction in between; 0: every step (the seed)")
       .min(0.0);
