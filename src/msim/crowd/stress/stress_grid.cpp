@@ -1,0 +1,191 @@
+#include "msim/crowd/stress/stress_grid.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace msim::crowd::stress {
+
+namespace {
+
+// A cell counts as fully covered below this free fraction; partly covered ones divide by at least
+// kSmallestFree (the chapter's correction 1 / (1 - phi) guarded against slivers).
+constexpr float kCovered = 1e-6f;
+constexpr double kSmallestFree = 0.05;
+
+}  // namespace
+
+StressGrid::StressGrid(const GridSpec<2>& grid)
+    : grid_(grid),
+      nx_(grid.res.x()),
+      ny_(grid.res.y()),
+      count_(grid),
+      momentumX_(grid),
+      momentumY_(grid),
+      density_(grid),
+      velocityX_(grid),
+      velocityY_(grid),
+      covered_(grid),
+      active_(static_cast<std::size_t>((nx_ + 1) * ny_ + nx_ * (ny_ + 1)), 0) {}
+
+void StressGrid::splat(std::span<const Vec2f> positions, std::span<const Vec2f> velocities, const Grid<float, 2>& free) {
+  if (positions.size() != velocities.size()) throw std::invalid_argument("stress grid: positions and velocities differ in number");
+  if (!(free.spec() == grid_)) throw std::invalid_argument("stress grid: the free fractions lie on another grid");
+  const std::size_t n = positions.size();
+  ones_.assign(n, 1.0f);
+  vx_.resize(n);
+  vy_.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    vx_[k] = velocities[k].x();
+    vy_[k] = velocities[k].y();
+  }
+  count_.fill(0.0f);
+  momentumX_.fill(0.0f);
+  momentumY_.fill(0.0f);
+  splatter_.splatSums<3>(positions, {std::span<const float>(ones_), std::span<const float>(vx_), std::span<const float>(vy_)},
+                         {&count_, &momentumX_, &momentumY_}, TransferKernel::Linear);
+  const double area = grid_.dx * grid_.dx;
+  std::vector<std::uint8_t> known(count_.count(), 0);
+  for (std::size_t c = 0; c < count_.count(); ++c) {
+    const float f = free[c];
+    covered_[c] = f <= kCovered ? 1.0f : 0.0f;
+    if (covered_[c] != 0.0f) continue;
+    known[c] = 1;
+    density_[c] = static_cast<float>(count_[c] / (area * std::max<double>(f, kSmallestFree)));
+    velocityX_[c] = count_[c] > 1e-6f ? momentumX_[c] / count_[c] : 0.0f;
+    velocityY_[c] = count_[c] > 1e-6f ? momentumY_[c] / count_[c] : 0.0f;
+  }
+  // Covered cells take the density of the nearest uncovered one, layer by layer outwards (each
+  // layer reads the layers before it only; ties go to the first of -x, +x, -y, +y).
+  std::vector<std::uint8_t> next = known;
+  for (bool grew = true; grew;) {
+    grew = false;
+    for (int j = 0; j < ny_; ++j)
+      for (int i = 0; i < nx_; ++i) {
+        const std::size_t c = density_.index(IVec<2>(i, j));
+        if (known[c]) continue;
+        const IVec<2> around[4] = {IVec<2>(i - 1, j), IVec<2>(i + 1, j), IVec<2>(i, j - 1), IVec<2>(i, j + 1)};
+        for (const IVec<2>& a : around) {
+          if (!density_.inside(a) || !known[density_.index(a)]) continue;
+          density_[c] = density_(a);
+          velocityX_[c] = velocityY_[c] = 0.0f;
+          next[c] = 1;
+          grew = true;
+          break;
+        }
+      }
+    known = next;
+  }
+  // Faces between two cells that are not fully covered carry momentum; the domain's walls do not.
+  const auto open = [&](int i, int j) { return covered_(IVec<2>(i, j)) == 0.0f; };
+  for (int j = 0; j < ny_; ++j)
+    for (int i = 0; i <= nx_; ++i)
+      active_[static_cast<std::size_t>(i + (nx_ + 1) * j)] = i > 0 && i < nx_ && open(i - 1, j) && open(i, j);
+  const std::size_t xFaces = static_cast<std::size_t>((nx_ + 1) * ny_);
+  for (int j = 0; j <= ny_; ++j)
+    for (int i = 0; i < nx_; ++i)
+      active_[xFaces + static_cast<std::size_t>(i + nx_ * j)] = j > 0 && j < ny_ && open(i, j - 1) && open(i, j);
+  buildDivergence();
+}
+
+void StressGrid::discomfortGradient(const StressLaws& laws, MacGrid<2>& gradient) const {
+  if (!(gradient.spec() == grid_)) gradient = MacGrid<2>(grid_);
+  const double h = grid_.dx;
+  const auto g = [&](int i, int j) { return discomfort(density_(IVec<2>(i, j)), laws); };
+  Grid<float, 2>& gx = gradient.component(0);
+  Grid<float, 2>& gy = gradient.component(1);
+  for (int j = 0; j < ny_; ++j)
+    for (int i = 0; i <= nx_; ++i)
+      gx(IVec<2>(i, j)) = active_[static_cast<std::size_t>(i + (nx_ + 1) * j)]
+                              ? static_cast<float>((g(i, j) - g(i - 1, j)) / h)
+                              : 0.0f;
+  const std::size_t xFaces = static_cast<std::size_t>((nx_ + 1) * ny_);
+  for (int j = 0; j <= ny_; ++j)
+    for (int i = 0; i < nx_; ++i)
+      gy(IVec<2>(i, j)) = active_[xFaces + static_cast<std::size_t>(i + nx_ * j)]
+                              ? static_cast<float>((g(i, j) - g(i, j - 1)) / h)
+                              : 0.0f;
+}
+
+void StressGrid::buildDivergence() {
+  const std::size_t cells = static_cast<std::size_t>(nx_ * ny_);
+  const auto sd = [&](int i, int j) { return static_cast<int>(i + nx_ * j); };
+  const auto so = [&](int i, int j) { return static_cast<int>(cells) + i + (nx_ + 1) * j; };
+  const double inv = 1.0 / grid_.dx;
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(4 * active_.size());
+  for (int j = 0; j < ny_; ++j)
+    for (int i = 1; i < nx_; ++i) {
+      const int face = i + (nx_ + 1) * j;
+      if (!active_[static_cast<std::size_t>(face)]) continue;
+      // (div s)_x at the face between cells (i - 1, j) and (i, j), whose ends are corners (i, j), (i, j + 1).
+      entries.emplace_back(face, sd(i, j), inv);
+      entries.emplace_back(face, sd(i - 1, j), -inv);
+      entries.emplace_back(face, so(i, j + 1), inv);
+      entries.emplace_back(face, so(i, j), -inv);
+    }
+  const int xFaces = (nx_ + 1) * ny_;
+  for (int j = 1; j < ny_; ++j)
+    for (int i = 0; i < nx_; ++i) {
+      const int face = xFaces + i + nx_ * j;
+      if (!active_[static_cast<std::size_t>(face)]) continue;
+      // (div s)_y at the face between cells (i, j - 1) and (i, j), whose ends are corners (i, j), (i + 1, j).
+      entries.emplace_back(face, so(i + 1, j), inv);
+      entries.emplace_back(face, so(i, j), -inv);
+      entries.emplace_back(face, sd(i, j), -inv);
+      entries.emplace_back(face, sd(i, j - 1), inv);
+    }
+  divergence_.resize(static_cast<Eigen::Index>(active_.size()), static_cast<Eigen::Index>(cells + (nx_ + 1) * (ny_ + 1)));
+  divergence_.setFromTriplets(entries.begin(), entries.end());
+}
+
+double StressGrid::cellDensity(int i, int j) const { return density_(IVec<2>(i, j)); }
+
+FrictionResult StressGrid::friction(const Eigen::VectorXd& momentum, double dt, const StressLaws& laws,
+                                    const numerics::BoundQpSettings& settings, Eigen::VectorXd& change) {
+  if (momentum.size() != divergence_.rows()) throw std::invalid_argument("stress grid: one momentum per face expected");
+  if (!(dt > 0.0)) throw std::invalid_argument("stress grid: the step must be > 0");
+  const Eigen::Index unknowns = divergence_.cols();
+  // The bounds: each cell's density for s_d, the mean of the open cells around a corner for s_o.
+  upper_.resize(unknowns);
+  for (int j = 0; j < ny_; ++j)
+    for (int i = 0; i < nx_; ++i) upper_[i + nx_ * j] = frictionBound(cellDensity(i, j), laws);
+  const Eigen::Index cells = nx_ * ny_;
+  for (int j = 0; j <= ny_; ++j)
+    for (int i = 0; i <= nx_; ++i) {
+      double sum = 0.0;
+      int count = 0;
+      for (int dj = -1; dj <= 0; ++dj)
+        for (int di = -1; di <= 0; ++di) {
+          const IVec<2> c(i + di, j + dj);
+          if (!density_.inside(c) || covered_(c) != 0.0f) continue;
+          sum += density_(c);
+          ++count;
+        }
+      upper_[cells + i + (nx_ + 1) * j] = count > 0 ? frictionBound(sum / count, laws) : 0.0;
+    }
+  lower_ = -upper_;
+  // 1/2 s^T A s - b^T s with A = dt^2 / rho_y D^T D and b = -dt / rho_y D^T m*: E(s) - E(0).
+  const double scale = dt * dt / laws.yield;
+  system_ = scale * (divergence_.transpose() * divergence_);
+  // Unknowns no open face sees (inside walls) get the largest diagonal, as in setDecoupledDiagonals:
+  // their bounds or zero right-hand side hold them at 0 without shortening MPRGP's steps.
+  double largest = 0.0;
+  for (Eigen::Index k = 0; k < unknowns; ++k) largest = std::max(largest, system_.coeff(k, k));
+  if (!(largest > 0.0)) largest = 1.0;
+  for (Eigen::Index k = 0; k < unknowns; ++k)
+    if (!(system_.coeff(k, k) > 0.0)) system_.coeffRef(k, k) = largest;
+  system_.makeCompressed();
+  rhs_ = -(dt / laws.yield) * (divergence_.transpose() * momentum);
+  if (stress_.size() != unknowns) stress_ = Eigen::VectorXd::Zero(unknowns);
+  stress_ = stress_.cwiseMax(lower_).cwiseMin(upper_);
+  const numerics::SparseQpOperator op(system_);
+  FrictionResult result;
+  result.qp = solver_.solve(op, rhs_, lower_, upper_, stress_, settings);
+  change = dt * (divergence_ * stress_);
+  result.energyBefore = momentum.squaredNorm() / (2.0 * laws.yield);
+  result.energyAfter = (momentum + change).squaredNorm() / (2.0 * laws.yield);
+  return result;
+}
+
+}  // namespace msim::crowd::stress
