@@ -26,10 +26,16 @@ StressGrid::StressGrid(const GridSpec<2>& grid)
       velocityX_(grid),
       velocityY_(grid),
       covered_(grid),
+      sumX_(grid),
+      sumY_(grid),
+      collisionFreeX_(grid),
+      collisionFreeY_(grid),
       active_(static_cast<std::size_t>((nx_ + 1) * ny_ + nx_ * (ny_ + 1)), 0) {}
 
-void StressGrid::splat(std::span<const Vec2f> positions, std::span<const Vec2f> velocities, const Grid<float, 2>& free) {
-  if (positions.size() != velocities.size()) throw std::invalid_argument("stress grid: positions and velocities differ in number");
+void StressGrid::splat(std::span<const Vec2f> positions, std::span<const Vec2f> velocities, const Grid<float, 2>& free,
+                       std::span<const Vec2f> collisionFree) {
+  if (positions.size() != velocities.size() || (!collisionFree.empty() && collisionFree.size() != positions.size()))
+    throw std::invalid_argument("stress grid: positions and velocities differ in number");
   if (!(free.spec() == grid_)) throw std::invalid_argument("stress grid: the free fractions lie on another grid");
   const std::size_t n = positions.size();
   ones_.assign(n, 1.0f);
@@ -44,6 +50,18 @@ void StressGrid::splat(std::span<const Vec2f> positions, std::span<const Vec2f> 
   momentumY_.fill(0.0f);
   splatter_.splatSums<3>(positions, {std::span<const float>(ones_), std::span<const float>(vx_), std::span<const float>(vy_)},
                          {&count_, &momentumX_, &momentumY_}, TransferKernel::Linear);
+  sumX_.fill(0.0f);
+  sumY_.fill(0.0f);
+  if (!collisionFree.empty()) {
+    cx_.resize(n);
+    cy_.resize(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      cx_[k] = collisionFree[k].x();
+      cy_[k] = collisionFree[k].y();
+    }
+    splatter_.splatSums<2>(positions, {std::span<const float>(cx_), std::span<const float>(cy_)}, {&sumX_, &sumY_},
+                           TransferKernel::Linear);
+  }
   const double area = grid_.dx * grid_.dx;
   std::vector<std::uint8_t> known(count_.count(), 0);
   for (std::size_t c = 0; c < count_.count(); ++c) {
@@ -54,6 +72,8 @@ void StressGrid::splat(std::span<const Vec2f> positions, std::span<const Vec2f> 
     density_[c] = static_cast<float>(count_[c] / (area * std::max<double>(f, kSmallestFree)));
     velocityX_[c] = count_[c] > 1e-6f ? momentumX_[c] / count_[c] : 0.0f;
     velocityY_[c] = count_[c] > 1e-6f ? momentumY_[c] / count_[c] : 0.0f;
+    collisionFreeX_[c] = count_[c] > 1e-6f ? sumX_[c] / count_[c] : 0.0f;
+    collisionFreeY_[c] = count_[c] > 1e-6f ? sumY_[c] / count_[c] : 0.0f;
   }
   // Covered cells take the density of the nearest uncovered one, layer by layer outwards (each
   // layer reads the layers before it only; ties go to the first of -x, +x, -y, +y).
@@ -68,7 +88,7 @@ void StressGrid::splat(std::span<const Vec2f> positions, std::span<const Vec2f> 
         for (const IVec<2>& a : around) {
           if (!density_.inside(a) || !known[density_.index(a)]) continue;
           density_[c] = density_(a);
-          velocityX_[c] = velocityY_[c] = 0.0f;
+          velocityX_[c] = velocityY_[c] = collisionFreeX_[c] = collisionFreeY_[c] = 0.0f;
           next[c] = 1;
           grew = true;
           break;

@@ -38,10 +38,14 @@ class StressGrid {
   const GridSpec<2>& grid() const { return grid_; }
 
   // Eqs. 4.1-4.2 with the obstacle correction; `free` is each cell's free fraction (FreeArea).
-  void splat(std::span<const Vec2f> positions, std::span<const Vec2f> velocities, const Grid<float, 2>& free);
+  // `collisionFree` (empty, or one per agent) is averaged onto the cells the same way.
+  void splat(std::span<const Vec2f> positions, std::span<const Vec2f> velocities, const Grid<float, 2>& free,
+             std::span<const Vec2f> collisionFree = {});
   const Grid<float, 2>& density() const { return density_; }      // [1/m^2]
   const Grid<float, 2>& velocityX() const { return velocityX_; }  // [m/s], 0 where nobody is
   const Grid<float, 2>& velocityY() const { return velocityY_; }
+  const Grid<float, 2>& collisionFreeX() const { return collisionFreeX_; }  // [m/s], 0 where nobody is
+  const Grid<float, 2>& collisionFreeY() const { return collisionFreeY_; }
   // Whether the face carries momentum (inside the domain, between two cells not fully covered):
   // x faces first ((nx + 1) ny of them), then y faces (nx (ny + 1)).
   bool activeFace(std::size_t face) const { return active_[face] != 0; }
@@ -66,7 +70,8 @@ class StressGrid {
   GridSpec<2> grid_;
   int nx_ = 0, ny_ = 0;
   Grid<float, 2> count_, momentumX_, momentumY_, density_, velocityX_, velocityY_, covered_;
-  std::vector<float> ones_, vx_, vy_;
+  Grid<float, 2> sumX_, sumY_, collisionFreeX_, collisionFreeY_;
+  std::vector<float> ones_, vx_, vy_, cx_, cy_;
   Splatter<2> splatter_;
   std::vector<std::uint8_t> active_;
   Eigen::SparseMatrix<double> divergence_;  // D: faces x stress unknowns (rows of inactive faces empty)
