@@ -128,8 +128,13 @@ void BM_LookaheadCircle100k(benchmark::State& state) {
   runFromStart(state, scene::loadScene(scenePath("crowd_circle"), overrides), 200);
 }
 
+// Golas ch. 4's stress model on scenes/crowd_stress_merge.json once its crowd has packed (after
+// 40 s, about 1300 agents): the midpoint step's two friction solves are the `crowd: stress` counter.
+void BM_StressMerge(benchmark::State& state) { stepScene(state, scenePath("crowd_stress_merge"), {}, 800); }
+
 }  // namespace
 
+BENCHMARK(BM_StressMerge)->Unit(benchmark::kMillisecond)->Iterations(100);
 BENCHMARK(BM_LookaheadFourWay)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->Iterations(100);
 BENCHMARK(BM_LookaheadFourGroups)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->Iterations(200);
 BENCHMARK(BM_LookaheadCircle100k)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->Iterations(1);

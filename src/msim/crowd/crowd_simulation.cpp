@@ -69,6 +69,7 @@ CrowdSimulation::CrowdSimulation(const CrowdSettings& settings, std::vector<Poly
       freeArea_(settings.grid),
       uic_(settings.grid, settings.uicSettings),
       lookahead_(settings.lookahead) {
+  if (settings_.stress) stress_.emplace(settings_.grid, *settings_.stress);
   goalSummaries_.reserve(goals_.size());
   for (const Goal& g : goals_)
     goalSummaries_.push_back(
@@ -249,8 +250,12 @@ void CrowdSimulation::prepareLookahead(double dt) {
   farDirection_.resize(n, Vec2f::Zero());
   lookahead::AgentLookahead::Needs needs;
   needs.tree = orca && la.method != LookaheadMethod::Continuum;
-  needs.densities.now = orca && la.method != LookaheadMethod::Discrete;
-  const bool farWanted = stats_.uicAgents > 0 || needs.densities.now;
+  needs.tree = needs.tree && la.enabled();
+  // Level 0 (the crowd now): the hybrid's weights and the continuum's last word for ORCA agents,
+  // and the stress model's collision-free velocities (Golas ch. 4.3.3: Chapter 3's continuum).
+  const bool stressed = stress_ && stats_.uicAgents > 0;
+  needs.densities.now = (la.enabled() && orca && la.method != LookaheadMethod::Discrete) || stressed;
+  const bool farWanted = la.enabled() && (stats_.uicAgents > 0 || needs.densities.now);
   sinceRefresh_ += dt;
   needs.densities.far = farWanted && (!refreshed_ || sinceRefresh_ >= la.refresh - 1e-9);
   stats_.lookahead = {};
@@ -273,7 +278,8 @@ void CrowdSimulation::prepareLookahead(double dt) {
   const bool far = needs.densities.far;
   parallelFor(0, n, [&](std::size_t i) {
     const AgentModel model = agents_.model[i];
-    if (model == AgentModel::Scripted || (model == AgentModel::Orca && !needs.densities.now)) return;
+    if (model == AgentModel::Scripted || (model == AgentModel::Orca && (!la.enabled() || la.method == LookaheadMethod::Discrete)))
+      return;
     const Vec2f& x = agents_.position[i];
     const Vec2f& preferred = agents_.preferredVelocity[i];
     int iterations = 0, solves = 0;
@@ -288,8 +294,15 @@ void CrowdSimulation::prepareLookahead(double dt) {
     }
     const float wanted = preferred.norm();
     const Vec2f suggested = farDirection_[i].squaredNorm() > 0.0f ? Vec2f(wanted * farDirection_[i]) : preferred;
-    if (model == AgentModel::Uic) {
+    if (model == AgentModel::Uic && !stressed) {
       agents_.preferredVelocity[i] = suggested;  // the UIC decides at level 0
+    } else if (model == AgentModel::Uic) {
+      // The stress model walks towards level 0's collision-free velocity f(rho) v* (eq. 4.9).
+      const lookahead::CascadeResult r = lookahead::continuumLookahead(future, la.continuum, x, agents_.velocity[i],
+                                                                       suggested, agents_.maxSpeed[i], 0, 0);
+      iterations += r.iterations;
+      solves += r.solves;
+      continuumVelocity_[i] = r.velocity.cast<float>();
     } else {
       if (la.method == LookaheadMethod::Hybrid) {
         const lookahead::FutureDensity::Flow flow = future.flow(x.cast<double>());
@@ -367,6 +380,21 @@ void CrowdSimulation::walkingSpeeds() {
   walkingDensity_->measure(agents_.position, agents_.preferredVelocity, agents_.maxSpeed, walkDensity_, walkSpeed_);
 }
 
+void CrowdSimulation::splitContinuumAgents() {
+  uicIndex_.clear();
+  discCentres_.clear();
+  discRadii_.clear();
+  for (std::size_t i = 0; i < agents_.size(); ++i) {
+    if (agents_.model[i] == AgentModel::Uic) {
+      uicIndex_.push_back(static_cast<std::uint32_t>(i));
+    } else {
+      // Individually controlled agents are obstacles of the continuum (ch. 4.4.3).
+      discCentres_.push_back(agents_.position[i]);
+      discRadii_.push_back(agents_.radius[i]);
+    }
+  }
+}
+
 void CrowdSimulation::moveUic(double dt) {
   discCentres_.clear();
   discRadii_.clear();
@@ -380,16 +408,7 @@ void CrowdSimulation::moveUic(double dt) {
   // UIC agents are compacted into contiguous arrays.
   const bool allUic = stats_.uicAgents == agents_.size();
   if (!allUic) {
-    uicIndex_.clear();
-    for (std::size_t i = 0; i < agents_.size(); ++i) {
-      if (agents_.model[i] == AgentModel::Uic) {
-        uicIndex_.push_back(static_cast<std::uint32_t>(i));
-      } else {
-        // Individually controlled agents are obstacles of the continuum (ch. 4.4.3).
-        discCentres_.push_back(agents_.position[i]);
-        discRadii_.push_back(agents_.radius[i]);
-      }
-    }
+    splitContinuumAgents();
     const std::size_t n = uicIndex_.size();
     uicPosition_.resize(n);
     uicPreferred_.resize(n);
@@ -426,6 +445,30 @@ void CrowdSimulation::moveUic(double dt) {
     if (norm > speed[k]) v *= speed[k] / norm;
     agents_.velocity[i] = v;
     agents_.position[i] += h * v;
+  });
+}
+
+void CrowdSimulation::moveStressed(double dt) {
+  stats_.uic = UicStats{};
+  stats_.stress = {};
+  splitContinuumAgents();
+  const std::size_t n = uicIndex_.size();
+  if (n == 0) return;
+  freeArea_.update(discCentres_, discRadii_, movingNow_);
+  uicPosition_.resize(n);
+  uicVelocity_.resize(n);
+  uicPreferred_.resize(n);
+  parallelFor(0, n, [&](std::size_t k) {
+    const std::size_t i = uicIndex_[k];
+    uicPosition_[k] = agents_.position[i];
+    uicVelocity_[k] = agents_.velocity[i];
+    uicPreferred_[k] = continuumVelocity_[i];  // v_cf of prepareLookahead
+  });
+  stats_.stress = stress_->step(uicPosition_, uicVelocity_, uicPreferred_, freeArea_.fraction(), dt);
+  parallelFor(0, n, [&](std::size_t k) {
+    const std::size_t i = uicIndex_[k];
+    agents_.position[i] = uicPosition_[k];
+    agents_.velocity[i] = uicVelocity_[k];
   });
 }
 
@@ -527,7 +570,7 @@ void CrowdSimulation::step(double dt, StageTimers* timers) {
     ScopedStage s(t, "crowd: planning");
     plan();
   }
-  if (settings_.lookahead.enabled()) {
+  if (settings_.lookahead.enabled() || stress_) {
     ScopedStage s(t, "crowd: lookahead");
     prepareLookahead(dt);
   }
@@ -537,11 +580,14 @@ void CrowdSimulation::step(double dt, StageTimers* timers) {
     moveScripted(dt);
     moveOrca(dt);
   }
-  if (settings_.speedDensity.enabled && stats_.uicAgents > 0) {
-    ScopedStage s(t, "crowd: walking speeds");
-    walkingSpeeds();
-  }
-  {
+  if (stress_) {
+    ScopedStage s(t, "crowd: stress");
+    moveStressed(dt);
+  } else {
+    if (settings_.speedDensity.enabled && stats_.uicAgents > 0) {
+      ScopedStage s(t, "crowd: walking speeds");
+      walkingSpeeds();
+    }
     ScopedStage s(t, "crowd: uic");
     moveUic(dt);
   }

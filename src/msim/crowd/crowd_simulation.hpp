@@ -25,6 +25,7 @@
 #include "msim/crowd/orca.hpp"
 #include "msim/crowd/planner.hpp"
 #include "msim/crowd/speed_distribution.hpp"
+#include "msim/crowd/stress/stress_dynamics.hpp"
 #include "msim/crowd/uic_projection.hpp"
 #include "msim/crowd/walking_density.hpp"
 
@@ -70,6 +71,9 @@ struct CrowdSettings {
   CollisionResolutionParams collision;
   OrcaParams orca;
   lookahead::LookaheadSettings lookahead;     // long-range avoidance (Golas ch. 3)
+  // Inter-personal stress (Golas ch. 4): when set, the UIC agents move by eqs. 4.6-4.7 towards the
+  // continuum navigation's collision-free velocity instead of by the UIC projection.
+  std::optional<stress::StressSettings> stress;
   std::uint64_t seed = 1;                     // inflow positions (one stream per new agent id)
 };
 
@@ -84,6 +88,7 @@ struct CrowdStepStats {
   std::size_t agents = 0, uicAgents = 0, orcaAgents = 0, scriptedAgents = 0;
   std::size_t spawned = 0, exited = 0;  // this step
   UicStats uic;                         // the last projection (zeros when off or no UIC agents)
+  stress::StressStepStats stress;       // the stress model's solves (zeros without it)
   LookaheadStepStats lookahead;         // zeros without continuum lookahead
 };
 
@@ -118,6 +123,8 @@ class CrowdSimulation {
   // The inconsistency metric (Golas ch. 3.8): per agent (localInconsistency) and the scene's.
   const lookahead::AgentLookahead& lookahead() const { return lookahead_; }
   const UicProjection& uic() const { return uic_; }
+  // The stress model's fields (density, velocity, stress) of its last evaluation; null without it.
+  const stress::StressDynamics* stress() const { return stress_ ? &*stress_ : nullptr; }
   const FreeArea& freeArea() const { return freeArea_; }
   // Exits since the start (kept for the whole run).
   const std::vector<ExitEvent>& exits() const { return exits_; }
@@ -154,7 +161,10 @@ class CrowdSimulation {
   void applyFarDirections();
   void moveOrca(double dt);
   void walkingSpeeds();
+  // The UIC agents' indices into uicIndex_ and the other agents as discs of the continuum.
+  void splitContinuumAgents();
   void moveUic(double dt);
+  void moveStressed(double dt);
   void arriveAndSpawn(double dt);
   // Static and moving obstacles at time t, indexed for the local passes (only rebuilt when some move).
   void placeMovingObstacles(double t);
@@ -192,6 +202,7 @@ class CrowdSimulation {
   std::optional<WalkingDensity> walkingDensity_;  // speeds when speedDensity.enabled; freeWalkers()
   OrcaSolver orca_;
   lookahead::AgentLookahead lookahead_;   // and the inconsistency metric of every agent
+  std::optional<stress::StressDynamics> stress_;
   const lookahead::DiscreteLookahead* ahead_ = nullptr;  // this step's, from prepareLookahead()
   std::vector<Vec2f> farDirection_;  // per agent: the continuum lookahead's far levels' direction (0: none)
   double sinceRefresh_ = 0.0;        // [s] since the far levels were last asked

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "msim/crowd/lookahead/continuum_lookahead.hpp"
+#include "msim/crowd/stress/crowd_pressure.hpp"
 #include "msim/crowd/stress/stress_grid.hpp"
 #include "msim/crowd/stress/stress_laws.hpp"
 
@@ -222,4 +223,23 @@ TEST(CrowdStress, FrictionSlowsLayersSlidingPastEachOther) {
       EXPECT_LT(rowChange * (j - 11.5), 0.0) << "row " << j;
     }
   }
+}
+
+TEST(CrowdStress, PressureIsDensityTimesVelocityVariance) {
+  // 4 agents per 1 m cell, two walking east and two west at 0.5 m/s: Var = 0.25 m^2/s^2 and
+  // rho = 4 /m^2, P = 1 /s^2 in every cell; all walking alike, P = 0.
+  const GridSpec<2> spec(Vec2(0.0, 0.0), 1.0, IVec<2>(6, 6));
+  std::vector<Vec2f> x, v, same;
+  for (int j = 0; j < 6; ++j)
+    for (int i = 0; i < 6; ++i)
+      for (int k = 0; k < 4; ++k) {
+        x.emplace_back(i + 0.2f + 0.2f * k, j + 0.5f);
+        v.emplace_back(k % 2 == 0 ? 0.5f : -0.5f, 0.0f);
+        same.emplace_back(0.7f, 0.1f);
+      }
+  Grid<float, 2> p(spec);
+  spatialPressure(x, v, 1, p);
+  for (std::size_t c = 0; c < p.count(); ++c) EXPECT_NEAR(p[c], 1.0f, 1e-5f);
+  spatialPressure(x, same, 1, p);
+  for (std::size_t c = 0; c < p.count(); ++c) EXPECT_NEAR(p[c], 0.0f, 1e-5f);
 }

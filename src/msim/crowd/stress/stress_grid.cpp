@@ -13,6 +13,36 @@ namespace {
 constexpr float kCovered = 1e-6f;
 constexpr double kSmallestFree = 0.05;
 
+// A = scale D^T D + diag(extra), applied without assembling D^T D (rebuilding that product cost
+// more than the solve). Its norm is at most scale |D|_1 |D|_inf (every row and column of D has at
+// most four entries of 1/h) plus the largest extra.
+class FrictionOperator final : public numerics::QpOperator {
+ public:
+  FrictionOperator(const Eigen::SparseMatrix<double>& d, const Eigen::SparseMatrix<double>& dt, double scale,
+                   const Eigen::VectorXd& diagonal, double normBound, Eigen::VectorXd& scratch)
+      : d_(d), dt_(dt), scale_(scale), diagonal_(diagonal), normBound_(normBound), faces_(scratch) {}
+  Eigen::Index size() const override { return d_.cols(); }
+  void apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const override {
+    faces_.noalias() = d_ * x;
+    y.noalias() = dt_ * faces_;
+    y *= scale_;
+    for (Eigen::Index k = 0; k < y.size(); ++k)
+      if (decoupled(k)) y[k] = diagonal_[k] * x[k];
+  }
+  void diagonal(Eigen::VectorXd& d) const override { d = diagonal_; }
+  double normUpperBound() const override { return normBound_; }
+
+ private:
+  // Columns no open face sees carry only their placeholder diagonal.
+  bool decoupled(Eigen::Index k) const { return dt_.outerIndexPtr()[k + 1] == dt_.outerIndexPtr()[k]; }
+  const Eigen::SparseMatrix<double>& d_;
+  const Eigen::SparseMatrix<double>& dt_;
+  double scale_;
+  const Eigen::VectorXd& diagonal_;
+  double normBound_;
+  Eigen::VectorXd& faces_;
+};
+
 }  // namespace
 
 StressGrid::StressGrid(const GridSpec<2>& grid)
@@ -105,7 +135,11 @@ void StressGrid::splat(std::span<const Vec2f> positions, std::span<const Vec2f> 
   for (int j = 0; j <= ny_; ++j)
     for (int i = 0; i < nx_; ++i)
       active_[xFaces + static_cast<std::size_t>(i + nx_ * j)] = j > 0 && j < ny_ && open(i, j - 1) && open(i, j);
-  buildDivergence();
+  // D follows the open faces, which change only where obstacles move.
+  if (active_ != builtFor_) {
+    buildDivergence();
+    builtFor_ = active_;
+  }
 }
 
 void StressGrid::discomfortGradient(const StressLaws& laws, MacGrid<2>& gradient) const {
@@ -157,6 +191,7 @@ void StressGrid::buildDivergence() {
     }
   divergence_.resize(static_cast<Eigen::Index>(active_.size()), static_cast<Eigen::Index>(cells + (nx_ + 1) * (ny_ + 1)));
   divergence_.setFromTriplets(entries.begin(), entries.end());
+  divergenceT_ = divergence_.transpose();
 }
 
 double StressGrid::cellDensity(int i, int j) const { return density_(IVec<2>(i, j)); }
@@ -187,19 +222,18 @@ FrictionResult StressGrid::friction(const Eigen::VectorXd& momentum, double dt, 
   lower_ = -upper_;
   // 1/2 s^T A s - b^T s with A = dt^2 / rho_y D^T D and b = -dt / rho_y D^T m*: E(s) - E(0).
   const double scale = dt * dt / laws.yield;
-  system_ = scale * (divergence_.transpose() * divergence_);
   // Unknowns no open face sees (inside walls) get the largest diagonal, as in setDecoupledDiagonals:
-  // their bounds or zero right-hand side hold them at 0 without shortening MPRGP's steps.
-  double largest = 0.0;
-  for (Eigen::Index k = 0; k < unknowns; ++k) largest = std::max(largest, system_.coeff(k, k));
-  if (!(largest > 0.0)) largest = 1.0;
+  // their bounds or zero right-hand side hold them at 0 without shortening MPRGP's steps. D^T D's
+  // diagonal is the squared norm of D's columns.
+  diagonal_ = scale * (divergenceT_.cwiseAbs2() * Eigen::VectorXd::Ones(divergence_.rows()));
+  const double largest = diagonal_.size() > 0 && diagonal_.maxCoeff() > 0.0 ? diagonal_.maxCoeff() : 1.0;
   for (Eigen::Index k = 0; k < unknowns; ++k)
-    if (!(system_.coeff(k, k) > 0.0)) system_.coeffRef(k, k) = largest;
-  system_.makeCompressed();
-  rhs_ = -(dt / laws.yield) * (divergence_.transpose() * momentum);
+    if (!(diagonal_[k] > 0.0)) diagonal_[k] = largest;
+  const double h = grid_.dx;
+  const FrictionOperator op(divergence_, divergenceT_, scale, diagonal_, std::max(16.0 * scale / (h * h), largest), faces_);
+  rhs_ = -(dt / laws.yield) * (divergenceT_ * momentum);
   if (stress_.size() != unknowns) stress_ = Eigen::VectorXd::Zero(unknowns);
   stress_ = stress_.cwiseMax(lower_).cwiseMin(upper_);
-  const numerics::SparseQpOperator op(system_);
   FrictionResult result;
   result.qp = solver_.solve(op, rhs_, lower_, upper_, stress_, settings);
   change = dt * (divergence_ * stress_);

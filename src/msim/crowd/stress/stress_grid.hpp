@@ -73,10 +73,10 @@ class StressGrid {
   Grid<float, 2> sumX_, sumY_, collisionFreeX_, collisionFreeY_;
   std::vector<float> ones_, vx_, vy_, cx_, cy_;
   Splatter<2> splatter_;
-  std::vector<std::uint8_t> active_;
-  Eigen::SparseMatrix<double> divergence_;  // D: faces x stress unknowns (rows of inactive faces empty)
-  Eigen::SparseMatrix<double> system_;      // dt^2 / rho_yield D^T D (+ a tiny diagonal)
-  Eigen::VectorXd stress_, lower_, upper_, rhs_;
+  std::vector<std::uint8_t> active_, builtFor_;
+  Eigen::SparseMatrix<double> divergence_;   // D: faces x stress unknowns (rows of inactive faces empty)
+  Eigen::SparseMatrix<double> divergenceT_;  // D^T
+  Eigen::VectorXd stress_, lower_, upper_, rhs_, diagonal_, faces_;
   numerics::BoundQpSolver solver_;
 };
 

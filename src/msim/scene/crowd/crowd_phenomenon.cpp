@@ -13,6 +13,7 @@
 #include "msim/crowd/metric_plots.hpp"
 #include "msim/crowd/metrics_json.hpp"
 #include "msim/crowd/metrics.hpp"
+#include "msim/crowd/stress/crowd_pressure.hpp"
 #include "msim/crowd/voronoi_density.hpp"
 #include "msim/io/atomic_file.hpp"
 #include "msim/io/csv.hpp"
@@ -64,6 +65,14 @@ class CrowdPhenomenon final : public Phenomenon {
     ++stepsThisFrame_;
     uicIterations_ += sim_->lastStep().uic.innerIterations + sim_->lastStep().uic.outerIterations;
     uicSolveSeconds_ += sim_->lastStep().uic.solveSeconds;
+    const crowd::stress::StressStepStats& st = sim_->lastStep().stress;
+    stressSolves_ += st.solves;
+    stressIterations_ += st.iterations;
+    if (st.unconverged > 0 && stressUnconverged_ == 0)
+      logger().warn("{}: crowd stress: the friction solve did not converge at step {} (t = {:.4g} s; counted in "
+                    "run.json results.stress)", source_, steps_ + 1, sim_->time());
+    stressUnconverged_ += st.unconverged;
+    ++steps_;
     const crowd::LookaheadStepStats& la = sim_->lastStep().lookahead;
     lookaheadSolves_ += la.solves;
     lookaheadIterations_ += la.iterations;
@@ -201,6 +210,11 @@ class CrowdPhenomenon final : public Phenomenon {
       plan.valueMax = rhoMax();
       discs.values.assign(agentDensity_.begin(), agentDensity_.end());
       discs.values.resize(a.size(), 0.0);
+    } else if (setup_.colourBy == "pressure") {
+      // Helbing's crowd pressure at each agent's cell, yellow from twice the turbulent 0.02 /s^2.
+      plan.valueMax = 2.0 * kTurbulentPressure;
+      for (std::size_t i = 0; i < a.size(); ++i)
+        discs.values.push_back(pressure_.count() > 0 ? pressure_[pressure_.spec().clampedCellIndex(a.position[i])] : 0.0);
     } else {
       plan.valueMax = std::max(1.0, static_cast<double>(groupCount() - 1));
       for (std::size_t i = 0; i < a.size(); ++i) discs.values.push_back(a.group[i]);
@@ -240,7 +254,10 @@ class CrowdPhenomenon final : public Phenomenon {
               // The continuum lookahead's ascent (eq. 3.2; the seed: fewer than 10 iterations on
               // average) and the hybrid's mean blend weight w (eq. 3.11; 0 all discrete, 1 all continuum).
               {"lookahead_iterations_per_solve", iterationsPerSolve_},
-              {"lookahead_blend_weight", meanBlendWeight_}};
+              {"lookahead_blend_weight", meanBlendWeight_},
+              // Helbing's crowd pressure rho Var(v) over 3 x 3 cells (Golas eq. 4.13): turbulent above 0.02 /s^2.
+              {"pressure_max_per_s2", pressureMax_},
+              {"pressure_cells_over_turbulent", pressureCellsOver_}};
     for (std::size_t k = 0; k < setup_.lines.size(); ++k)
       s["line_" + setup_.lines[k].name + "_crossings"] = lineCrossings_[k];
     return s;
@@ -304,6 +321,10 @@ class CrowdPhenomenon final : public Phenomenon {
           break;
         }
     results["completion"] = completion;
+    if (setup_.settings.stress)
+      results["stress"] = {{"friction_solves", stressSolves_},
+                           {"iterations_per_solve", stressSolves_ > 0 ? double(stressIterations_) / double(stressSolves_) : 0.0},
+                           {"unconverged_solves", stressUnconverged_}};
     json flows = json::object();
     const double duration = frames.back().at("time_s").get<double>();
     for (const auto& l : setup_.lines) {
@@ -369,6 +390,14 @@ class CrowdPhenomenon final : public Phenomenon {
     ScopedStage stage(timers_, "crowd: metrics");
     const crowd::Agents& a = sim_->agents();
     speed_ = crowd::speedStats(a.velocity);
+    if (!(pressure_.spec() == setup_.settings.grid)) pressure_ = Grid<float, 2>(setup_.settings.grid);
+    crowd::stress::spatialPressure(a.position, a.velocity, 1, pressure_);
+    pressureMax_ = 0.0;
+    pressureCellsOver_ = 0;
+    for (std::size_t c = 0; c < pressure_.count(); ++c) {
+      pressureMax_ = std::max(pressureMax_, double(pressure_[c]));
+      pressureCellsOver_ += pressure_[c] > kTurbulentPressure;
+    }
     checkStall();
     agentDensity_.clear();
     nn_ = crowd::NearestNeighbourFrame{};
@@ -491,6 +520,11 @@ class CrowdPhenomenon final : public Phenomenon {
   double uicSolveSeconds_ = 0.0;  // QP solve time of those steps (Fig. 4.10)
   double iterationsPerStep_ = 0.0;  // of the last complete frame
   double solveMsPerStep_ = 0.0;     // of the last complete frame
+  static constexpr double kTurbulentPressure = 0.02;  // [1/s^2] (Helbing et al. 2007)
+  Grid<float, 2> pressure_;
+  double pressureMax_ = 0.0;
+  long pressureCellsOver_ = 0;
+  long steps_ = 0, stressSolves_ = 0, stressIterations_ = 0, stressUnconverged_ = 0;
   std::size_t lookaheadSolves_ = 0, lookaheadIterations_ = 0;  // of the frame being simulated
   double blendWeightSum_ = 0.0;                                 // the steps' mean weights summed
   double iterationsPerSolve_ = 0.0, meanBlendWeight_ = 0.0;     // of the last complete frame

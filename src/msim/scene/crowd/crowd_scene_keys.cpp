@@ -146,6 +146,26 @@ Schema crowdKeys() {
       .min(0.0);
   ahead.field("blend", blend);
   c.field("lookahead", ahead);
+  Schema turbulence = Schema::object("inter-personal stress in extreme densities (Golas ch. 4, docs/crowd.md#stress)");
+  turbulence.boolean("enabled", false,
+                     "UIC agents move by eqs. 4.6-4.7 (navigation, discomfort and friction) instead of the UIC projection");
+  turbulence.number("critical_density", "1/m^2", 3.5, "rho_crit: no stress below").min(0.0, Bound::Exclusive);
+  turbulence.number("yield_density", "1/m^2", 5.5, "rho_yield: the discomfort's plateau and full friction (more than critical_density)")
+      .min(0.0, Bound::Exclusive);
+  turbulence.number("c1", "", 13.33, "eq. 4.10's scale").min(0.0, Bound::Exclusive);
+  turbulence.number("c2", "", 1.5, "eq. 4.10's offset");
+  turbulence.number("epsilon", "1/m^2", 0.01, "eq. 4.10's guard at the yield density").min(0.0, Bound::Exclusive);
+  turbulence.string("lower_branch", "continuous",
+                    "g below the critical density: continuous (the middle branch's value there) or literal (0, with "
+                    "the printed constants' jump)")
+      .choices({"continuous", "literal"});
+  turbulence.number("friction", "", 0.75, "alpha above the yield density (0: discomfort only, Fig. 4.10's control)")
+      .min(0.0)
+      .max(1.0);
+  turbulence.number("relaxation", "s", 0.5, "tau: how fast agents take their collision-free velocity (eq. 4.3)")
+      .min(0.0, Bound::Exclusive);
+  turbulence.number("max_acceleration", "m/s^2", 3.0, "a_max of eq. 4.7").min(0.0, Bound::Exclusive);
+  c.field("turbulence", turbulence);
   Schema planner = Schema::object("global planning (ch. 4.3.1)");
   planner.string("type", "auto",
                  "auto: direct without obstacles, else navigation_field; roadmap: the seed's CDT roadmap (in builds "
@@ -157,7 +177,9 @@ Schema crowdKeys() {
   c.number("grid_cfl", "", 0.5, "grid cells the fastest agent may cross in one step (eq. 4.14 is first order)")
       .min(0.0, Bound::Exclusive);
   c.integer("seed", 1, "random placement of agents (groups, inflows)").min(0);
-  c.string("colour_by", "speed", "colour of the agents in the pictures").choices({"speed", "density", "group"});
+  c.string("colour_by", "speed",
+           "colour of the agents in the pictures (pressure: Helbing's rho Var(v) over 3 x 3 cells, yellow from 0.04 /s^2)")
+      .choices({"speed", "density", "group", "pressure"});
   c.boolean("trajectories", true, "write trajectories.csv (frame,id,x,y,vx,vy,inconsistency)");
   c.number("dense_fraction", "", 0.8, "'densest regions' of the nearest-neighbour metric: density >= this x rho_max")
       .min(0.0)
@@ -342,6 +364,23 @@ struct Builder {
     if (!(t.disorderedFrom > t.uniformBelow))
       fail("crowd.lookahead.blend.variance_high", fmt::format("= {} must be more than crowd.lookahead.blend.variance_low = {} "
                                                               "(eq. 3.13 blends between them)", t.disorderedFrom, t.uniformBelow));
+    const json& tu = c.at("turbulence");
+    if (tu.at("enabled").get<bool>()) {
+      crowd::stress::StressSettings st;
+      st.laws.critical = tu.at("critical_density").get<double>();
+      st.laws.yield = tu.at("yield_density").get<double>();
+      if (!(st.laws.yield > st.laws.critical))
+        fail("crowd.turbulence.yield_density", fmt::format("= {} must be more than crowd.turbulence.critical_density = {}",
+                                                           st.laws.yield, st.laws.critical));
+      st.laws.c1 = tu.at("c1").get<double>();
+      st.laws.c2 = tu.at("c2").get<double>();
+      st.laws.epsilon = tu.at("epsilon").get<double>();
+      st.laws.continuousLowerBranch = tu.at("lower_branch").get<std::string>() == "continuous";
+      st.laws.frictionMax = tu.at("friction").get<double>();
+      st.relaxation = tu.at("relaxation").get<double>();
+      st.maxAcceleration = tu.at("max_acceleration").get<double>();
+      out.settings.stress = st;
+    }
     out.settings.seed = c.at("seed").get<std::uint64_t>();
     out.maxStep = c.at("max_step").get<double>();
     out.gridCfl = c.at("grid_cfl").get<double>();

@@ -1,0 +1,54 @@
+// The crowd stress model end to end (Golas ch. 4) on scenes/crowd_stress_merge.json: the merge
+// packs past the critical density, every friction solve converges, the crowd pressure is measured
+// per frame; bad settings exit 2 naming their key.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_harness.hpp"
+
+namespace {
+
+using nlohmann::json;
+
+const std::string kScene = std::string(MSIM_SOURCE_DIR) + "/scenes/crowd_stress_merge.json";
+
+}  // namespace
+
+TEST(CrowdStressCli, MergePacksPastTheCriticalDensityAndEverySolveConverges) {
+  const fs::path dir = scratch("stress_merge");
+  const Result r = runMsim("run " + kScene + " -q --out " + (dir / "out").string() +
+                           " --set time.duration=40 --set outputs.png=false --set outputs.mp4=false --set outputs.vdb=false");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  const json run = readJson(dir / "out" / "run.json");
+  const json& stress = run.at("results").at("stress");
+  EXPECT_GT(stress.at("friction_solves").get<long>(), 0);
+  EXPECT_EQ(stress.at("unconverged_solves").get<long>(), 0);
+  double densest = 0.0;
+  for (const json& f : run.at("frames")) {
+    densest = std::max(densest, f.at("max_density_per_m2").get<double>());
+    EXPECT_GE(f.at("pressure_max_per_s2").get<double>(), 0.0);
+  }
+  EXPECT_GT(densest, 3.5);  // the stress model's regime
+  EXPECT_GT(run.at("frames").back().at("agents").get<int>(), 500);
+}
+
+TEST(CrowdStressCli, BadSettingsNameTheirKey) {
+  // Densities in the wrong order, friction outside [0, 1]: exit 2 naming the key, no frames.
+  std::string scene;
+  {
+    std::ifstream in(kScene);
+    scene.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  const std::string turbulence = R"("turbulence": {"enabled": true})";
+  ASSERT_NE(scene.find(turbulence), std::string::npos);
+  expectInputError("stress_densities",
+                   replaced(scene, turbulence, R"("turbulence": {"enabled": true, "critical_density": 6})"),
+                   {"crowd.turbulence.yield_density", "critical_density"});
+  expectInputError("stress_friction", replaced(scene, turbulence, R"("turbulence": {"enabled": true, "friction": 1.5})"),
+                   {"crowd.turbulence.friction"});
+}
