@@ -35,6 +35,9 @@ TEST(LookaheadHorizons, EveryDistanceInRangeFallsInExactlyOneBand) {
   const double end = s.neighbourDist + 2.0 * s.maxSpeed * s.horizon(s.levels);
   std::mt19937 random(3);
   std::uniform_real_distribution<double> distance(0.0, end + 5.0);
+  DiscreteLookahead tabulated;
+  tabulated.schedule = s;
+  tabulated.tabulate();
   for (int k = 0; k < 20000; ++k) {
     const double d = k < 10 ? s.bandStart(k % 9) : distance(random);  // band edges included
     int holding = 0, holder = -1;
@@ -48,6 +51,10 @@ TEST(LookaheadHorizons, EveryDistanceInRangeFallsInExactlyOneBand) {
     }
     EXPECT_EQ(holding, d < end ? 1 : 0) << d;
     EXPECT_EQ(s.levelOfDistance(d), holder) << d;
+    // The traversal's tabulated squares agree away from float rounding at the band edges.
+    bool nearEdge = false;
+    for (int i = 1; i <= s.levels + 1; ++i) nearEdge = nearEdge || std::abs(d - s.bandStart(i)) < 1e-3;
+    if (!nearEdge) EXPECT_EQ(tabulated.levelOfSquaredDistance(static_cast<float>(d * d)), holder) << d;
     for (int i = 0; i < holder; ++i)
       EXPECT_GE(d - 2.0 * s.maxSpeed * s.horizon(i), s.neighbourDist - 1e-12) << d << " level " << i;
   }

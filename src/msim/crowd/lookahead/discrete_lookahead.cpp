@@ -9,12 +9,12 @@ namespace msim::crowd::lookahead {
 
 namespace {
 
-// Nearest and farthest distances from x to the points of a box.
-float nearestInBox(const Vec2f& x, const Vec2f& lo, const Vec2f& hi) {
-  return (lo - x).cwiseMax(x - hi).cwiseMax(0.0f).norm();
+// Squared nearest and farthest distances from x to the points of a box.
+float nearestInBox2(const Vec2f& x, const Vec2f& lo, const Vec2f& hi) {
+  return (lo - x).cwiseMax(x - hi).cwiseMax(0.0f).squaredNorm();
 }
-float farthestInBox(const Vec2f& x, const Vec2f& lo, const Vec2f& hi) {
-  return (x - lo).cwiseAbs().cwiseMax((hi - x).cwiseAbs()).norm();
+float farthestInBox2(const Vec2f& x, const Vec2f& lo, const Vec2f& hi) {
+  return (x - lo).cwiseAbs().cwiseMax((hi - x).cwiseAbs()).squaredNorm();
 }
 
 }  // namespace
@@ -24,12 +24,13 @@ void DiscreteLookahead::tabulate() {
   for (int i = 0; i <= schedule.levels + 1; ++i) {
     horizon[static_cast<std::size_t>(i)] = static_cast<float>(schedule.horizon(i));
     bandStart[static_cast<std::size_t>(i)] = static_cast<float>(schedule.bandStart(i));
+    bandStart2[static_cast<std::size_t>(i)] = static_cast<float>(schedule.bandStart(i) * schedule.bandStart(i));
     shrink[static_cast<std::size_t>(i)] = static_cast<float>(schedule.effectiveRadius(1.0, i));
   }
 }
 
-int DiscreteLookahead::levelOfDistance(float distance) const {
-  return levelInBands(distance, schedule.levels, [this](int i) { return bandStart[static_cast<std::size_t>(i)]; });
+int DiscreteLookahead::levelOfSquaredDistance(float distance2) const {
+  return levelInBands(distance2, schedule.levels, [this](int i) { return bandStart2[static_cast<std::size_t>(i)]; });
 }
 
 void appendLookaheadPlanes(const DiscreteLookahead& l, std::uint32_t self, const Vec2f& x, const Vec2f& v, float r,
@@ -37,7 +38,7 @@ void appendLookaheadPlanes(const DiscreteLookahead& l, std::uint32_t self, const
   const HorizonSchedule& s = l.schedule;
   const int depth = std::min<int>(l.depth[self], s.levels);
   if (depth <= 0 || l.tree.empty()) return;
-  const float reach = l.bandStart[static_cast<std::size_t>(depth) + 1], near = l.bandStart[1];
+  const float reach2 = l.bandStart2[static_cast<std::size_t>(depth) + 1], near2 = l.bandStart2[1];
   // Constraint against a blocker at position xc moving at vc, of radius rc, seen at `level`.
   const auto avoid = [&](const Vec2f& xc, const Vec2f& vc, float rc, int level) {
     const float horizon = l.horizon[static_cast<std::size_t>(level)];
@@ -50,16 +51,16 @@ void appendLookaheadPlanes(const DiscreteLookahead& l, std::uint32_t self, const
   stack[top++] = 0;
   while (top > 0) {
     const AgentTree::Node& n = l.tree.node(stack[--top]);
-    const float nearest = nearestInBox(x, n.lo, n.hi);
-    if (nearest >= reach || farthestInBox(x, n.lo, n.hi) < near) continue;  // beyond every band, or all at level 0
+    const float nearest2 = nearestInBox2(x, n.lo, n.hi);
+    if (nearest2 >= reach2 || farthestInBox2(x, n.lo, n.hi) < near2) continue;  // beyond every band, or all at level 0
     if (n.left < 0) {
       const std::uint32_t j = l.tree.agents()[n.first];
       if (j == self) continue;
-      const int level = l.levelOfDistance((l.positions[j] - x).norm());
+      const int level = l.levelOfSquaredDistance((l.positions[j] - x).squaredNorm());
       if (level >= 1 && level <= depth) avoid(l.positions[j], l.velocities[j], l.radii[j] * l.shrink[static_cast<std::size_t>(level)], level);
       continue;
     }
-    const int level = l.levelOfDistance(nearest);
+    const int level = l.levelOfSquaredDistance(nearest2);
     const bool containsSelf = x.x() >= n.lo.x() && x.x() <= n.hi.x() && x.y() >= n.lo.y() && x.y() <= n.hi.y();
     if (level >= 1 && level <= depth && !containsSelf && n.count <= (1u << (level - 1))) {
       const float horizon = l.horizon[static_cast<std::size_t>(level)];

@@ -27,10 +27,11 @@ struct DiscreteLookahead {
   // horizon dt_i, band start and radius factor 1 / c^i (levels <= kMaxLevels).
   static constexpr int kMaxLevels = 16;
   HorizonSchedule schedule;
-  std::array<float, kMaxLevels + 2> horizon{}, bandStart{}, shrink{};
+  std::array<float, kMaxLevels + 2> horizon{}, bandStart{}, bandStart2{}, shrink{};  // bandStart2: squared
   void tabulate();
-  // The level whose band holds `distance` (0 within R; tabulated levelOfDistance), -1 beyond.
-  int levelOfDistance(float distance) const;
+  // The level whose band holds a distance, given squared (0 within R; HorizonSchedule's
+  // levelOfDistance tabulated; the traversal compares squares, without square roots), -1 beyond.
+  int levelOfSquaredDistance(float distance2) const;
 
   AgentTree tree;  // over `positions`
   std::span<const Vec2f> positions, velocities;
