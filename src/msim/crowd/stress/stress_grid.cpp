@@ -33,8 +33,9 @@ class FrictionOperator final : public numerics::QpOperator {
   double normUpperBound() const override { return normBound_; }
 
  private:
-  // Columns no open face sees carry only their placeholder diagonal.
-  bool decoupled(Eigen::Index k) const { return dt_.outerIndexPtr()[k + 1] == dt_.outerIndexPtr()[k]; }
+  // Unknowns no open face sees (D's column k empty; D is column-major) carry only their
+  // placeholder diagonal.
+  bool decoupled(Eigen::Index k) const { return d_.outerIndexPtr()[k + 1] == d_.outerIndexPtr()[k]; }
   const Eigen::SparseMatrix<double>& d_;
   const Eigen::SparseMatrix<double>& dt_;
   double scale_;
@@ -240,6 +241,11 @@ FrictionResult StressGrid::friction(const Eigen::VectorXd& momentum, double dt, 
   result.energyBefore = momentum.squaredNorm() / (2.0 * laws.yield);
   result.energyAfter = (momentum + change).squaredNorm() / (2.0 * laws.yield);
   return result;
+}
+
+double StressGrid::energy(const Eigen::VectorXd& momentum, const Eigen::VectorXd& stress, double dt,
+                          const StressLaws& laws) const {
+  return (momentum + dt * (divergence_ * stress)).squaredNorm() / (2.0 * laws.yield);
 }
 
 }  // namespace msim::crowd::stress

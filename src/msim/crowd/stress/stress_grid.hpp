@@ -59,6 +59,8 @@ class StressGrid {
   // the faces (`change`, faceCount() entries).
   FrictionResult friction(const Eigen::VectorXd& momentum, double dt, const StressLaws& laws,
                           const numerics::BoundQpSettings& settings, Eigen::VectorXd& change);
+  // E(s) of eq. 4.12 for the face momenta m* and any stress s (as stress()), dt and rho_yield.
+  double energy(const Eigen::VectorXd& momentum, const Eigen::VectorXd& stress, double dt, const StressLaws& laws) const;
   // The last solve's stress: s_d per cell (x fastest), then s_o per corner ((nx + 1) (ny + 1)).
   const Eigen::VectorXd& stress() const { return stress_; }
   const Eigen::VectorXd& bound() const { return upper_; }  // b per stress unknown
