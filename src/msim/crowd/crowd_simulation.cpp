@@ -409,17 +409,10 @@ void CrowdSimulation::moveUic(double dt) {
   const bool allUic = stats_.uicAgents == agents_.size();
   if (!allUic) {
     splitContinuumAgents();
-    const std::size_t n = uicIndex_.size();
-    uicPosition_.resize(n);
-    uicPreferred_.resize(n);
-    uicSpeed_.resize(n);
-    uicVelocity_.resize(n);
-    parallelFor(0, n, [&](std::size_t k) {
-      const std::size_t i = uicIndex_[k];
-      uicPosition_[k] = agents_.position[i];
-      uicPreferred_[k] = agents_.preferredVelocity[i];
-      uicSpeed_[k] = walking[i];
-    });
+    uicVelocity_.resize(uicIndex_.size());
+    gatherContinuum<Vec2f>(agents_.position, uicPosition_);
+    gatherContinuum<Vec2f>(agents_.preferredVelocity, uicPreferred_);
+    gatherContinuum<float>(walking, uicSpeed_);
     position = uicPosition_;
     preferred = uicPreferred_;
     speed = uicSpeed_;
@@ -455,15 +448,9 @@ void CrowdSimulation::moveStressed(double dt) {
   const std::size_t n = uicIndex_.size();
   if (n == 0) return;
   freeArea_.update(discCentres_, discRadii_, movingNow_);
-  uicPosition_.resize(n);
-  uicVelocity_.resize(n);
-  uicPreferred_.resize(n);
-  parallelFor(0, n, [&](std::size_t k) {
-    const std::size_t i = uicIndex_[k];
-    uicPosition_[k] = agents_.position[i];
-    uicVelocity_[k] = agents_.velocity[i];
-    uicPreferred_[k] = continuumVelocity_[i];  // v_cf of prepareLookahead
-  });
+  gatherContinuum<Vec2f>(agents_.position, uicPosition_);
+  gatherContinuum<Vec2f>(agents_.velocity, uicVelocity_);
+  gatherContinuum<Vec2f>(continuumVelocity_, uicPreferred_);  // v_cf of prepareLookahead
   stats_.stress = stress_->step(uicPosition_, uicVelocity_, uicPreferred_, freeArea_.fraction(), dt);
   parallelFor(0, n, [&](std::size_t k) {
     const std::size_t i = uicIndex_[k];

@@ -15,6 +15,7 @@
 #include <optional>
 #include <vector>
 
+#include "msim/core/parallel.hpp"
 #include "msim/core/rng.hpp"
 #include "msim/core/timer.hpp"
 #include "msim/crowd/agents.hpp"
@@ -163,6 +164,12 @@ class CrowdSimulation {
   void walkingSpeeds();
   // The UIC agents' indices into uicIndex_ and the other agents as discs of the continuum.
   void splitContinuumAgents();
+  // to[k] = from[uicIndex_[k]] for every UIC agent (in parallel).
+  template <typename T>
+  void gatherContinuum(std::span<const T> from, std::vector<T>& to) const {
+    to.resize(uicIndex_.size());
+    parallelFor(0, uicIndex_.size(), [&](std::size_t k) { to[k] = from[uicIndex_[k]]; });
+  }
   void moveUic(double dt);
   void moveStressed(double dt);
   void arriveAndSpawn(double dt);
