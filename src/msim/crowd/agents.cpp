@@ -63,26 +63,16 @@ std::size_t Agents::add(const AgentSpec& spec) {
   return position.size() - 1;
 }
 
-namespace {
-template <typename T>
-void compact(std::vector<T>& v, const std::vector<std::uint8_t>& remove) {
-  std::size_t out = 0;
-  for (std::size_t i = 0; i < v.size(); ++i)
-    if (!remove[i]) v[out++] = v[i];
-  v.resize(out);
-}
-}  // namespace
-
 void Agents::removeFlagged(const std::vector<std::uint8_t>& remove) {
-  compact(position, remove);
-  compact(velocity, remove);
-  compact(preferredVelocity, remove);
-  compact(radius, remove);
-  compact(maxSpeed, remove);
-  compact(goal, remove);
-  compact(model, remove);
-  compact(group, remove);
-  compact(id, remove);
+  compactFlagged(position, remove);
+  compactFlagged(velocity, remove);
+  compactFlagged(preferredVelocity, remove);
+  compactFlagged(radius, remove);
+  compactFlagged(maxSpeed, remove);
+  compactFlagged(goal, remove);
+  compactFlagged(model, remove);
+  compactFlagged(group, remove);
+  compactFlagged(id, remove);
 }
 
 AgentSpec Agents::spec(std::size_t i) const {

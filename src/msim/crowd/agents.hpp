@@ -35,6 +35,16 @@ struct AgentSpec {
 // their ids in this order; it lasts as long as neighbours stay neighbours.
 void sortSpatially(std::vector<Vec2>& points);
 
+// Drops the entries of `v` flagged in `remove` (one flag per agent; entries past its end are
+// kept), keeping the order: per-agent state that must follow Agents::removeFlagged.
+template <typename T>
+void compactFlagged(std::vector<T>& v, const std::vector<std::uint8_t>& remove) {
+  std::size_t out = 0;
+  for (std::size_t i = 0; i < v.size(); ++i)
+    if (i >= remove.size() || !remove[i]) v[out++] = v[i];
+  v.resize(out);
+}
+
 class Agents {
  public:
   std::size_t size() const { return position.size(); }

@@ -249,8 +249,7 @@ void CrowdSimulation::prepareLookahead(double dt) {
   // have none until the next refresh).
   farDirection_.resize(n, Vec2f::Zero());
   lookahead::AgentLookahead::Needs needs;
-  needs.tree = orca && la.method != LookaheadMethod::Continuum;
-  needs.tree = needs.tree && la.enabled();
+  needs.tree = la.enabled() && orca && la.method != LookaheadMethod::Continuum;
   // Level 0 (the crowd now): the hybrid's weights and the continuum's last word for ORCA agents,
   // and the stress model's collision-free velocities (Golas ch. 4.3.3: Chapter 3's continuum).
   const bool stressed = stress_ && stats_.uicAgents > 0;
@@ -296,22 +295,16 @@ void CrowdSimulation::prepareLookahead(double dt) {
     const Vec2f suggested = farDirection_[i].squaredNorm() > 0.0f ? Vec2f(wanted * farDirection_[i]) : preferred;
     if (model == AgentModel::Uic && !stressed) {
       agents_.preferredVelocity[i] = suggested;  // the UIC decides at level 0
-    } else if (model == AgentModel::Uic) {
-      // The stress model walks towards level 0's collision-free velocity f(rho) v* (eq. 4.9).
-      const lookahead::CascadeResult r = lookahead::continuumLookahead(future, la.continuum, x, agents_.velocity[i],
-                                                                       suggested, agents_.maxSpeed[i], 0, 0);
-      iterations += r.iterations;
-      solves += r.solves;
-      continuumVelocity_[i] = r.velocity.cast<float>();
     } else {
-      if (la.method == LookaheadMethod::Hybrid) {
+      if (model == AgentModel::Orca && la.method == LookaheadMethod::Hybrid) {
         const lookahead::FutureDensity::Flow flow = future.flow(x.cast<double>());
         const double w = lookahead::blendWeight(flow.density, flow.speedDeviation, flow.meanVelocity.norm(), la.blend);
         blendWeight_[i] = static_cast<float>(w);
         skipOrca_[i] = w >= 1.0;
       }
-      if (la.method == LookaheadMethod::Continuum || blendWeight_[i] > 0.0f) {
-        // Level 0: eq. 3.2 on the crowd now, towards the far levels' suggestion.
+      // Level 0: eq. 3.2 on the crowd now, towards the far levels' suggestion: the stress model's
+      // collision-free velocity f(rho) v* (eq. 4.9), or the ORCA agent's continuum answer.
+      if (model == AgentModel::Uic || la.method == LookaheadMethod::Continuum || blendWeight_[i] > 0.0f) {
         const lookahead::CascadeResult r = lookahead::continuumLookahead(future, la.continuum, x, agents_.velocity[i],
                                                                          suggested, agents_.maxSpeed[i], 0, 0);
         iterations += r.iterations;
@@ -494,12 +487,7 @@ void CrowdSimulation::arriveAndSpawn(double dt) {
       if (remove_[i]) exits_.push_back(ExitEvent{agents_.id[i], agents_.goal[i], time_});
     agents_.removeFlagged(remove_);
     lookahead_.removeFlagged(remove_);
-    if (!farDirection_.empty()) {
-      std::size_t kept = 0;
-      for (std::size_t i = 0; i < farDirection_.size(); ++i)
-        if (i >= remove_.size() || remove_[i] == 0) farDirection_[kept++] = farDirection_[i];
-      farDirection_.resize(kept);
-    }
+    compactFlagged(farDirection_, remove_);
   }
   stats_.exited = exited;
 

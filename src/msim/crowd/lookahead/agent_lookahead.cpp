@@ -38,14 +38,8 @@ void AgentLookahead::resize(std::size_t agents) {
 }
 
 void AgentLookahead::removeFlagged(const std::vector<std::uint8_t>& remove) {
-  std::size_t kept = 0;
-  for (std::size_t i = 0; i < moments_.size(); ++i)
-    if (i >= remove.size() || remove[i] == 0) {
-      moments_[kept] = moments_[i];
-      walked_[kept++] = walked_[i];
-    }
-  moments_.resize(kept);
-  walked_.resize(kept);
+  compactFlagged(moments_, remove);
+  compactFlagged(walked_, remove);
 }
 
 void AgentLookahead::record(std::span<const Vec2f> previous, std::span<const Vec2f> current, double dt) {

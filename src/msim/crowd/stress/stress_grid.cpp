@@ -94,7 +94,8 @@ void StressGrid::splat(std::span<const Vec2f> positions, std::span<const Vec2f> 
                            TransferKernel::Linear);
   }
   const double area = grid_.dx * grid_.dx;
-  std::vector<std::uint8_t> known(count_.count(), 0);
+  std::vector<std::uint8_t>& known = known_;
+  known.assign(count_.count(), 0);
   for (std::size_t c = 0; c < count_.count(); ++c) {
     const float f = free[c];
     covered_[c] = f <= kCovered ? 1.0f : 0.0f;
@@ -108,7 +109,8 @@ void StressGrid::splat(std::span<const Vec2f> positions, std::span<const Vec2f> 
   }
   // Covered cells take the density of the nearest uncovered one, layer by layer outwards (each
   // layer reads the layers before it only; ties go to the first of -x, +x, -y, +y).
-  std::vector<std::uint8_t> next = known;
+  std::vector<std::uint8_t>& next = nextKnown_;
+  next = known;
   for (bool grew = true; grew;) {
     grew = false;
     for (int j = 0; j < ny_; ++j)
@@ -193,9 +195,9 @@ void StressGrid::buildDivergence() {
   divergence_.resize(static_cast<Eigen::Index>(active_.size()), static_cast<Eigen::Index>(cells + (nx_ + 1) * (ny_ + 1)));
   divergence_.setFromTriplets(entries.begin(), entries.end());
   divergenceT_ = divergence_.transpose();
+  // D^T D's diagonal: the squared norms of D's columns.
+  columnNorms_ = divergenceT_.cwiseAbs2() * Eigen::VectorXd::Ones(divergence_.rows());
 }
-
-double StressGrid::cellDensity(int i, int j) const { return density_(IVec<2>(i, j)); }
 
 FrictionResult StressGrid::friction(const Eigen::VectorXd& momentum, double dt, const StressLaws& laws,
                                     const numerics::BoundQpSettings& settings, Eigen::VectorXd& change) {
@@ -205,7 +207,7 @@ FrictionResult StressGrid::friction(const Eigen::VectorXd& momentum, double dt, 
   // The bounds: each cell's density for s_d, the mean of the open cells around a corner for s_o.
   upper_.resize(unknowns);
   for (int j = 0; j < ny_; ++j)
-    for (int i = 0; i < nx_; ++i) upper_[i + nx_ * j] = frictionBound(cellDensity(i, j), laws);
+    for (int i = 0; i < nx_; ++i) upper_[i + nx_ * j] = frictionBound(density_(IVec<2>(i, j)), laws);
   const Eigen::Index cells = nx_ * ny_;
   for (int j = 0; j <= ny_; ++j)
     for (int i = 0; i <= nx_; ++i) {
@@ -224,9 +226,8 @@ FrictionResult StressGrid::friction(const Eigen::VectorXd& momentum, double dt, 
   // 1/2 s^T A s - b^T s with A = dt^2 / rho_y D^T D and b = -dt / rho_y D^T m*: E(s) - E(0).
   const double scale = dt * dt / laws.yield;
   // Unknowns no open face sees (inside walls) get the largest diagonal, as in setDecoupledDiagonals:
-  // their bounds or zero right-hand side hold them at 0 without shortening MPRGP's steps. D^T D's
-  // diagonal is the squared norm of D's columns.
-  diagonal_ = scale * (divergenceT_.cwiseAbs2() * Eigen::VectorXd::Ones(divergence_.rows()));
+  // their bounds or zero right-hand side hold them at 0 without shortening MPRGP's steps.
+  diagonal_ = scale * columnNorms_;
   const double largest = diagonal_.size() > 0 && diagonal_.maxCoeff() > 0.0 ? diagonal_.maxCoeff() : 1.0;
   for (Eigen::Index k = 0; k < unknowns; ++k)
     if (!(diagonal_[k] > 0.0)) diagonal_[k] = largest;

@@ -67,7 +67,6 @@ class StressGrid {
 
  private:
   void buildDivergence();
-  double cellDensity(int i, int j) const;
 
   GridSpec<2> grid_;
   int nx_ = 0, ny_ = 0;
@@ -78,7 +77,9 @@ class StressGrid {
   std::vector<std::uint8_t> active_, builtFor_;
   Eigen::SparseMatrix<double> divergence_;   // D: faces x stress unknowns (rows of inactive faces empty)
   Eigen::SparseMatrix<double> divergenceT_;  // D^T
+  Eigen::VectorXd columnNorms_;               // |column k of D|^2
   Eigen::VectorXd stress_, lower_, upper_, rhs_, diagonal_, faces_;
+  std::vector<std::uint8_t> known_, nextKnown_;  // splat(): cells whose density is set
   numerics::BoundQpSolver solver_;
 };
 
