@@ -8,6 +8,7 @@ packages=(
   build-essential cmake ninja-build pkg-config ccache
   libtbb-dev libeigen3-dev nlohmann-json3-dev libcli11-dev libspdlog-dev libfmt-dev
   libpng-dev libopenexr-dev libopenvdb-dev libboost-dev libboost-iostreams-dev libgtest-dev libgmock-dev libbenchmark-dev libkissfft-dev libxxhash-dev
+  libopenmpi-dev openmpi-bin libhypre-dev  # MPI runs (msim/parallel): OpenMPI (BSD) and hypre (Apache-2.0 or MIT)
   ffmpeg
   libopenvdb-tools  # vdb_print: the tests check that OpenVDB's own tools read msim's frames
 )

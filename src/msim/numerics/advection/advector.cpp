@@ -26,8 +26,8 @@ void parallelForBlocks(std::size_t n, F&& f) {
 
 template <typename T, int D>
 Advector<T, D>::Advector(const GridSpec<D>& spec, const AdvectionSettings& settings,
-                         const AxisBoundaries<D>& boundaries)
-    : spec_(spec), settings_(settings), boundaries_(boundaries) {}
+                         const AxisBoundaries<D>& boundaries, const BlockPlacement<D>& placement)
+    : spec_(spec), settings_(settings), boundaries_(boundaries), placement_(placement) {}
 
 template <typename T, int D>
 void Advector<T, D>::setSolid(const Grid<float, D>& mask) {
@@ -114,7 +114,7 @@ const typename Advector<T, D>::FeetCache& Advector<T, D>::feetFor(const Grid<T, 
   f.solidVersion = solidVersion;
   f.touched.assign(solid ? field.count() : 0, 0);
   traceFeet<T, D>(field, boundaries_, velocity_, dt, settings_.trace, solid, f.forward, f.backward,
-                  solid ? f.touched.data() : nullptr);
+                  solid ? f.touched.data() : nullptr, placement_);
   f.valid = true;
   return f;
 }
@@ -137,7 +137,7 @@ void Advector<T, D>::advect(MacGrid<D>& field, const MacGrid<D>& velocity, doubl
 template <typename T, int D>
 void Advector<T, D>::advectComponent(Grid<T, D>& field, double dt, Scratch& s) {
   const AdvectionSettings& cfg = settings_;
-  const FieldLayout<D> layout = FieldLayout<D>::of(field, boundaries_);
+  const FieldLayout<D> layout = FieldLayout<D>::of(field, boundaries_, placement_);
   const std::uint8_t* solid = solidSamples(field, s);
   const bool nearSolidRule = solid && cfg.firstOrderNearSolids;
   const bool semiLagrangian = cfg.block == BuildingBlock::SemiLagrangian;

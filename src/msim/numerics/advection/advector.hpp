@@ -28,8 +28,11 @@ namespace msim::numerics {
 template <typename T, int D>
 class Advector {
  public:
+  // `placement`: where `spec` lies in a domain split among processes (msim/parallel); the
+  // fields' ghost layers must then hold the neighbours' samples a step reads. Default: spec is
+  // the whole domain.
   Advector(const GridSpec<D>& spec, const AdvectionSettings& settings,
-           const AxisBoundaries<D>& boundaries = allClamped<D>());
+           const AxisBoundaries<D>& boundaries = allClamped<D>(), const BlockPlacement<D>& placement = {});
 
   const AdvectionSettings& settings() const { return settings_; }
   void setSettings(const AdvectionSettings& settings) { settings_ = settings; }
@@ -75,6 +78,7 @@ class Advector {
   GridSpec<D> spec_;
   AdvectionSettings settings_;
   AxisBoundaries<D> boundaries_;
+  BlockPlacement<D> placement_;
   std::optional<Grid<float, D>> solid_;
   std::uint64_t solidVersion_ = 0;  // bumped by setSolid
   Scratch scratch_[D + 1];  // slot 0: cell-centred / arbitrary grids, slot 1 + a: face component a

@@ -34,6 +34,18 @@ AxisBoundaries<D> allPeriodic() {
   return b;
 }
 
+// Where a grid lies inside a larger one that is split among processes (msim/parallel): its cell 0
+// is the global grid's cell `cellOrigin`, and the global grid has `globalRes` cells. Advection
+// then works in global sample coordinates, clamping at the global domain's border only, so a
+// block with wide enough ghost layers computes its samples bit for bit as the whole grid would.
+// The default, a grid that is the whole domain, is every serial run.
+template <int D>
+struct BlockPlacement {
+  IVec<D> cellOrigin = IVec<D>::Zero();
+  IVec<D> globalRes = IVec<D>::Zero();  // zero: the grid is the whole domain
+  bool whole() const { return globalRes.isZero(); }
+};
+
 // The 2^D samples a D-linear interpolation reads, with their weights.
 template <int D>
 struct InterpolationStencil {
@@ -50,10 +62,19 @@ struct FieldLayout {
   double dx;
   int period[D];  // samples per period on periodic axes (= spec.res)
   bool periodic[D];
+  int first[D];       // global index of sample 0 (0 unless the grid is a block of a larger one)
+  int globalSize[D];  // samples per axis of the global field (= size unless a block)
 
   template <typename T>
-  static FieldLayout of(const Grid<T, D>& g, const AxisBoundaries<D>& boundaries) {
+  static FieldLayout of(const Grid<T, D>& g, const AxisBoundaries<D>& boundaries,
+                        const BlockPlacement<D>& placement = {}) {
     FieldLayout l;
+    for (int a = 0; a < D; ++a) {
+      // A face grid has one sample more than cells along its axis, locally and globally.
+      const int extra = g.size()[a] - g.spec().res[a];
+      l.first[a] = placement.whole() ? 0 : placement.cellOrigin[a];
+      l.globalSize[a] = placement.whole() ? g.size()[a] : placement.globalRes[a] + extra;
+    }
     l.size = g.size();
     l.origin = g.position(IVec<D>::Zero());
     l.dx = g.spec().dx;

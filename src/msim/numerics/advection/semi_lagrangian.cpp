@@ -62,14 +62,18 @@ void locateChunk(const SampleLattice<D>& L, const T (*s)[kChunk], int m, ChunkSt
         st.base[q] += i0 * stride;
       }
     } else {
-      const T last = T(n - 1);
+      // Positions are global sample coordinates, clamped at the global border; on a block of a
+      // larger grid the local lower corner is the global one less `first`, clamped into the
+      // block (a no-op while its ghost layers cover every stencil).
+      const int globalSize = L.globalSize[a], first = L.first[a];
+      const T last = T(globalSize - 1);
       for (int q = 0; q < m; ++q) {
         T x = std::isfinite(s[a][q]) ? s[a][q] : T(0);
         x = std::clamp(x, T(0), last);
-        const int i0 = std::min(static_cast<int>(x), n - 2);
-        st.t[a][q] = x - T(i0);
+        const int g0 = std::min(static_cast<int>(x), globalSize - 2);
+        st.t[a][q] = x - T(g0);
         st.up[a][q] = step;
-        st.base[q] += i0 * stride;
+        st.base[q] += std::clamp(g0 - first, 0, n - 2) * stride;
       }
     }
   }
@@ -94,8 +98,16 @@ void interpolateChunkScalar(const ChunkStencil<T, D>& st, const V* data, int fir
       hi[q] = *std::max_element(v, v + (1 << D));
     }
     for (int a = 0; a < D; ++a)
-      for (int k = 0; k < (1 << (D - 1 - a)); ++k)
-        v[k] = (T(1) - st.t[a][q]) * v[2 * k] + st.t[a][q] * v[2 * k + 1];
+      for (int k = 0; k < (1 << (D - 1 - a)); ++k) {
+        const T t = st.t[a][q];
+#if defined(__FMA__)
+        // Rounded as the AVX2 path rounds: which samples of a row take this tail depends on where
+        // the row starts, and a block of a split grid must match the whole grid bit for bit.
+        v[k] = std::fma(t, v[2 * k + 1], (T(1) - t) * v[2 * k]);
+#else
+        v[k] = (T(1) - t) * v[2 * k] + t * v[2 * k + 1];
+#endif
+      }
     out[q] = scale * v[0];
   }
 }
@@ -160,11 +172,12 @@ struct Displacement {
   const float* data[D];
   T scale;
 
-  Displacement(const MacGrid<D>& velocity, const AxisBoundaries<D>& boundaries, double dt)
+  Displacement(const MacGrid<D>& velocity, const AxisBoundaries<D>& boundaries, double dt,
+               const BlockPlacement<D>& placement)
       : scale(static_cast<T>(dt / velocity.spec().dx)) {
     for (int a = 0; a < D; ++a) {
       const auto& g = velocity.component(a);
-      lattice[a] = SampleLattice<D>(FieldLayout<D>::of(g, boundaries));
+      lattice[a] = SampleLattice<D>(FieldLayout<D>::of(g, boundaries, placement));
       for (int b = 0; b < D; ++b) offset[a][b] = static_cast<T>(g.offset()[b]);
       data[a] = g.data().data();
     }
@@ -209,9 +222,9 @@ bool readsSolid(const ChunkStencil<T, D>& st, int q, const std::uint8_t* solid) 
 template <typename T, int D>
 void traceFeet(const Grid<T, D>& field, const AxisBoundaries<D>& boundaries, const MacGrid<D>& velocity, double dt,
                BackTrace trace, const std::uint8_t* solid, Feet<T, D>& forward, Feet<T, D>& backward,
-               std::uint8_t* touched) {
-  const SampleLattice<D> lattice(FieldLayout<D>::of(field, boundaries));
-  const Displacement<T, D> displacement(velocity, boundaries, dt);
+               std::uint8_t* touched, const BlockPlacement<D>& placement) {
+  const SampleLattice<D> lattice(FieldLayout<D>::of(field, boundaries, placement));
+  const Displacement<T, D> displacement(velocity, boundaries, dt, placement);
   T offset[D];
   for (int a = 0; a < D; ++a) offset[a] = static_cast<T>(field.offset()[a]);
   forward.resize(field.count());
@@ -232,9 +245,9 @@ void traceFeet(const Grid<T, D>& field, const AxisBoundaries<D>& boundaries, con
       for (int i0 = 0; i0 < size[0]; i0 += kChunk) {
         const int m = std::min(kChunk, size[0] - i0);
         const std::size_t lin = row * static_cast<std::size_t>(size[0]) + i0;
-        for (int q = 0; q < m; ++q) s[0][q] = static_cast<T>(i0 + q);
+        for (int q = 0; q < m; ++q) s[0][q] = static_cast<T>(lattice.first[0] + i0 + q);
         for (int a = 1; a < D; ++a)
-          for (int q = 0; q < m; ++q) s[a][q] = static_cast<T>(coord[a]);
+          for (int q = 0; q < m; ++q) s[a][q] = static_cast<T>(lattice.first[a] + coord[a]);
         for (int a = 0; a < D; ++a)
           for (int q = 0; q < m; ++q) g[a][q] = s[a][q] + offset[a];
         displacement(g, m, u);
@@ -289,7 +302,8 @@ void sampleAtFeet(const SampleLattice<D>& lattice, const Feet<T, D>& feet, const
 
 #define MSIM_INSTANTIATE(T, D)                                                                                    \
   template void traceFeet<T, D>(const Grid<T, D>&, const AxisBoundaries<D>&, const MacGrid<D>&, double, BackTrace, \
-                                const std::uint8_t*, Feet<T, D>&, Feet<T, D>&, std::uint8_t*);                    \
+                                const std::uint8_t*, Feet<T, D>&, Feet<T, D>&, std::uint8_t*,                     \
+                                const BlockPlacement<D>&);                                                         \
   template void sampleAtFeet<T, D>(const SampleLattice<D>&, const Feet<T, D>&, const T*, T*, T*, T*);
 MSIM_INSTANTIATE(float, 2)
 MSIM_INSTANTIATE(float, 3)

@@ -38,6 +38,8 @@ struct SampleLattice {
   int size[D];
   int period[D];
   bool periodic[D];
+  int first[D];       // global index of sample 0 (FieldLayout::first)
+  int globalSize[D];  // global samples per axis: clamping happens at the global border
   std::ptrdiff_t stride[D];
   std::ptrdiff_t step[D];      // lower -> upper corner: stride, 0 on single-sample axes
   std::ptrdiff_t wrapStep[D];  // lower -> upper corner when it wraps: from the last sample to 0
@@ -48,6 +50,8 @@ struct SampleLattice {
       size[a] = layout.size[a];
       period[a] = layout.period[a];
       periodic[a] = layout.periodic[a];
+      first[a] = layout.first[a];
+      globalSize[a] = layout.globalSize[a];
       stride[a] = layout.stride[a];
       step[a] = size[a] < 2 ? 0 : stride[a];
       wrapStep[a] = -static_cast<std::ptrdiff_t>(size[a] - 1) * stride[a];
@@ -56,13 +60,14 @@ struct SampleLattice {
 };
 
 // The feet of the forward (velocity V) and backward (velocity -V) steps of every sample of
-// `field`, in `velocity` over dt. Solid samples (solid[i] != 0) get their own position
+// `field`, in `velocity` over dt. Both grids lie at `placement` in the global domain (the
+// default: they are the domain); positions are traced in global sample coordinates. Solid samples (solid[i] != 0) get their own position
 // as both feet, so interpolating there returns the old value unchanged. If `touched` is given,
 // touched[i] = any corner of either stencil of sample i is solid (Selle ch. 2.9).
 template <typename T, int D>
 void traceFeet(const Grid<T, D>& field, const AxisBoundaries<D>& boundaries, const MacGrid<D>& velocity, double dt,
                BackTrace trace, const std::uint8_t* solid, Feet<T, D>& forward, Feet<T, D>& backward,
-               std::uint8_t* touched);
+               std::uint8_t* touched, const BlockPlacement<D>& placement = {});
 
 // dst[i] = src interpolated at feet[i]; lo/hi (optional) get the range of the corners read.
 template <typename T, int D>

@@ -1,0 +1,29 @@
+#pragma once
+// The MPI environment of a run split over processes: MPI_Init on construction, MPI_Finalize on
+// destruction, and the rules every rank follows (Selle ch. 8: ranks receive what they read, so
+// all writes are local). Input errors are found identically on every rank, so every rank exits
+// with code 2 and only rank 0 prints; an error on some ranks only ends the whole job through
+// MPI_Abort, so no rank waits forever for a message that will not come.
+#include <mpi.h>
+
+#include <string>
+
+namespace msim::parallel {
+
+class MpiSession {
+ public:
+  MpiSession(int& argc, char**& argv);
+  ~MpiSession();
+  MpiSession(const MpiSession&) = delete;
+  MpiSession& operator=(const MpiSession&) = delete;
+};
+
+int rankOf(MPI_Comm comm);
+int sizeOf(MPI_Comm comm);
+bool isRoot(MPI_Comm comm);
+
+// Ends every rank of `comm` with exit code `code`, after printing `message` (if not empty) on
+// standard error from the calling rank.
+[[noreturn]] void abortAll(MPI_Comm comm, int code, const std::string& message);
+
+}  // namespace msim::parallel
