@@ -1,0 +1,277 @@
+#include "msim/parallel/distributed_projection.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace msim::parallel {
+
+namespace {
+
+// hypre's 7-point stencil: the cell, then its lower and upper neighbour along x, y, z.
+constexpr int kStencilSize = 7;
+constexpr int kOffsets[kStencilSize][3] = {{0, 0, 0}, {-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}};
+
+// f(local cell, owned-cell ordinal) over the owned cells, x fastest (hypre's box order).
+template <typename F>
+void forOwnedCells(const GridBlock<3>& block, F&& f) {
+  const IVec<3> n = block.owned().size();
+  std::size_t k = 0;
+  for (int z = 0; z < n[2]; ++z)
+    for (int y = 0; y < n[1]; ++y)
+      for (int x = 0; x < n[0]; ++x, ++k) f(IVec<3>(x + block.ghost, y + block.ghost, z + block.ghost), k);
+}
+
+}  // namespace
+
+DistributedProjection::DistributedProjection(const GridBlock<3>& block, const numerics::DomainSides<3>& sides,
+                                             const numerics::PcgSettings& settings, MPI_Comm comm,
+                                             float minOpenFraction)
+    : block_(block),
+      sides_(sides),
+      settings_(settings),
+      comm_(comm),
+      minOpenFraction_(minOpenFraction),
+      velocityGhosts_(block, comm),
+      weightGhosts_(block, comm),
+      cellGhosts_(block, IVec<3>::Zero(), comm),
+      pressure_(block.localSpec()),
+      scaled_(block.localSpec()) {
+  if (block.ghost < 1) throw std::invalid_argument("distributed projection: blocks need at least one ghost layer");
+  setOpenFractions(MacGrid<3>(block.localSpec(), 1.0f));
+}
+
+DistributedProjection::~DistributedProjection() { destroyHypre(); }
+
+void DistributedProjection::destroyHypre() {
+  if (pcg_) HYPRE_StructPCGDestroy(pcg_);
+  if (pfmg_) HYPRE_StructPFMGDestroy(pfmg_);
+  if (x_) HYPRE_StructVectorDestroy(x_);
+  if (b_) HYPRE_StructVectorDestroy(b_);
+  if (matrix_) HYPRE_StructMatrixDestroy(matrix_);
+  if (stencil_) HYPRE_StructStencilDestroy(stencil_);
+  if (grid_) HYPRE_StructGridDestroy(grid_);
+  pcg_ = pfmg_ = nullptr;
+  x_ = b_ = nullptr;
+  matrix_ = nullptr;
+  stencil_ = nullptr;
+  grid_ = nullptr;
+}
+
+void DistributedProjection::setOpenFractions(const MacGrid<3>& openFraction) {
+  weights_ = MacGrid<3>(block_.localSpec());
+  const IVec<3> origin = block_.cellOrigin(), res = block_.global.res;
+  for (int a = 0; a < 3; ++a) {
+    Grid<float, 3>& w = weights_.component(a);
+    const Grid<float, 3>& open = openFraction.component(a);
+    for (std::size_t i = 0; i < w.count(); ++i) {
+      const IVec<3> g = w.coord(i) + origin;
+      bool inDomain = true;
+      for (int b = 0; b < 3; ++b) inDomain = inDomain && g[b] >= 0 && g[b] <= res[b] - (b != a);
+      const bool wall = (g[a] == 0 && sides_.side[a][0] == numerics::DomainSide::Wall) ||
+                        (g[a] == res[a] && sides_.side[a][1] == numerics::DomainSide::Wall);
+      w[i] = inDomain && !wall && open[i] >= minOpenFraction_ ? std::min(open[i], 1.0f) : 0.0f;
+    }
+  }
+  weightGhosts_.exchange(weights_);
+  assemble();
+}
+
+void DistributedProjection::assemble() {
+  destroyHypre();
+  const IndexBox<3> owned = block_.owned();
+  const IVec<3> origin = block_.cellOrigin(), res = block_.global.res;
+  const std::size_t cells = static_cast<std::size_t>(owned.count());
+  coefficients_.assign(cells * kStencilSize, 0.0);
+  fluid_.assign(cells, 0);
+  int dirichlet = 0;  // some face of an owned cell opens onto an open domain side
+  forOwnedCells(block_, [&](const IVec<3>& l, std::size_t k) {
+    double* row = coefficients_.data() + k * kStencilSize;
+    const IVec<3> g = l + origin;
+    for (int a = 0; a < 3; ++a) {
+      const IVec<3> up = l + IVec<3>::Unit(a);
+      const double wLow = weights_.component(a)(l), wUp = weights_.component(a)(up);
+      row[0] += wLow + wUp;
+      row[1 + 2 * a] = g[a] > 0 ? -wLow : 0.0;
+      row[2 + 2 * a] = g[a] + 1 < res[a] ? -wUp : 0.0;
+      dirichlet |= (g[a] == 0 && wLow > 0.0) || (g[a] + 1 == res[a] && wUp > 0.0);
+    }
+    fluid_[k] = row[0] > 0.0;
+    if (!fluid_[k]) row[0] = 1.0;  // inside a solid: no unknown, p^ = 0
+  });
+  // Without a Dirichlet face anywhere the constants are a null space: pin the first fluid cell.
+  int anyDirichlet = 0;
+  MPI_Allreduce(&dirichlet, &anyDirichlet, 1, MPI_INT, MPI_MAX, comm_);
+  long long firstFluid = std::numeric_limits<long long>::max();
+  forOwnedCells(block_, [&](const IVec<3>& l, std::size_t k) {
+    const IVec<3> g = l + origin;
+    if (fluid_[k]) firstFluid = std::min(firstFluid, g[0] + res[0] * (g[1] + static_cast<long long>(res[1]) * g[2]));
+  });
+  pinned_ = -1;
+  if (!anyDirichlet) {
+    MPI_Allreduce(MPI_IN_PLACE, &firstFluid, 1, MPI_LONG_LONG, MPI_MIN, comm_);
+    pinned_ = firstFluid == std::numeric_limits<long long>::max() ? -1 : firstFluid;
+    forOwnedCells(block_, [&](const IVec<3>& l, std::size_t k) {
+      const IVec<3> g = l + origin;
+      if (g[0] + res[0] * (g[1] + static_cast<long long>(res[1]) * g[2]) == pinned_)
+        coefficients_[k * kStencilSize] *= 2.0;  // A + d e e^T: the solution moves by a constant only
+    });
+  }
+
+  int lower[3], upper[3];
+  for (int a = 0; a < 3; ++a) {
+    lower[a] = owned.lo[a];
+    upper[a] = owned.hi[a] - 1;  // hypre's boxes are inclusive
+  }
+  HYPRE_StructGridCreate(comm_, 3, &grid_);
+  HYPRE_StructGridSetExtents(grid_, lower, upper);
+  HYPRE_StructGridAssemble(grid_);
+  HYPRE_StructStencilCreate(3, kStencilSize, &stencil_);
+  for (int e = 0; e < kStencilSize; ++e) HYPRE_StructStencilSetElement(stencil_, e, const_cast<int*>(kOffsets[e]));
+  HYPRE_StructMatrixCreate(comm_, grid_, stencil_, &matrix_);
+  HYPRE_StructMatrixInitialize(matrix_);
+  int entries[kStencilSize];
+  for (int e = 0; e < kStencilSize; ++e) entries[e] = e;
+  HYPRE_StructMatrixSetBoxValues(matrix_, lower, upper, kStencilSize, entries, coefficients_.data());
+  HYPRE_StructMatrixAssemble(matrix_);
+  for (HYPRE_StructVector* v : {&b_, &x_}) {
+    HYPRE_StructVectorCreate(comm_, grid_, v);
+    HYPRE_StructVectorInitialize(*v);
+    HYPRE_StructVectorAssemble(*v);
+  }
+  // CG preconditioned by one V-cycle of PFMG with symmetric red-black Gauss-Seidel (a symmetric
+  // preconditioner, as CG needs).
+  HYPRE_StructPFMGCreate(comm_, &pfmg_);
+  HYPRE_StructPFMGSetMaxIter(pfmg_, 1);
+  HYPRE_StructPFMGSetTol(pfmg_, 0.0);
+  HYPRE_StructPFMGSetZeroGuess(pfmg_);
+  HYPRE_StructPFMGSetRelaxType(pfmg_, 2);
+  HYPRE_StructPFMGSetNumPreRelax(pfmg_, 1);
+  HYPRE_StructPFMGSetNumPostRelax(pfmg_, 1);
+  HYPRE_StructPCGCreate(comm_, &pcg_);
+  HYPRE_StructPCGSetTwoNorm(pcg_, 1);
+  HYPRE_StructPCGSetPrecond(pcg_, HYPRE_StructPFMGSolve, HYPRE_StructPFMGSetup, pfmg_);
+  HYPRE_StructPCGSetup(pcg_, matrix_, b_, x_);
+  rhs_.assign(cells, 0.0);
+  values_.assign(cells, 0.0);
+}
+
+double DistributedProjection::maxResidual() {
+  cellGhosts_.exchange(scaled_);
+  const IVec<3> origin = block_.cellOrigin(), res = block_.global.res;
+  double worst = 0.0;
+  forOwnedCells(block_, [&](const IVec<3>& l, std::size_t k) {
+    if (!fluid_[k]) return;
+    const IVec<3> g = l + origin;
+    const double x = scaled_(l);
+    double ax = 0.0;
+    for (int a = 0; a < 3; ++a) {
+      const IVec<3> up = l + IVec<3>::Unit(a), low = l - IVec<3>::Unit(a);
+      ax += weights_.component(a)(l) * (x - (g[a] > 0 ? scaled_(low) : 0.0));
+      ax += weights_.component(a)(up) * (x - (g[a] + 1 < res[a] ? scaled_(up) : 0.0));
+    }
+    worst = std::max(worst, std::abs(rhs_[k] - ax));
+  });
+  MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPI_DOUBLE, MPI_MAX, comm_);
+  return worst;
+}
+
+DistributedProjectionStats DistributedProjection::project(MacGrid<3>& velocity, double dt, double density) {
+  if (!(dt > 0.0) || !(density > 0.0))
+    throw std::invalid_argument("pressure projection: the step and the density must be positive");
+  const double toScaled = dt / (density * block_.global.dx);
+  velocityGhosts_.exchange(velocity);
+  // b = -dx div u*: the net face-weighted outflow of each fluid cell, negated.
+  double sum = 0.0, count = 0.0;
+  forOwnedCells(block_, [&](const IVec<3>& l, std::size_t k) {
+    double outflow = 0.0;
+    for (int a = 0; a < 3; ++a) {
+      const IVec<3> up = l + IVec<3>::Unit(a);
+      outflow += double(weights_.component(a)(up)) * velocity.component(a)(up) -
+                 double(weights_.component(a)(l)) * velocity.component(a)(l);
+    }
+    rhs_[k] = fluid_[k] ? -outflow : 0.0;
+    sum += rhs_[k];
+    count += fluid_[k];
+  });
+  if (pinned_ >= 0) {  // the compatibility condition of the pure Neumann problem
+    double totals[2] = {sum, count};
+    MPI_Allreduce(MPI_IN_PLACE, totals, 2, MPI_DOUBLE, MPI_SUM, comm_);
+    const double mean = totals[1] > 0.0 ? totals[0] / totals[1] : 0.0;
+    for (std::size_t k = 0; k < rhs_.size(); ++k)
+      if (fluid_[k]) rhs_[k] -= mean;
+  }
+  double bMax = 0.0;
+  for (double b : rhs_) bMax = std::max(bMax, std::abs(b));
+  MPI_Allreduce(MPI_IN_PLACE, &bMax, 1, MPI_DOUBLE, MPI_MAX, comm_);
+
+  // Warm start from the last pressure, as the serial projection does.
+  forOwnedCells(block_, [&](const IVec<3>& l, std::size_t k) { values_[k] = fluid_[k] ? pressure_(l) * toScaled : 0.0; });
+  const IndexBox<3> owned = block_.owned();
+  int lower[3], upper[3];
+  for (int a = 0; a < 3; ++a) {
+    lower[a] = owned.lo[a];
+    upper[a] = owned.hi[a] - 1;
+  }
+  HYPRE_StructVectorSetBoxValues(b_, lower, upper, rhs_.data());
+  HYPRE_StructVectorSetBoxValues(x_, lower, upper, values_.data());
+  DistributedProjectionStats stats;
+  const double target = settings_.tolerance * bMax;
+  // hypre stops on the 2-norm; the criterion here is the max-norm, so tighten and resume until
+  // it holds (usually once).
+  double tolerance = settings_.tolerance;
+  for (int round = 0; round < 4 && stats.iterations < settings_.maxIterations; ++round) {
+    if (bMax > 0.0) {
+      HYPRE_StructPCGSetTol(pcg_, tolerance);
+      HYPRE_StructPCGSetMaxIter(pcg_, settings_.maxIterations - stats.iterations);
+      HYPRE_StructPCGSolve(pcg_, matrix_, b_, x_);
+      int iterations = 0;
+      HYPRE_StructPCGGetNumIterations(pcg_, &iterations);
+      stats.iterations += iterations;
+    }
+    HYPRE_StructVectorGetBoxValues(x_, lower, upper, values_.data());
+    forOwnedCells(block_, [&](const IVec<3>& l, std::size_t k) { scaled_(l) = values_[k]; });
+    const double residual = maxResidual();
+    stats.relativeResidual = bMax > 0.0 ? residual / bMax : 0.0;
+    if (residual <= target) break;
+    tolerance *= 0.1;
+  }
+  stats.converged = stats.relativeResidual <= settings_.tolerance;
+  if (pinned_ >= 0) {  // p^ up to a constant: keep the mean over fluid cells at 0 (as the serial solver)
+    double totals[2] = {0.0, 0.0};
+    forOwnedCells(block_, [&](const IVec<3>& l, std::size_t k) {
+      totals[0] += fluid_[k] ? scaled_(l) : 0.0;
+      totals[1] += fluid_[k];
+    });
+    MPI_Allreduce(MPI_IN_PLACE, totals, 2, MPI_DOUBLE, MPI_SUM, comm_);
+    const double mean = totals[1] > 0.0 ? totals[0] / totals[1] : 0.0;
+    forOwnedCells(block_, [&](const IVec<3>& l, std::size_t k) {
+      if (fluid_[k]) scaled_(l) -= mean;
+    });
+    cellGhosts_.exchange(scaled_);
+  }
+
+  // u = u* - grad p^ on the owned open faces; closed faces take the (static) solid's velocity 0.
+  const IVec<3> origin = block_.cellOrigin(), res = block_.global.res;
+  for (int a = 0; a < 3; ++a) {
+    Grid<float, 3>& u = velocity.component(a);
+    const Grid<float, 3>& w = weights_.component(a);
+    const IndexBox<3> faces = block_.ownedSamples(block_.rank, IVec<3>::Unit(a));
+    for (int z = faces.lo[2]; z < faces.hi[2]; ++z)
+      for (int y = faces.lo[1]; y < faces.hi[1]; ++y)
+        for (int x = faces.lo[0]; x < faces.hi[0]; ++x) {
+          const IVec<3> g(x, y, z), l = g - origin, low = l - IVec<3>::Unit(a);
+          if (w(l) <= 0.0f) {
+            u(l) = 0.0f;
+            continue;
+          }
+          const double pUp = g[a] < res[a] ? scaled_(l) : 0.0, pLow = g[a] > 0 ? scaled_(low) : 0.0;
+          u(l) = static_cast<float>(u(l) - (pUp - pLow));
+        }
+  }
+  forOwnedCells(block_, [&](const IVec<3>& l, std::size_t) { pressure_(l) = static_cast<float>(scaled_(l) / toScaled); });
+  return stats;
+}
+
+}  // namespace msim::parallel
