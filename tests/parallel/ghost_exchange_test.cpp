@@ -33,12 +33,8 @@ TEST(GhostExchange, FillsEveryGhostWithItsOwnersValueOnEveryLayout) {
     }
     GhostExchange<float, 3>(block, extra, MPI_COMM_WORLD).exchange(field);
     int wrong = 0;
-    const IVec<3> samples = global.res + extra;
-    for (std::size_t i = 0; i < field.count(); ++i) {
-      const IVec<3> g = field.coord(i) + origin;
-      const bool inDomain = (g.array() >= 0).all() && (g.array() < samples.array()).all();
-      if (inDomain && field[i] != label(g)) ++wrong;
-    }
+    for (std::size_t i = 0; i < field.count(); ++i)
+      if (field[i] != label(field.coord(i) + origin)) ++wrong;
     EXPECT_EQ(wrong, 0) << "layout " << layout << " on rank " << worldRank();
   }
 }

@@ -16,11 +16,11 @@ constexpr int kOffsets[kStencilSize][3] = {{0, 0, 0}, {-1, 0, 0}, {1, 0, 0}, {0,
 // f(local cell, owned-cell ordinal) over the owned cells, x fastest (hypre's box order).
 template <typename F>
 void forOwnedCells(const GridBlock<3>& block, F&& f) {
-  const IVec<3> n = block.owned().size();
+  const IndexBox<3> owned = block.ownedLocal();
   std::size_t k = 0;
-  for (int z = 0; z < n[2]; ++z)
-    for (int y = 0; y < n[1]; ++y)
-      for (int x = 0; x < n[0]; ++x, ++k) f(IVec<3>(x + block.ghost, y + block.ghost, z + block.ghost), k);
+  for (int z = owned.lo[2]; z < owned.hi[2]; ++z)
+    for (int y = owned.lo[1]; y < owned.hi[1]; ++y)
+      for (int x = owned.lo[0]; x < owned.hi[0]; ++x, ++k) f(IVec<3>(x, y, z), k);
 }
 
 }  // namespace
@@ -67,11 +67,9 @@ void DistributedProjection::setOpenFractions(const MacGrid<3>& openFraction) {
     const Grid<float, 3>& open = openFraction.component(a);
     for (std::size_t i = 0; i < w.count(); ++i) {
       const IVec<3> g = w.coord(i) + origin;
-      bool inDomain = true;
-      for (int b = 0; b < 3; ++b) inDomain = inDomain && g[b] >= 0 && g[b] <= res[b] - (b != a);
       const bool wall = (g[a] == 0 && sides_.side[a][0] == numerics::DomainSide::Wall) ||
                         (g[a] == res[a] && sides_.side[a][1] == numerics::DomainSide::Wall);
-      w[i] = inDomain && !wall && open[i] >= minOpenFraction_ ? std::min(open[i], 1.0f) : 0.0f;
+      w[i] = !wall && open[i] >= minOpenFraction_ ? std::min(open[i], 1.0f) : 0.0f;
     }
   }
   weightGhosts_.exchange(weights_);

@@ -4,6 +4,7 @@
 // so its interpolation reads samples at most ceil(cfl) away (an upwind stage: 1); MacCormack runs
 // two stages on each other's results and BFECC three, so their reach adds up. The velocity is
 // read at the stages' points, on face grids half a cell off the field's lattice: one more layer.
+#include <algorithm>
 #include <cmath>
 
 #include "msim/numerics/advection/advection_settings.hpp"
@@ -16,6 +17,16 @@ inline int advectionGhostLayers(const numerics::AdvectionSettings& s, double cfl
                                                                           : 3;
   const int reach = s.block == numerics::BuildingBlock::Upwind ? 1 : static_cast<int>(std::ceil(cfl));
   return stages * reach + 1;
+}
+
+// Vorticity confinement (Selle eq. 3.3) differences the velocity three times on its way to a
+// face: cell-centred velocity, its curl, the gradient of |curl|; the force is then averaged
+// onto faces. An owned face reads samples up to three cells away.
+constexpr int kConfinementGhostLayers = 3;
+
+// The ghost layers a smoke step reads: its advection scheme's or confinement's, whichever is wider.
+inline int smokeGhostLayers(const numerics::AdvectionSettings& s, double cfl) {
+  return std::max(advectionGhostLayers(s, cfl), kConfinementGhostLayers);
 }
 
 }  // namespace msim::parallel

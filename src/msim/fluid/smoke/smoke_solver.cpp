@@ -130,7 +130,7 @@ std::size_t SmokeSolver<D>::addScalar(std::string name, double dissipation, floa
 
 template <int D>
 double SmokeSolver<D>::cflTimestep() const {
-  const double speed = maxFaceSpeed(velocity_);
+  const double speed = split_ ? split_->maxOverRanks(maxFaceSpeed(velocity_)) : maxFaceSpeed(velocity_);
   double dt = speed > 0.0 ? params_.cfl * spec_.dx / speed : std::numeric_limits<double>::infinity();
   // Explicit diffusion is stable for nu dt / dx^2 <= 1 / (2 D) (the Laplacian's largest eigenvalue).
   if (params_.viscosity > 0.0 && params_.viscosityMode == ViscosityMode::Explicit)
@@ -147,8 +147,49 @@ int SmokeSolver<D>::advance(double dt) {
 }
 
 template <int D>
+void SmokeSolver<D>::setDomainSplit(DomainSplit<D>* split) {
+  split_ = split;
+  advector_.setPlacement(split ? split->placement() : BlockPlacement<D>{});
+}
+
+template <int D>
+void SmokeSolver<D>::checkDistributable() const {
+  auto refuse = [](const std::string& what) {
+    throw InputError("smoke split among MPI processes: " + what + " is not distributed; run it on one process");
+  };
+  if (hasObstacles_) refuse("obstacles");
+  if (vortex_) refuse("vortex particles");
+  if (params_.viscosity > 0.0) refuse("viscosity");
+  if (params_.scalarTransport == ScalarTransport::Conservative) refuse("conservative scalar transport");
+  if (advectionOffset_ || scalarsElsewhere_) refuse("procedural turbulence");
+  for (int a = 0; a < D; ++a)
+    for (int side = 0; side < 2; ++side)
+      if (!params_.wallVelocity[a][side].isZero()) refuse("a moving wall");
+  for (const auto& src : sources_)
+    if (src.active && src.expansion != 0.0) refuse("an expanding source");
+}
+
+template <int D>
+double SmokeSolver<D>::splitDivergence() const {
+  const IVec<D> lo = split_->ownedLo(), hi = split_->ownedHi();
+  const double worst = parallelMax(density_.count(), [&](std::size_t i) {
+    const IVec<D> c = density_.coord(i);
+    if ((c.array() < lo.array()).any() || (c.array() >= hi.array()).any()) return 0.0;
+    double div = 0.0;
+    for (int a = 0; a < D; ++a) {
+      IVec<D> up = c;
+      up[a] += 1;
+      div += velocity_.component(a)(up) - velocity_.component(a)(c);
+    }
+    return std::abs(div) / spec_.dx;
+  });
+  return split_->maxOverRanks(worst);
+}
+
+template <int D>
 void SmokeSolver<D>::step(double dt) {
   const Grid<float, D>* solid = hasObstacles_ ? &solid_ : nullptr;
+  if (split_) checkDistributable();
   {
     ScopedStage s(timers_, "sources");
     if (params_.scalarTransport == ScalarTransport::Advector) resetInflowCells();
@@ -167,6 +208,7 @@ void SmokeSolver<D>::step(double dt) {
       }
       advector_.advect(velocity_, *advecting_, dt);
     } else {
+      if (split_) split_->exchange(velocity_);
       advector_.advect(velocity_, velocity_, dt);
     }
     // Faces the projection treats as (partly) fluid but the advector as solid keep their old value
@@ -177,6 +219,11 @@ void SmokeSolver<D>::step(double dt) {
   {
     ScopedStage s(timers_, "forces");
     const auto& b = params_.buoyancy;
+    if (split_) {  // buoyancy averages cells to faces, confinement differences the velocity twice
+      split_->exchange(velocity_);
+      split_->exchange(density_);
+      split_->exchange(temperature_);
+    }
     if (b.alpha != 0.0 || b.beta != 0.0) addBuoyancy(velocity_, density_, temperature_, b, dt, solid);
     // Confinement re-injects the small-scale rotation (eq. 3.3) numerical dissipation removed.
     if (params_.vorticityEpsilon != 0.0) confinement_.apply(velocity_, params_.vorticityEpsilon, dt, solid);
@@ -195,8 +242,14 @@ void SmokeSolver<D>::step(double dt) {
     ScopedStage s(timers_, "project");
     applyInflow();
     updateExpansion();
-    pressureIterations_ = projection_.project(velocity_, dt, params_.fluidDensity).iterations;
-    maxDivergence_ = measureDivergence();
+    if (split_) {
+      pressureIterations_ = split_->project(velocity_, dt, params_.fluidDensity).iterations;
+      split_->exchange(velocity_);  // the divergence below and the scalars' advection read ghosts
+      maxDivergence_ = splitDivergence();
+    } else {
+      pressureIterations_ = projection_.project(velocity_, dt, params_.fluidDensity).iterations;
+      maxDivergence_ = measureDivergence();
+    }
   }
   if (vortex_) {
     // The particles move with the divergence-free velocity (Selle ch. 3.3).
@@ -220,10 +273,12 @@ template <int D>
 void SmokeSolver<D>::advectScalars(double dt) {
   if (!scalarsElsewhere_)
     for (Grid<float, D>* f : {&density_, &temperature_}) {
+      if (split_) split_->exchange(*f);
       border_.extend(*f);
       advector_.advect(*f, velocity_, dt);
     }
   for (auto& sc : scalars_) {
+    if (split_) split_->exchange(sc.field);
     border_.extend(sc.field);
     advector_.advect(sc.field, velocity_, dt);
   }
@@ -418,13 +473,18 @@ void SmokeSolver<D>::checkFinite() const {
   auto fail = [&](const std::string& field) {
     throw SimulationError("smoke solver: non-finite " + field + " at step " + std::to_string(steps_));
   };
+  // A split run agrees on every field before throwing, so that every rank stops together.
+  auto finite = [&](const std::vector<float>& v) {
+    const bool here = allFinite(v);
+    return split_ ? split_->maxOverRanks(here ? 0.0 : 1.0) == 0.0 : here;
+  };
   static const char* axisName[] = {"x", "y", "z"};
   for (int a = 0; a < D; ++a)
-    if (!allFinite(velocity_.component(a).data())) fail(std::string("velocity ") + axisName[a]);
-  if (!allFinite(density_.data())) fail("density");
-  if (!allFinite(temperature_.data())) fail("temperature");
+    if (!finite(velocity_.component(a).data())) fail(std::string("velocity ") + axisName[a]);
+  if (!finite(density_.data())) fail("density");
+  if (!finite(temperature_.data())) fail("temperature");
   for (const auto& sc : scalars_)
-    if (!allFinite(sc.field.data())) fail("scalar '" + sc.name + "'");
+    if (!finite(sc.field.data())) fail("scalar '" + sc.name + "'");
 }
 
 template <int D>

@@ -21,6 +21,7 @@
 #include <utility>
 #include <vector>
 
+#include "msim/core/domain_split.hpp"
 #include "msim/core/grid.hpp"
 #include "msim/core/mac_grid.hpp"
 #include "msim/core/timer.hpp"
@@ -162,6 +163,13 @@ class SmokeSolver {
   void setVortexLayer(std::unique_ptr<VortexLayer<D>> layer);
   const VortexLayer<D>* vortexLayer() const { return vortex_.get(); }
   VortexLayer<D>* vortexLayer() { return vortex_.get(); }
+  // Runs the solver on one block of a grid split among processes (msim/parallel): the solver's
+  // spec is the block's local grid, ghosts are exchanged where stencils read them, scalars are
+  // reduced over the ranks and the pressure solve is the split's. Obstacles, vortex particles,
+  // viscosity, conservative scalar transport, expanding sources, moving walls and procedural
+  // turbulence are not distributed: step() throws InputError naming the one in use. `split`
+  // must outlive the solver.
+  void setDomainSplit(DomainSplit<D>* split);
   // The clock the winds are sampled at [s]; step() advances it, a resumed run sets it.
   void setTime(double time) { time_ = time; }
   double time() const { return time_; }
@@ -229,6 +237,10 @@ class SmokeSolver {
   void dissipate(double dt);
   void applyWinds(double dt);
   void checkFinite() const;
+  // Split runs: throws InputError if a feature that is not distributed is in use.
+  void checkDistributable() const;
+  // Split runs: max |div u| over the owned cells of every rank (velocity ghosts filled).
+  double splitDivergence() const;
   double measureDivergence();
 
   GridSpec<D> spec_;
@@ -257,6 +269,7 @@ class SmokeSolver {
   VorticityConfinement<D> confinement_;
   ViscousDiffusion<D> viscosity_;
   StageTimers timers_;
+  DomainSplit<D>* split_ = nullptr;
   double maxDivergence_ = 0.0;
   int pressureIterations_ = 0, viscosityIterations_ = 0;
   long steps_ = 0;

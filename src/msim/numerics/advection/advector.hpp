@@ -35,6 +35,11 @@ class Advector {
            const AxisBoundaries<D>& boundaries = allClamped<D>(), const BlockPlacement<D>& placement = {});
 
   const AdvectionSettings& settings() const { return settings_; }
+  // Where the grids lie in a split domain (see the constructor).
+  void setPlacement(const BlockPlacement<D>& placement) {
+    placement_ = placement;
+    feet_.valid = false;
+  }
   void setSettings(const AdvectionSettings& settings) { settings_ = settings; }
 
   // Cells with mask > 0.5 are solid: their samples (and, on MAC grids, every face of a solid cell)

@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "msim/core/block_placement.hpp"
 #include "msim/core/grid.hpp"
 
 namespace msim::numerics {
@@ -33,18 +34,6 @@ AxisBoundaries<D> allPeriodic() {
   b.fill(AxisBoundary::Periodic);
   return b;
 }
-
-// Where a grid lies inside a larger one that is split among processes (msim/parallel): its cell 0
-// is the global grid's cell `cellOrigin`, and the global grid has `globalRes` cells. Advection
-// then works in global sample coordinates, clamping at the global domain's border only, so a
-// block with wide enough ghost layers computes its samples bit for bit as the whole grid would.
-// The default, a grid that is the whole domain, is every serial run.
-template <int D>
-struct BlockPlacement {
-  IVec<D> cellOrigin = IVec<D>::Zero();
-  IVec<D> globalRes = IVec<D>::Zero();  // zero: the grid is the whole domain
-  bool whole() const { return globalRes.isZero(); }
-};
 
 // The 2^D samples a D-linear interpolation reads, with their weights.
 template <int D>

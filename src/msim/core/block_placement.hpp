@@ -1,0 +1,18 @@
+#pragma once
+// Where a grid lies inside a larger one that is split among processes (msim/parallel): its cell 0
+// is the global grid's cell `cellOrigin`, and the global grid has `globalRes` cells. Schemes that
+// clamp or trace positions then work in global sample coordinates, clamping at the global
+// domain's border only, so a block with wide enough ghost layers computes its samples bit for bit
+// as the whole grid would. The default, a grid that is the whole domain, is every serial run.
+#include "msim/core/vec.hpp"
+
+namespace msim {
+
+template <int D>
+struct BlockPlacement {
+  IVec<D> cellOrigin = IVec<D>::Zero();
+  IVec<D> globalRes = IVec<D>::Zero();  // zero: the grid is the whole domain
+  bool whole() const { return globalRes.isZero(); }
+};
+
+}  // namespace msim

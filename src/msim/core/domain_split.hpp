@@ -1,0 +1,40 @@
+#pragma once
+// DomainSplit<D>: what a grid solver needs from the processes its domain is split among
+// (msim/parallel implements it over MPI; Selle ch. 8.1). The solver's grids are one block of the
+// global grid with ghost layers (placement()); it calls exchange() where a stencil is about to
+// read the neighbours' samples, reduces its scalars over the ranks, and hands the pressure solve,
+// the one global coupling, to project(). Without a split (the default) none of this is called.
+#include "msim/core/block_placement.hpp"
+#include "msim/core/grid.hpp"
+#include "msim/core/mac_grid.hpp"
+
+namespace msim {
+
+struct SplitSolveStats {
+  int iterations = 0;
+  double relativeResidual = 0.0;  // |b - A x|_inf / |b|_inf over every rank
+  bool converged = false;
+};
+
+template <int D>
+class DomainSplit {
+ public:
+  virtual ~DomainSplit() = default;
+  virtual BlockPlacement<D> placement() const = 0;
+  // Ghost layers around the owned cells (where the domain does not end first).
+  virtual int ghostLayers() const = 0;
+  // The owned cells in the local grid's coordinates: [lo, hi).
+  virtual IVec<D> ownedLo() const = 0;
+  virtual IVec<D> ownedHi() const = 0;
+  // Fills the ghost samples of a local cell-centred field, or of every component of a local MAC
+  // grid, from their owners. Collective.
+  virtual void exchange(Grid<float, D>& cells) = 0;
+  virtual void exchange(MacGrid<D>& faces) = 0;
+  // The largest of `value` over every rank. Collective.
+  virtual double maxOverRanks(double value) = 0;
+  // The pressure projection of the global grid on the local velocity (walls at rest, no solids
+  // inside): u = u* - (dt / rho) grad p with div u = 0 on the owned cells. Collective.
+  virtual SplitSolveStats project(MacGrid<D>& velocity, double dt, double density) = 0;
+};
+
+}  // namespace msim

@@ -1,0 +1,40 @@
+#pragma once
+// MpiDomainSplit: DomainSplit<3> over MPI for one rank's GridBlock: ghost exchanges per field
+// layout (cells and the three face components), max-reductions, and the pressure solve through
+// DistributedProjection (hypre).
+#include <mpi.h>
+
+#include <memory>
+
+#include "msim/core/domain_split.hpp"
+#include "msim/parallel/distributed_projection.hpp"
+#include "msim/parallel/ghost_exchange.hpp"
+
+namespace msim::parallel {
+
+class MpiDomainSplit final : public DomainSplit<3> {
+ public:
+  MpiDomainSplit(const GridBlock<3>& block, const numerics::DomainSides<3>& sides,
+                 const numerics::PcgSettings& pressureSolve, MPI_Comm comm);
+
+  BlockPlacement<3> placement() const override { return block_.placement(); }
+  int ghostLayers() const override { return block_.ghost; }
+  IVec<3> ownedLo() const override { return block_.ownedLocal().lo; }
+  IVec<3> ownedHi() const override { return block_.ownedLocal().hi; }
+  void exchange(Grid<float, 3>& cells) override { cells_.exchange(cells); }
+  void exchange(MacGrid<3>& faces) override { faces_.exchange(faces); }
+  double maxOverRanks(double value) override;
+  SplitSolveStats project(MacGrid<3>& velocity, double dt, double density) override;
+
+  const GridBlock<3>& block() const { return block_; }
+  MPI_Comm comm() const { return comm_; }
+
+ private:
+  GridBlock<3> block_;
+  MPI_Comm comm_;
+  GhostExchange<float, 3> cells_;
+  MacGhostExchange<3> faces_;
+  DistributedProjection projection_;
+};
+
+}  // namespace msim::parallel
