@@ -1,6 +1,7 @@
 // msim: the command-line program. run / info / validate a scene; render saved frames.
 // Exit codes: 0 success, 2 bad input (scene, command line, files), 3 simulation failure,
 // 130 interrupted by the user (the last frame written is complete; --resume continues).
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -17,6 +18,7 @@
 #include "msim/core/log.hpp"
 #include "msim/core/system_memory.hpp"
 #include "msim/io/png.hpp"
+#include "msim/parallel/mpi_session.hpp"
 #include "msim/render/image_detail.hpp"
 #include "msim/scene/interrupt.hpp"
 #include "msim/scene/runner.hpp"
@@ -53,6 +55,11 @@ void printInfo(const scene::Scene& s) {
 
 int main(int argc, char** argv) {
   flushSubnormalsToZero();
+  // Started by mpirun: MPI runs for the whole program, and `msim run` splits the scene among the
+  // processes (msim/parallel). Otherwise MPI is never initialised.
+  std::optional<parallel::MpiSession> mpi;
+  if (parallel::launchedByMpi()) mpi.emplace(argc, argv);
+  const int rank = parallel::worldRank(), ranks = parallel::worldSize();
   CLI::App app{"msim: multi-scale simulation of natural phenomena"};
   app.set_version_flag("--version", std::string("msim ") + kVersion);
   app.require_subcommand(1);
@@ -116,11 +123,17 @@ int main(int argc, char** argv) {
   }
 
   initLogging(spdlog::level::info);
-  setQuiet(quiet);
+  setQuiet(quiet || rank > 0);  // rank 0 speaks for a split run
+  // Processes sharing a machine share its cores: by default each takes its part of them.
+  if (threads == 0 && ranks > 1)
+    threads = std::max(1, static_cast<int>(tbb::info::default_concurrency()) / parallel::ranksOnThisNode());
   std::optional<tbb::global_control> threadLimit;
   if (threads > 0) threadLimit.emplace(tbb::global_control::max_allowed_parallelism, threads);
 
   try {
+    if (ranks > 1 && !*run)
+      throw InputError(fmt::format("only 'msim run' splits work among MPI processes; run this command without mpirun "
+                                   "(-np {})", ranks));
     if (*schema) {
       const scene::PhenomenonType* type = scene::findPhenomenonType(phenomenonName);
       if (!type) throw InputError(fmt::format("unknown phenomenon '{}'", phenomenonName));
@@ -180,7 +193,7 @@ int main(int argc, char** argv) {
     }
     if (runOptions.outDir.empty()) runOptions.outDir = std::filesystem::path("out") / s.name();
     runOptions.frameLimit = frames;
-    runOptions.showProgress = !quiet;
+    runOptions.showProgress = !quiet && rank == 0;
     runOptions.commandLine = joinArgs(argc, argv);
     scene::installInterruptHandler();
     logger().info("{}: {} {}D, {} x {}{} cells, {} frames -> {}", scenePath, s.type->name, s.dimensions,
@@ -195,12 +208,17 @@ int main(int argc, char** argv) {
     logger().info("done: {}", runOptions.outDir.string());
     return 0;
   } catch (const InputError& e) {
-    std::fprintf(stderr, "msim: error: %s\n", e.what());
+    // Bad input is found alike on every rank (the scene is read and checked by all): rank 0
+    // reports it and every rank leaves with code 2.
+    if (rank == 0) std::fprintf(stderr, "msim: error: %s\n", e.what());
     return kExitInputError;
   } catch (const SimulationError& e) {
-    std::fprintf(stderr, "msim: simulation failed: %s\n", e.what());
+    // A split run's checks (CFL, finite fields) are reduced over the ranks: all throw together.
+    if (rank == 0) std::fprintf(stderr, "msim: simulation failed: %s\n", e.what());
     return kExitSimulationError;
   } catch (const std::exception& e) {
+    // Anything else may have hit one rank only: stop them all rather than leave them waiting.
+    if (ranks > 1) parallel::abortAll(MPI_COMM_WORLD, 1, std::string("error: ") + e.what());
     std::fprintf(stderr, "msim: error: %s\n", e.what());
     return 1;
   }

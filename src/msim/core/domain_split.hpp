@@ -21,6 +21,8 @@ class DomainSplit {
  public:
   virtual ~DomainSplit() = default;
   virtual BlockPlacement<D> placement() const = 0;
+  // The local grid: the owned cells and the ghost layers, over which the solver's fields lie.
+  virtual GridSpec<D> localSpec() const = 0;
   // Ghost layers around the owned cells (where the domain does not end first).
   virtual int ghostLayers() const = 0;
   // The owned cells in the local grid's coordinates: [lo, hi).
@@ -30,6 +32,12 @@ class DomainSplit {
   // grid, from their owners. Collective.
   virtual void exchange(Grid<float, D>& cells) = 0;
   virtual void exchange(MacGrid<D>& faces) = 0;
+  // The owned samples of every rank's local field put together into `global` on rank 0 (left
+  // as it is elsewhere). Collective.
+  virtual void gather(const Grid<float, D>& local, Grid<float, D>& global) = 0;
+  virtual void gather(const MacGrid<D>& local, MacGrid<D>& global) = 0;
+  // Whether this rank writes the run's files (rank 0).
+  virtual bool root() const = 0;
   // The largest of `value` over every rank. Collective.
   virtual double maxOverRanks(double value) = 0;
   // The pressure projection of the global grid on the local velocity (walls at rest, no solids

@@ -10,6 +10,16 @@ MpiDomainSplit::MpiDomainSplit(const GridBlock<3>& block, const numerics::Domain
       faces_(block, comm),
       projection_(block, sides, pressureSolve, comm) {}
 
+void MpiDomainSplit::gather(const Grid<float, 3>& local, Grid<float, 3>& global) {
+  Grid<float, 3> all = gatherToRoot(local, block_, comm_);
+  if (root()) global = std::move(all);
+}
+
+void MpiDomainSplit::gather(const MacGrid<3>& local, MacGrid<3>& global) {
+  MacGrid<3> all = gatherToRoot(local, block_, comm_);
+  if (root()) global = std::move(all);
+}
+
 double MpiDomainSplit::maxOverRanks(double value) {
   MPI_Allreduce(MPI_IN_PLACE, &value, 1, MPI_DOUBLE, MPI_MAX, comm_);
   return value;

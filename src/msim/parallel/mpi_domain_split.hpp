@@ -18,11 +18,15 @@ class MpiDomainSplit final : public DomainSplit<3> {
                  const numerics::PcgSettings& pressureSolve, MPI_Comm comm);
 
   BlockPlacement<3> placement() const override { return block_.placement(); }
+  GridSpec<3> localSpec() const override { return block_.localSpec(); }
   int ghostLayers() const override { return block_.ghost; }
   IVec<3> ownedLo() const override { return block_.ownedLocal().lo; }
   IVec<3> ownedHi() const override { return block_.ownedLocal().hi; }
   void exchange(Grid<float, 3>& cells) override { cells_.exchange(cells); }
   void exchange(MacGrid<3>& faces) override { faces_.exchange(faces); }
+  void gather(const Grid<float, 3>& local, Grid<float, 3>& global) override;
+  void gather(const MacGrid<3>& local, MacGrid<3>& global) override;
+  bool root() const override { return block_.rank == 0; }
   double maxOverRanks(double value) override;
   SplitSolveStats project(MacGrid<3>& velocity, double dt, double density) override;
 

@@ -20,6 +20,43 @@ MpiSession::~MpiSession() {
   if (!finalised) MPI_Finalize();
 }
 
+namespace {
+
+bool mpiRunning() {
+  int initialised = 0, finalised = 0;
+  MPI_Initialized(&initialised);
+  MPI_Finalized(&finalised);
+  return initialised && !finalised;
+}
+
+}  // namespace
+
+bool launchedByMpi() {
+  for (const char* variable : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_SIZE"})
+    if (std::getenv(variable)) return true;
+  return false;
+}
+
+int worldRank() { return mpiRunning() ? rankOf(MPI_COMM_WORLD) : 0; }
+
+int worldSize() { return mpiRunning() ? sizeOf(MPI_COMM_WORLD) : 1; }
+
+int ranksOnThisNode() {
+  if (!mpiRunning()) return 1;
+  MPI_Comm node;
+  MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node);
+  const int n = sizeOf(node);
+  MPI_Comm_free(&node);
+  return n;
+}
+
+bool anyRank(bool flag) {
+  if (!mpiRunning()) return flag;
+  int mine = flag, any = 0;
+  MPI_Allreduce(&mine, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  return any != 0;
+}
+
 int rankOf(MPI_Comm comm) {
   int r = 0;
   MPI_Comm_rank(comm, &r);

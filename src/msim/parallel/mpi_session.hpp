@@ -18,6 +18,18 @@ class MpiSession {
   MpiSession& operator=(const MpiSession&) = delete;
 };
 
+// Whether this process was started by mpirun (or another MPI launcher: Slurm's srun, Hydra),
+// read from the environment the launchers set. `msim run` initialises MPI only then, so a plain
+// run behaves as if MPI were not there.
+bool launchedByMpi();
+// MPI_COMM_WORLD's rank and size once MPI runs; 0 and 1 otherwise.
+int worldRank();
+int worldSize();
+// Ranks of MPI_COMM_WORLD on this machine (1 without MPI). Collective.
+int ranksOnThisNode();
+// Whether `flag` holds on some rank (the flag itself without MPI). Collective.
+bool anyRank(bool flag);
+
 int rankOf(MPI_Comm comm);
 int sizeOf(MPI_Comm comm);
 bool isRoot(MPI_Comm comm);

@@ -36,6 +36,10 @@ class Phenomenon {
   virtual void restore(const std::filesystem::path& vdbFile, double time) = 0;
   // Summary numbers of the current state, one JSON object of named numbers.
   virtual nlohmann::json statistics() const = 0;
+  // In a run split among MPI processes (PhenomenonType::splitsAmongProcesses) every rank calls
+  // stableTimestep, step, checkFinite and endFrame together (collective: endFrame gathers the
+  // frame on rank 0); the outputs below (writeVolume, preview, statistics, writeFrameData,
+  // finishRun) are called on rank 0 only.
   // Per-frame files besides the VDB and the preview (a crowd's trajectory rows), written before
   // the VDB so that a frame whose VDB exists has them too (--resume). None by default.
   virtual void writeFrameData(const std::filesystem::path& /*runDir*/, int /*frame*/) const {}
@@ -55,6 +59,8 @@ struct PhenomenonType {
   // Bytes of memory per grid cell while running (state, scratch, output buffers).
   double (*bytesPerCell)(int dimensions, const nlohmann::json& resolved);
   std::unique_ptr<Phenomenon> (*create)(const Scene& scene, StageTimers& timers);
+  // Whether `mpirun -np N msim run` splits it among the N processes (msim/parallel).
+  bool splitsAmongProcesses = false;
 };
 
 const std::vector<PhenomenonType>& phenomenonTypes();

@@ -89,12 +89,14 @@ std::unique_ptr<geometry::Shape<D>> sceneShape(const Scene& scene, const nlohman
 
 template <int D>
 std::vector<std::pair<std::size_t, float>> coveredOpenCells(const Scene& scene, const geometry::Shape<D>& shape,
-                                                            const Grid<float, D>& solid, const std::string& key) {
+                                                            const Grid<float, D>& solid, const std::string& key,
+                                                            DomainSplit<D>* split) {
   const Grid<float, D> cover = geometry::occupancy(shape, solid.spec());
   std::vector<std::pair<std::size_t, float>> cells;
   for (std::size_t c = 0; c < cover.count(); ++c)
     if (cover[c] > 0.0f && solid[c] < 0.5f) cells.emplace_back(c, cover[c]);
-  if (cells.empty())
+  const double mostCells = static_cast<double>(cells.size());
+  if ((split ? split->maxOverRanks(mostCells) : mostCells) == 0.0)
     throw InputError(fmt::format("{}: '{}' covers no open cell of the domain (outside it, or inside an obstacle)",
                                  scene.file.string(), key));
   return cells;
@@ -109,7 +111,8 @@ std::vector<std::pair<std::size_t, float>> coveredOpenCells(const Scene& scene, 
   template std::unique_ptr<geometry::Shape<D>> sceneShape<D>(const Scene&, const nlohmann::json&,                  \
                                                              const std::string&);                                 \
   template std::vector<std::pair<std::size_t, float>> coveredOpenCells<D>(const Scene&, const geometry::Shape<D>&, \
-                                                                          const Grid<float, D>&, const std::string&);
+                                                                          const Grid<float, D>&, const std::string&,  \
+                                                                          DomainSplit<D>*);
 MSIM_INSTANTIATE(2)
 MSIM_INSTANTIATE(3)
 #undef MSIM_INSTANTIATE

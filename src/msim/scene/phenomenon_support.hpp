@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "msim/core/domain_split.hpp"
 #include "msim/core/grid.hpp"
 #include "msim/core/mac_grid.hpp"
 #include "msim/geometry/shape.hpp"
@@ -67,9 +68,11 @@ std::unique_ptr<geometry::Shape<D>> sceneShape(const Scene& scene, const nlohman
                                                const std::string& key);
 
 // Cells covered by `shape` (coverage in (0,1]) that are not solid; InputError naming `key` when
-// there is none (the shape lies outside the domain or inside an obstacle).
+// there is none (the shape lies outside the domain or inside an obstacle). In a run split among
+// processes (`split`), `solid` is the local grid and the error needs no covered cell on any rank.
 template <int D>
 std::vector<std::pair<std::size_t, float>> coveredOpenCells(const Scene& scene, const geometry::Shape<D>& shape,
-                                                            const Grid<float, D>& solid, const std::string& key);
+                                                            const Grid<float, D>& solid, const std::string& key,
+                                                            DomainSplit<D>* split = nullptr);
 
 }  // namespace msim::scene

@@ -15,6 +15,7 @@
 #include "msim/io/csv.hpp"
 #include "msim/io/png.hpp"
 #include "msim/io/video.hpp"
+#include "msim/parallel/mpi_session.hpp"
 #include "msim/scene/interrupt.hpp"
 #include "msim/scene/progress_bar.hpp"
 #include "msim/scene/saved_frames.hpp"
@@ -180,6 +181,14 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
   const int lastFrame = options.frameLimit > 0 ? std::min(options.frameLimit, scene.frameCount) : scene.frameCount;
   if (options.resume && !layout.vdb)
     throw InputError(scene.file.string() + ": --resume needs the VDB frames, but 'outputs.vdb' is false");
+  // Under mpirun every rank runs this loop; rank 0 alone writes files and reports.
+  const int ranks = parallel::worldSize();
+  const bool writer = parallel::worldRank() == 0;
+  if (ranks > 1 && !scene.type->splitsAmongProcesses)
+    throw InputError(fmt::format("{}: 'phenomenon' {} runs on one process; run it without mpirun (-np {})",
+                                 scene.file.string(), scene.type->name, ranks));
+  if (ranks > 1 && options.resume)
+    throw InputError(scene.file.string() + ": --resume is not available under mpirun; rerun the scene");
 
   // Build first: a scene that fails here (a mesh that does not load, a source outside the
   // domain) must not leave even an empty output folder behind.
@@ -189,12 +198,16 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
     ScopedStage stage(timers, "setup");
     phenomenon = scene.type->create(scene, timers);
   }
-  fs::create_directories(layout.root);
-  if (layout.vdb) fs::create_directories(layout.vdbDir);
-  if (layout.png) fs::create_directories(layout.pngDir);
-  if (layout.render.enabled) fs::create_directories(layout.renderDir);
-  for (const fs::path& dir : {layout.root, layout.vdbDir, layout.pngDir, layout.renderDir}) io::removeStaleTemporaries(dir);
+  if (writer) {
+    fs::create_directories(layout.root);
+    if (layout.vdb) fs::create_directories(layout.vdbDir);
+    if (layout.png) fs::create_directories(layout.pngDir);
+    if (layout.render.enabled) fs::create_directories(layout.renderDir);
+    for (const fs::path& dir : {layout.root, layout.vdbDir, layout.pngDir, layout.renderDir})
+      io::removeStaleTemporaries(dir);
+  }
   RunRecord record(scene, options, layout);
+  if (ranks > 1) record.note("mpi_processes", std::to_string(ranks));
 
   int firstFrame = 1;
   if (options.resume) {
@@ -212,7 +225,7 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
     }
     firstFrame = done + 1;
     logger().info("resuming after frame {} of {}", done, lastFrame);
-  } else {
+  } else if (writer) {
     clearFrames(layout);
   }
 
@@ -247,6 +260,13 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
         phenomenon->checkFinite(stepIndex, frameEnd);
       }
       phenomenon->endFrame();
+      if (!writer) {
+        if (parallel::anyRank(interruptRequested()) && frame < lastFrame) {
+          status = RunStatus::Interrupted;
+          break;
+        }
+        continue;
+      }
       {
         ScopedStage stage(timers, "write frame data");
         phenomenon->writeFrameData(layout.root, frame);
@@ -274,18 +294,21 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
       record.addFrame(std::move(stats));
       record.save(frame == lastFrame ? "complete" : "running", timers, wall());
       if (options.showProgress) progress.update(frame, substeps);
-      if (interruptRequested() && frame < lastFrame) {
+      if (parallel::anyRank(interruptRequested()) && frame < lastFrame) {
         status = RunStatus::Interrupted;
         break;
       }
     }
   } catch (const std::exception& e) {
     if (options.showProgress) progress.finish();
-    record.note("error", e.what());
-    record.save("failed", timers, wall());
+    if (writer) {
+      record.note("error", e.what());
+      record.save("failed", timers, wall());
+    }
     throw;
   }
   if (options.showProgress) progress.finish();
+  if (!writer) return status;
 
   if (status == RunStatus::Complete) {
     ScopedStage stage(timers, "finish run");

@@ -488,26 +488,34 @@ void SmokeSolver<D>::checkFinite() const {
 }
 
 template <int D>
-SmokeStatistics SmokeSolver<D>::statistics() const {
+SmokeStatistics measureSmoke(const MacGrid<D>& velocity, const MacGrid<D>* weights, const Grid<float, D>& density,
+                             const Grid<float, D>* excluded, double fluidDensity) {
   SmokeStatistics s;
-  const double dV = spec_.cellVolume();
+  const GridSpec<D>& spec = velocity.spec();
+  const double dV = spec.cellVolume();
   for (int a = 0; a < D; ++a) {
-    const auto& u = velocity_.component(a);
-    const auto& w = projection_.faceWeights().component(a);
-    s.kineticEnergy += 0.5 * params_.fluidDensity * dV * parallelSum(u.count(), [&](std::size_t i) {
-      return double(w[i]) * u[i] * u[i];
+    const auto& u = velocity.component(a);
+    const float* w = weights ? weights->component(a).data().data() : nullptr;
+    s.kineticEnergy += 0.5 * fluidDensity * dV * parallelSum(u.count(), [&](std::size_t i) {
+      return (w ? double(w[i]) : 1.0) * u[i] * u[i];
     });
   }
-  s.maxSpeed = maxFaceSpeed(velocity_);
+  s.maxSpeed = maxFaceSpeed(velocity);
+  s.totalDensity = dV * parallelSum(density.count(), [&](std::size_t i) {
+    return excluded && (*excluded)[i] > 0.5f ? 0.0 : double(density[i]);
+  });
+  Vorticity<D> vorticity(spec);
+  computeVorticity(velocity, vorticity);
+  s.enstrophy = enstrophy<D>(vorticity, [](std::size_t) { return true; });
+  return s;
+}
+
+template <int D>
+SmokeStatistics SmokeSolver<D>::statistics() const {
   // The cells each transport keeps scalars in: the Advector overwrites solid cells with their
   // neighbours' mean every step, the conservative transport owns every cell with an open face.
   const Grid<float, D>& excluded = params_.scalarTransport == ScalarTransport::Conservative ? sealed_ : solid_;
-  s.totalDensity = dV * parallelSum(density_.count(), [&](std::size_t i) {
-    return excluded[i] > 0.5f ? 0.0 : double(density_[i]);
-  });
-  Vorticity<D> vorticity(spec_);
-  computeVorticity(velocity_, vorticity);
-  s.enstrophy = enstrophy<D>(vorticity, [](std::size_t) { return true; });
+  SmokeStatistics s = measureSmoke<D>(velocity_, &projection_.faceWeights(), density_, &excluded, params_.fluidDensity);
   s.vortexParticles = vortex_ ? vortex_->particles().size() : 0;
   s.maxDivergence = maxDivergence_;
   s.pressureIterations = pressureIterations_;
@@ -548,6 +556,10 @@ void SmokeSolver<D>::applyWinds(double dt) {
   }
 }
 
+template SmokeStatistics measureSmoke<2>(const MacGrid<2>&, const MacGrid<2>*, const Grid<float, 2>&,
+                                         const Grid<float, 2>*, double);
+template SmokeStatistics measureSmoke<3>(const MacGrid<3>&, const MacGrid<3>*, const Grid<float, 3>&,
+                                         const Grid<float, 3>*, double);
 template void dissipateSmoke<2>(Grid<float, 2>&, Grid<float, 2>&, double, double, double, double);
 template void dissipateSmoke<3>(Grid<float, 3>&, Grid<float, 3>&, double, double, double, double);
 template class SmokeSolver<2>;

@@ -126,6 +126,14 @@ struct SmokeStatistics {
   std::size_t vortexParticles = 0;
 };
 
+// The measures of a smoke state that SmokeSolver::statistics() reports, from its fields: kinetic
+// energy (faces weighted by `weights`; all open when null), fastest face, smoke mass outside the
+// `excluded` cells (all cells when null) and enstrophy. A run split among processes measures the
+// fields gathered on rank 0 with it.
+template <int D>
+SmokeStatistics measureSmoke(const MacGrid<D>& velocity, const MacGrid<D>* weights, const Grid<float, D>& density,
+                             const Grid<float, D>* excluded, double fluidDensity);
+
 // Smoke decays as exp(-densityRate dt) per step and T - T_ambient as exp(-temperatureRate dt)
 // (params.densityDissipation, temperatureDissipation), on whichever grid carries them.
 template <int D>

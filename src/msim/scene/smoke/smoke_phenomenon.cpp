@@ -13,6 +13,9 @@
 #include "msim/fluid/smoke/smoke_solver.hpp"
 #include "msim/io/ply.hpp"
 #include "msim/io/vdb.hpp"
+#include "msim/parallel/ghost_layers.hpp"
+#include "msim/parallel/mpi_domain_split.hpp"
+#include "msim/parallel/mpi_session.hpp"
 #include "msim/render/density_preview.hpp"
 #include "msim/scene/keys/json_vectors.hpp"
 #include "msim/scene/phenomenon_support.hpp"
@@ -46,6 +49,57 @@ double smokeBytesPerCell(int dimensions, const json& resolved) {
   return bytes;
 }
 
+// Under mpirun with several processes the grid is split among them (msim/parallel): each runs
+// the solver on its block, and rank 0 gathers the fields at the end of every frame and writes
+// them. What is not distributed yet is refused here, naming the key.
+[[noreturn]] void refuseSplit(const std::string& file, const std::string& key, const std::string& what) {
+  throw InputError(fmt::format("{}: '{}': {} does not run split among MPI processes yet; run the scene without mpirun",
+                               file, key, what));
+}
+
+template <int D>
+std::unique_ptr<DomainSplit<D>> smokeSplit(const Scene& scene) {
+  const int ranks = parallel::worldSize();
+  if (ranks == 1) return nullptr;
+  const std::string file = scene.file.string();
+  auto refuse = [&](const std::string& key, const std::string& what) { refuseSplit(file, key, what); };
+  const json& r = scene.resolved;
+  const json& smoke = r.at("smoke");
+  if constexpr (D != 3) {
+    refuseSplit(file, "domain.resolution", "a 2D grid");
+  } else {
+    if (!r.at("obstacles").empty()) refuse("obstacles", "smoke around obstacles");
+    if (smoke.at("turbulence").at("enabled").get<bool>()) refuse("smoke.turbulence.enabled", "sub-grid turbulence");
+    if (smoke.at("vortex_particles").at("enabled").get<bool>())
+      refuse("smoke.vortex_particles.enabled", "the vortex particles");
+    if (smoke.at("viscosity").get<double>() > 0.0) refuse("smoke.viscosity", "viscosity");
+    if (smoke.at("advection").at("scalars") == "conservative") refuse("smoke.advection.scalars", "conservative transport");
+    const json& sources = r.at("sources");
+    for (std::size_t i = 0; i < sources.size(); ++i)
+      if (sources[i].at("expansion").get<double>() != 0.0)
+        refuse(fmt::format("sources[{}].expansion", i), "an expanding source");
+    const fluid::SmokeParams<3> p = smokeParams<3>(scene);
+    for (const auto& axis : p.wallVelocity)
+      for (const auto& wall : axis)
+        if (!wall.isZero()) refuse("smoke.wall_velocity", "a moving wall");
+    // Enough ghost layers for the scheme at the solver's CFL number (and blocks at least that thick).
+    const int ghost = parallel::smokeGhostLayers(p.advection, std::max(1.0, p.cfl));
+    const GridSpec<3> global = scene.gridSpec<3>();
+    const parallel::GridBlock<3> block(
+        global, parallel::BlockDecomposition<3>(global.res, ranks, ghost, file + ": mpirun -np " + std::to_string(ranks)),
+        parallel::worldRank(), ghost);
+    return std::make_unique<parallel::MpiDomainSplit>(block, p.sides, p.projection.pcg, MPI_COMM_WORLD);
+  }
+}
+
+// The fields of a split run put together on rank 0 for its outputs.
+template <int D>
+struct GatheredSmoke {
+  Grid<float, D> density, temperature, pressure;
+  MacGrid<D> velocity;
+  std::vector<Grid<float, D>> scalars;
+};
+
 template <int D>
 class SmokePhenomenon final : public Phenomenon {
  public:
@@ -53,8 +107,9 @@ class SmokePhenomenon final : public Phenomenon {
       : source_(scene.file.string()),
         name_(scene.name()),
         timers_(timers),
+        split_(smokeSplit<D>(scene)),
         obstacles_(scene, scene.gridSpec<D>()),
-        solver_(scene.gridSpec<D>(), smokeParams<D>(scene)),
+        solver_(split_ ? split_->localSpec() : scene.gridSpec<D>(), smokeParams<D>(scene)),
         timeCfl_(scene.resolved.at("time").at("cfl").get<double>()) {
     const json& r = scene.resolved;
     for (const auto& axis : solver_.params().wallVelocity)
@@ -75,6 +130,7 @@ class SmokePhenomenon final : public Phenomenon {
     for (auto& wind : turbulentWinds<D>(scene)) solver_.addWind(std::move(wind));
     preview_ = previewSettings(scene);
     preview_.emissionScale = r.at("fire").at("emission").get<double>();
+    if (split_) solver_.setDomainSplit(split_.get());
   }
 
   double stableTimestep() const override {
@@ -85,8 +141,9 @@ class SmokePhenomenon final : public Phenomenon {
     const double cflDt = solver_.cflTimestep();
     double speed = std::isfinite(cflDt) ? p.cfl * dx / cflDt : 0.0;
     speed = std::max({speed, boundarySpeed_, obstacles_.maxSpeed(time_), solver_.maxWindSpeed()});
-    const double hottest = maxValue(solver_.temperature()) - p.buoyancy.ambientTemperature;
-    const double accel = p.buoyancy.beta * std::max(hottest, 0.0) + p.buoyancy.alpha * maxValue(solver_.density());
+    const double hottest = overRanks(maxValue(solver_.temperature())) - p.buoyancy.ambientTemperature;
+    const double accel =
+        p.buoyancy.beta * std::max(hottest, 0.0) + p.buoyancy.alpha * overRanks(maxValue(solver_.density()));
     speed += std::sqrt(dx * accel);
     return speed > 0.0 ? timeCfl_ * p.cfl * dx / speed : std::numeric_limits<double>::infinity();
   }
@@ -130,6 +187,9 @@ class SmokePhenomenon final : public Phenomenon {
   }
 
   void checkFinite(long stepIndex, double time) const override {
+    // A split run's solver checks every step on every rank together (one rank throwing alone
+    // would leave the others waiting).
+    if (split_) return;
     static const char* axes[] = {"velocity x", "velocity y", "velocity z"};
     for (int a = 0; a < D; ++a) requireFinite(solver_.velocity().component(a), axes[a], stepIndex, time);
     requireFinite(solver_.density(), "density", stepIndex, time);
@@ -145,20 +205,33 @@ class SmokePhenomenon final : public Phenomenon {
   // density, temperature (and fuel, flame) for users; "vel" at cell centres in 3D for tools; the
   // face velocities vel_face_x.. and the pressure (the next solve's warm start) make --resume exact;
   // "obstacle_distance" (signed, at cell centres) lets renderers draw the obstacles.
+  // A split run's fields on rank 0 (every rank calls this; only rank 0 writes).
+  void endFrame() override {
+    if (!split_) return;
+    ScopedStage stage(timers_, "smoke: gather frame");
+    GatheredSmoke<D>& g = gathered_;
+    split_->gather(solver_.density(), g.density);
+    split_->gather(solver_.temperature(), g.temperature);
+    split_->gather(solver_.pressure(), g.pressure);
+    split_->gather(solver_.velocity(), g.velocity);
+    g.scalars.resize(solver_.scalarCount());
+    for (std::size_t i = 0; i < solver_.scalarCount(); ++i) split_->gather(solver_.scalar(i), g.scalars[i]);
+  }
+
   void writeVolume(io::VdbWriter& writer) const override {
     // With turbulence the smoke lives on the fine grid; the coarse scalars are its averages.
-    writer.addFogVolume("density", turbulence_ ? turbulence_->density() : solver_.density());
-    writer.addFloatGrid("temperature", turbulence_ ? turbulence_->temperature() : solver_.temperature());
+    writer.addFogVolume("density", turbulence_ ? turbulence_->density() : density());
+    writer.addFloatGrid("temperature", turbulence_ ? turbulence_->temperature() : temperature());
     if (turbulence_) writer.addFloatGrid("turbulent_energy", turbulence_->energy().energy());
-    for (std::size_t i = 0; i < solver_.scalarCount(); ++i) writer.addFogVolume(solver_.scalarName(i), solver_.scalar(i));
+    for (std::size_t i = 0; i < solver_.scalarCount(); ++i) writer.addFogVolume(solver_.scalarName(i), scalar(i));
     if constexpr (D == 3) {
       if (turbulence_ && turbulence_->params().writeVelocity)
         writer.addVectorGrid("vel", turbulence_->fineVelocity(solver_.velocity()));
       else
-        writer.addVectorGrid("vel", solver_.velocity());
+        writer.addVectorGrid("vel", velocity());
     }
-    writeFaceVelocities(writer, solver_.velocity());
-    writer.addFloatGrid("pressure", solver_.pressure());
+    writeFaceVelocities(writer, velocity());
+    writer.addFloatGrid("pressure", split_ ? gathered_.pressure : solver_.pressure());
     if (!obstacles_.empty()) writer.addLevelSet("obstacle_distance", obstacles_.cellDistance(time_));
     if (solver_.vortexLayer())
       writer.addPoints(kVortexPoints, vortexParticleCloud(solver_.vortexLayer()->particles()), solver_.spec().dx);
@@ -179,8 +252,8 @@ class SmokePhenomenon final : public Phenomenon {
                                           obstacles_.empty() ? nullptr : &turbulence_->fineSolid());
     const Grid<float, D>* solid = obstacles_.empty() ? nullptr : &solver_.solid();
     render::PreviewEmission<D> emission;
-    if (combustion_) emission = {&solver_.scalar(flame_), &solver_.temperature()};
-    return render::renderDensityPreview(solver_.density(), preview_, solid, emission);
+    if (combustion_) emission = {&scalar(flame_), &temperature()};
+    return render::renderDensityPreview(density(), preview_, solid, emission);
   }
 
   void restore(const std::filesystem::path& vdbFile, double time) override {
@@ -213,13 +286,21 @@ class SmokePhenomenon final : public Phenomenon {
   }
 
   json statistics() const override {
-    const fluid::SmokeStatistics s = solver_.statistics();
+    fluid::SmokeStatistics s = solver_.statistics();
+    if (split_) {  // measured on the gathered fields; the solver's own numbers are already reduced
+      const fluid::SmokeStatistics whole =
+          fluid::measureSmoke<D>(gathered_.velocity, nullptr, gathered_.density, nullptr, solver_.params().fluidDensity);
+      s.kineticEnergy = whole.kineticEnergy;
+      s.maxSpeed = whole.maxSpeed;
+      s.totalDensity = whole.totalDensity;
+      s.enstrophy = whole.enstrophy;
+    }
     json j = {{"smoke_mass_kg", s.totalDensity},
               {"kinetic_energy_J", s.kineticEnergy},
               {"max_speed_m_s", s.maxSpeed},
               {"max_divergence_1_s", s.maxDivergence},
               {"pressure_iterations", s.pressureIterations},
-              {"max_temperature_K", maxValue(solver_.temperature())}};
+              {"max_temperature_K", maxValue(temperature())}};
     if (turbulence_) {
       j["turbulent_energy_integral"] = turbulence_->energy().integral();
       j["turbulent_kinetic_energy"] = turbulence_->turbulentKineticEnergy();
@@ -231,8 +312,8 @@ class SmokePhenomenon final : public Phenomenon {
     if (solver_.vortexLayer()) j["vortex_particles"] = s.vortexParticles;
     if (combustion_) {
       const double dV = solver_.spec().cellVolume();
-      j["fuel_kg"] = dV * total(solver_.scalar(fuel_));
-      j["flame_kg"] = dV * total(solver_.scalar(flame_));
+      j["fuel_kg"] = dV * total(scalar(fuel_));
+      j["flame_kg"] = dV * total(scalar(flame_));
     }
     return j;
   }
@@ -244,6 +325,12 @@ class SmokePhenomenon final : public Phenomenon {
   static double total(const Grid<float, D>& g) {
     return parallelSum(g.count(), [&](std::size_t i) { return double(g[i]); });
   }
+  double overRanks(double value) const { return split_ ? split_->maxOverRanks(value) : value; }
+  // The fields the outputs show: the solver's, or in a split run those gathered on rank 0.
+  const Grid<float, D>& density() const { return split_ ? gathered_.density : solver_.density(); }
+  const Grid<float, D>& temperature() const { return split_ ? gathered_.temperature : solver_.temperature(); }
+  const MacGrid<D>& velocity() const { return split_ ? gathered_.velocity : solver_.velocity(); }
+  const Grid<float, D>& scalar(std::size_t i) const { return split_ ? gathered_.scalars[i] : solver_.scalar(i); }
 
   static constexpr const char* kVortexPoints = "vortex_particles";
 
@@ -277,7 +364,8 @@ class SmokePhenomenon final : public Phenomenon {
       const std::string key = fmt::format("sources[{}]", i);
       fluid::SmokeSource<D> src;
       const auto shape = sceneShape<D>(scene, s.at("shape"), key + ".shape");
-      src.cells = coveredOpenCells<D>(scene, *shape, solver_.solid(), key + ".shape");
+      // A split run's source may lie in other ranks' blocks: it must cover some cell of one.
+      src.cells = coveredOpenCells<D>(scene, *shape, solver_.solid(), key + ".shape", split_.get());
       src.mode = s.at("mode") == "set" ? fluid::SmokeSource<D>::Mode::Set : fluid::SmokeSource<D>::Mode::Add;
       src.density = s.at("density").get<double>();
       src.temperature = s.at("temperature").get<double>();
@@ -322,6 +410,8 @@ class SmokePhenomenon final : public Phenomenon {
 
   std::string source_, name_;
   StageTimers& timers_;
+  std::unique_ptr<DomainSplit<D>> split_;  // null on one process
+  GatheredSmoke<D> gathered_;              // split runs, rank 0: the last frame's fields
   SceneObstacles<D> obstacles_;
   fluid::SmokeSolver<D> solver_;
   double timeCfl_;
@@ -345,7 +435,7 @@ PhenomenonType smokePhenomenonType() {
   return {"smoke",
           "incompressible smoke and fire on a MAC grid: high-order advection, pressure projection, buoyancy, "
           "vorticity confinement, combustion (Selle ch. 2-3, Stam ch. 6.4)",
-          &declareSmokeKeys, &smokeBytesPerCell, &createSmoke};
+          &declareSmokeKeys, &smokeBytesPerCell, &createSmoke, true};
 }
 
 }  // namespace msim::scene

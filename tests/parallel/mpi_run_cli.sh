@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# `mpirun -np 2 msim run` on a 3D smoke scene: the statistics of the one-process run (within what
+# the two pressure solvers' tolerances leave), each frame written once by rank 0; bad input
+# reported by rank 0 alone with exit code 2 and nothing written; a failure on one rank stops all.
+# Usage: mpi_run_cli.sh MSIM SCENES_DIR TMP_DIR
+set -euo pipefail
+msim=$1
+scenes=$2
+tmp=$3
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+two=(timeout 300 mpirun -np 2 --oversubscribe --bind-to none "$msim")
+rm -rf "$tmp"
+mkdir -p "$tmp"
+short=(--set domain.resolution=32 --frames 6 -q)
+
+"$msim" run "$scenes/plume_3d.json" --out "$tmp/one" "${short[@]}"
+"${two[@]}" run "$scenes/plume_3d.json" --out "$tmp/two" "${short[@]}"
+python3 - "$tmp/one/run.json" "$tmp/two/run.json" <<'PY'
+import json, sys
+one, two = (json.load(open(p)) for p in sys.argv[1:3])
+assert two["status"] == "complete", two["status"]
+assert two.get("mpi_processes") == "2", two.get("mpi_processes")
+a, b = one["frames"][-1], two["frames"][-1]
+for key in ("smoke_mass_kg", "kinetic_energy_J", "max_speed_m_s", "enstrophy"):
+    rel = abs(a[key] - b[key]) / abs(a[key])
+    print(f"{key}: 1 process {a[key]:.9g}, 2 processes {b[key]:.9g}, relative difference {rel:.1e}")
+    assert rel < 1e-4, key
+PY
+[[ $(ls "$tmp/two/vdb" | wc -l) -eq 6 && $(ls "$tmp/two/png" | wc -l) -eq 6 ]] || { echo "expected 6 frames"; exit 1; }
+
+expect_failure() {  # expect_failure CODE PATTERN ARGS...: exit CODE, PATTERN in one message
+  local code=$1 pattern=$2
+  shift 2
+  set +e
+  out=$("${two[@]}" "$@" 2>&1)
+  rc=$?
+  set -e
+  [[ $rc -eq $code ]] || { echo "msim $*: exit $rc, expected $code"; echo "$out"; exit 1; }
+  [[ $(grep -c "msim.*error" <<< "$out") -eq 1 ]] || { echo "msim $*: expected one error message:"; echo "$out"; exit 1; }
+  grep -q -- "$pattern" <<< "$out" || { echo "msim $*: no '$pattern' in:"; echo "$out"; exit 1; }
+}
+expect_failure 2 "smoke.viscosity" run "$scenes/plume_3d.json" --out "$tmp/bad" --set smoke.viscosity=0.001 -q
+expect_failure 2 "cannot split" run "$scenes/plume_3d.json" --out "$tmp/bad" --set domain.resolution=4 -q
+[[ ! -e "$tmp/bad" ]] || { echo "bad input left $tmp/bad behind"; exit 1; }
+# Rank 0 cannot create its output folder: it stops every rank (no hang) with a non-zero exit.
+set +e
+"${two[@]}" run "$scenes/plume_3d.json" --out /proc/msim_cannot_write "${short[@]}" > "$tmp/abort.log" 2>&1
+rc=$?
+set -e
+[[ $rc -ne 0 && $rc -ne 124 ]] || { echo "a failing rank: exit $rc (124: hung)"; cat "$tmp/abort.log"; exit 1; }
+echo "ok: 2-process run matches, bad input exits 2 from rank 0, a failing rank stops the job (exit $rc)"
