@@ -5,7 +5,7 @@ SCENE ?= scenes/steam.json
 OUT ?= out/steam
 JOBS ?= $(shell nproc)
 
-.PHONY: deps configure build app run test sanitize bench clean
+.PHONY: deps configure build app run run-mpi test sanitize bench clean
 
 deps:
 	@bash scripts/install-deps.sh
@@ -22,6 +22,15 @@ app: configure
 
 run: app
 	$(BUILD_DIR)/bin/msim run $(SCENE) --out $(OUT)
+
+# A 3D smoke scene split among NP processes (docs/parallel.md). OpenMPI refuses root without the
+# two variables (containers); --oversubscribe lets NP exceed the cores.
+NP ?= 2
+MPI_SCENE ?= scenes/plume_3d.json
+MPI_OUT ?= out/plume_3d_mpi
+run-mpi: app
+	OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun -np $(NP) --oversubscribe --bind-to none \
+		$(BUILD_DIR)/bin/msim run $(MPI_SCENE) --out $(MPI_OUT)
 
 test: build
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)

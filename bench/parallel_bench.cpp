@@ -60,6 +60,7 @@ void BM_SplitSmokeStep(benchmark::State& state) {
   solver.setDomainSplit(&split);
   const double dt = 0.5 / n;  // half a cell per step at 1 m/s
   for (int s = 0; s < 2; ++s) solver.step(dt);
+  const std::size_t bytesBefore = split.receivedGhostBytes();
   for (auto _ : state) {
     MPI_Barrier(MPI_COMM_WORLD);
     const double start = MPI_Wtime();
@@ -69,6 +70,9 @@ void BM_SplitSmokeStep(benchmark::State& state) {
   }
   state.counters["ranks"] = parallel::worldSize();
   state.counters["cells"] = static_cast<double>(global.cellCount());
+  // Rank 0's ghost traffic per step (the communication-volume model of docs/parallel.md).
+  state.counters["ghost_MB_per_step"] =
+      static_cast<double>(split.receivedGhostBytes() - bytesBefore) / 1e6 / static_cast<double>(state.iterations());
 }
 BENCHMARK(BM_SplitSmokeStep)
     ->ArgsProduct({{64, 128, 256}, {1, 2}})

@@ -84,6 +84,20 @@ void GhostExchange<T, D>::exchange(Grid<T, D>& local) {
   for (Peer& p : peers_) unpackBox(local, origin_, p.receive, p.receiveBuffer.data());
 }
 
+template <typename T, int D>
+std::size_t GhostExchange<T, D>::receivedSamples() const {
+  std::size_t n = 0;
+  for (const Peer& p : peers_) n += p.receiveBuffer.size();
+  return n;
+}
+
+template <int D>
+std::size_t MacGhostExchange<D>::receivedSamples() const {
+  std::size_t n = 0;
+  for (const auto& c : components_) n += c.receivedSamples();
+  return n;
+}
+
 template <int D>
 MacGhostExchange<D>::MacGhostExchange(const GridBlock<D>& block, MPI_Comm comm) {
   for (int a = 0; a < D; ++a) components_.emplace_back(block, IVec<D>::Unit(a), comm);

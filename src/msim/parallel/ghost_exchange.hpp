@@ -30,6 +30,8 @@ class GhostExchange {
   // Fills the ghost samples of `local` (a field over block.localSpec() with this layout) from
   // their owners. Collective: every rank of comm calls it for the same field.
   void exchange(Grid<T, D>& local);
+  // Samples one exchange brings into this rank's ghost layers (the communication volume).
+  std::size_t receivedSamples() const;
 
  private:
   struct Peer {
@@ -49,6 +51,7 @@ class MacGhostExchange {
  public:
   MacGhostExchange(const GridBlock<D>& block, MPI_Comm comm);
   void exchange(MacGrid<D>& local);
+  std::size_t receivedSamples() const;
 
  private:
   std::vector<GhostExchange<float, D>> components_;
