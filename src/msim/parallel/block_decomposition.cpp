@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <limits>
 
 #include "msim/core/error.hpp"
@@ -119,6 +120,17 @@ IndexBox<D> BlockDecomposition<D>::ownedCells(int rank) const {
     box.hi[a] = static_cast<int>((c[a] + 1) * n / p);
   }
   return box;
+}
+
+// Block k holds cell c when floor(k n / p) <= c < floor((k + 1) n / p), i.e. k = floor(((c + 1) p - 1) / n).
+template <int D>
+int BlockDecomposition<D>::ownerOfCell(const IVec<D>& c) const {
+  IVec<D> k;
+  for (int a = 0; a < D; ++a) {
+    const long long n = res_[a], p = blocks_[a], cell = std::clamp<long long>(c[a], 0, n - 1);
+    k[a] = static_cast<int>(((cell + 1) * p - 1) / n);
+  }
+  return rankAt(k);
 }
 
 template class BlockDecomposition<2>;

@@ -44,6 +44,8 @@ class BlockDecomposition {
   int rankAt(const IVec<D>& c) const;
   // The cells rank r owns.
   IndexBox<D> ownedCells(int rank) const;
+  // The rank that owns cell c (clamped into the grid).
+  int ownerOfCell(const IVec<D>& c) const;
 
  private:
   IVec<D> res_;
