@@ -1,7 +1,8 @@
 // A 3D smoke step split among MPI processes (msim/parallel): run under mpirun, e.g.
 //   mpirun -np 1 build/release/bench/parallel_bench --benchmark_filter=/256/1
 //   mpirun -np 2 build/release/bench/parallel_bench --benchmark_filter=/256/1
-// The arguments are the grid's cells per axis and oneTBB threads per process. Every rank times
+// BM_SplitSmokeStep (strong scaling): the grid's cells per axis and oneTBB threads per process;
+// BM_SplitSmokeStepWeak: n^3 cells per process (the grid grows along z), one thread each. Every rank times
 // the same steps between barriers; rank 0 reports. The plume is the one of the distributed smoke
 // test (hot smoke with inflow, buoyancy, vorticity confinement, MacCormack, open top), warmed up
 // for two steps so the pressure solve has work.
@@ -45,10 +46,10 @@ fluid::SmokeSource<3> plumeSource(const GridSpec<3>& spec) {
   return src;
 }
 
-void BM_SplitSmokeStep(benchmark::State& state) {
-  const int n = static_cast<int>(state.range(0));
-  tbb::global_control threads(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(state.range(1)));
-  const GridSpec<3> global(Vec<3>::Zero(), 1.0 / n, IVec<3>::Constant(n));
+// Steps of the plume on `global`, split among the ranks; time per step between barriers.
+void runSplitSmoke(benchmark::State& state, const GridSpec<3>& global, int threadCount) {
+  const int n = global.res.minCoeff();
+  tbb::global_control threads(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threadCount));
   const fluid::SmokeParams<3> params = plumeParams();
   const int ghost = parallel::smokeGhostLayers(params.advection, 1.0);
   const parallel::GridBlock<3> block(
@@ -69,10 +70,16 @@ void BM_SplitSmokeStep(benchmark::State& state) {
     state.SetIterationTime(MPI_Wtime() - start);
   }
   state.counters["ranks"] = parallel::worldSize();
+  state.counters["cells_per_rank"] = static_cast<double>(global.cellCount()) / parallel::worldSize();
   state.counters["cells"] = static_cast<double>(global.cellCount());
   // Rank 0's ghost traffic per step (the communication-volume model of docs/parallel.md).
   state.counters["ghost_MB_per_step"] =
       static_cast<double>(split.receivedGhostBytes() - bytesBefore) / 1e6 / static_cast<double>(state.iterations());
+}
+// Strong scaling: one n^3 grid, whatever the rank count.
+void BM_SplitSmokeStep(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  runSplitSmoke(state, GridSpec<3>(Vec<3>::Zero(), 1.0 / n, IVec<3>::Constant(n)), static_cast<int>(state.range(1)));
 }
 BENCHMARK(BM_SplitSmokeStep)
     ->ArgsProduct({{64, 128, 256}, {1, 2}})
@@ -80,6 +87,13 @@ BENCHMARK(BM_SplitSmokeStep)
     ->UseManualTime()
     ->Iterations(3)
     ->Unit(benchmark::kMillisecond);
+
+// Weak scaling: n^3 cells per rank, the grid growing along z with the rank count.
+void BM_SplitSmokeStepWeak(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  runSplitSmoke(state, GridSpec<3>(Vec<3>::Zero(), 1.0 / n, IVec<3>(n, n, n * parallel::worldSize())), 1);
+}
+BENCHMARK(BM_SplitSmokeStepWeak)->Arg(128)->ArgName("n")->UseManualTime()->Iterations(3)->Unit(benchmark::kMillisecond);
 
 // Reports nothing: the ranks other than 0 run the same steps silently.
 class SilentReporter : public benchmark::BenchmarkReporter {

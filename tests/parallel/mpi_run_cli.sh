@@ -41,7 +41,14 @@ expect_failure() {  # expect_failure CODE PATTERN ARGS...: exit CODE, PATTERN in
 }
 expect_failure 2 "smoke.viscosity" run "$scenes/plume_3d.json" --out "$tmp/bad" --set smoke.viscosity=0.001 -q
 expect_failure 2 "cannot split" run "$scenes/plume_3d.json" --out "$tmp/bad" --set domain.resolution=4 -q
+expect_failure 2 "mpi.ghost_layers" run "$scenes/plume_3d.json" --out "$tmp/bad" --set mpi.ghost_layers=2 -q
+expect_failure 2 "mpi.blocks" run "$scenes/plume_3d.json" --out "$tmp/bad" --set 'mpi.blocks=[3,1,1]' -q
 [[ ! -e "$tmp/bad" ]] || { echo "bad input left $tmp/bad behind"; exit 1; }
+# A given lattice and wider ghost layers give the same run.
+"${two[@]}" run "$scenes/plume_3d.json" --out "$tmp/given" "${short[@]}" --set 'mpi.blocks=[1,1,2]' --set mpi.ghost_layers=5
+cmp <(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['frames'][-1]['smoke_mass_kg'])" "$tmp/two/run.json") \
+    <(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['frames'][-1]['smoke_mass_kg'])" "$tmp/given/run.json") \
+  || { echo "mpi.blocks = [1,1,2] changed the run"; exit 1; }
 # Rank 0 cannot create its output folder: it stops every rank (no hang) with a non-zero exit.
 set +e
 "${two[@]}" run "$scenes/plume_3d.json" --out /proc/msim_cannot_write "${short[@]}" > "$tmp/abort.log" 2>&1

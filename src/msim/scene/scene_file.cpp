@@ -50,6 +50,14 @@ Schema timeSchema() {
   return time;
 }
 
+Schema mpiSchema() {
+  Schema mpi = Schema::object("how `mpirun -np N msim run` splits the grid among the N processes (docs/parallel.md)");
+  mpi.integer("ghost_layers", 0, "cells each block keeps of its neighbours; 0: what the schemes read").min(0);
+  mpi.vector("blocks", "", {0.0, 0.0, 0.0},
+             "processes along x, y, z (their product is N); zeros: the lattice with the least interface");
+  return mpi;
+}
+
 Schema outputsSchema() {
   Schema outputs = Schema::object("what each frame writes");
   outputs.boolean("vdb", true, "OpenVDB volumes per frame (needed by --resume)");
@@ -98,6 +106,7 @@ Schema sceneSchema(const PhenomenonType& type) {
   root.field("domain", domainSchema());
   root.field("time", timeSchema());
   root.field("outputs", outputsSchema());
+  root.field("mpi", mpiSchema());
   root.field("render", renderSchema());
   type.declare(root);
   return root;

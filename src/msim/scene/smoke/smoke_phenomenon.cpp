@@ -83,11 +83,33 @@ std::unique_ptr<DomainSplit<D>> smokeSplit(const Scene& scene) {
       for (const auto& wall : axis)
         if (!wall.isZero()) refuse("smoke.wall_velocity", "a moving wall");
     // Enough ghost layers for the scheme at the solver's CFL number (and blocks at least that thick).
-    const int ghost = parallel::smokeGhostLayers(p.advection, std::max(1.0, p.cfl));
+    const int needed = parallel::smokeGhostLayers(p.advection, std::max(1.0, p.cfl));
+    const json& mpi = r.at("mpi");
+    const int asked = mpi.at("ghost_layers").get<int>();
+    if (asked > 0 && asked < needed)
+      throw InputError(fmt::format("{}: 'mpi.ghost_layers' is {} but this smoke reads {} layers of its neighbours "
+                                   "(its advection at CFL {:g} and vorticity confinement); use {} or more, or 0",
+                                   file, asked, needed, p.cfl, needed));
+    const int ghost = asked > 0 ? asked : needed;
     const GridSpec<3> global = scene.gridSpec<3>();
-    const parallel::GridBlock<3> block(
-        global, parallel::BlockDecomposition<3>(global.res, ranks, ghost, file + ": mpirun -np " + std::to_string(ranks)),
-        parallel::worldRank(), ghost);
+    const Vec<3> blocks = sceneVector<3>(mpi.at("blocks"));
+    IVec<3> lattice;
+    for (int a = 0; a < 3; ++a) {
+      if (!(blocks[a] >= 0.0) || blocks[a] != std::floor(blocks[a]) || blocks[a] > ranks)
+        throw InputError(fmt::format("{}: 'mpi.blocks' must hold whole numbers from 0 to {} (got {})", file, ranks,
+                                     blocks[a]));
+      lattice[a] = static_cast<int>(blocks[a]);
+    }
+    if (!lattice.isZero() && (lattice.array() == 0).any())
+      throw InputError(fmt::format("{}: 'mpi.blocks' sets some axes but not all: give all three or none", file));
+    const parallel::BlockDecomposition<3> decomposition =
+        lattice.isZero() ? parallel::BlockDecomposition<3>(global.res, ranks, ghost,
+                                                           file + ": mpirun -np " + std::to_string(ranks))
+                         : parallel::BlockDecomposition<3>(global.res, lattice, ghost, file + ": 'mpi.blocks'");
+    if (decomposition.ranks() != ranks)
+      throw InputError(fmt::format("{}: 'mpi.blocks' makes {} blocks for {} processes (mpirun -np {})", file,
+                                   decomposition.ranks(), ranks, ranks));
+    const parallel::GridBlock<3> block(global, decomposition, parallel::worldRank(), ghost);
     return std::make_unique<parallel::MpiDomainSplit>(block, p.sides, p.projection.pcg, MPI_COMM_WORLD);
   }
 }
