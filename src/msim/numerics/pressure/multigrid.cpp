@@ -1,5 +1,7 @@
 #include "msim/numerics/pressure/multigrid.hpp"
 
+#include <algorithm>
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -21,10 +23,17 @@ inline float weight1D(int f, int C, int coarseCount) {
   return (C == J && hasJ) ? 0.25f : 0.0f;
 }
 
+// Cells per axis of the next coarser level: an odd count rounds up, its last coarse cell then
+// covering one fine cell (and the domain side beyond it).
+template <int D>
+IVec<D> coarserResolution(const IVec<D>& res) {
+  return ((res.array() + 1) / 2).matrix();
+}
+
 template <int D>
 bool canCoarsen(const IVec<D>& res, int minCells) {
   for (int a = 0; a < D; ++a)
-    if (res[a] % 2 != 0 || res[a] / 2 < minCells) return false;
+    if ((res[a] + 1) / 2 < minCells) return false;
   return true;
 }
 
@@ -33,22 +42,29 @@ bool canCoarsen(const IVec<D>& res, int minCells) {
 template <int D>
 MacGrid<D> coarsenFaceWeights(const MacGrid<D>& fine) {
   const GridSpec<D>& fs = fine.spec();
-  const GridSpec<D> cs(fs.origin, 2.0 * fs.dx, (fs.res / 2).eval());
+  const GridSpec<D> cs(fs.origin, 2.0 * fs.dx, coarserResolution<D>(fs.res));
   MacGrid<D> coarse(cs);
   constexpr int kSub = 1 << (D - 1);
   for (int a = 0; a < D; ++a) {
     const auto& wf = fine.component(a);
     auto& wc = coarse.component(a);
     parallelForCells(wc, [&](const IVec<D>& F, std::size_t lin) {
+      // The fine faces the coarse face covers. Along an odd axis the last coarse cell holds one
+      // fine cell: its upper side is the domain's (fine face res), and across it only the fine
+      // faces that exist count.
       float sum = 0.0f;
+      int count = 0;
       for (int m = 0; m < kSub; ++m) {
         IVec<D> f = 2 * F;
+        f[a] = std::min(f[a], fs.res[a]);
         int bit = 0;
         for (int b = 0; b < D; ++b)
           if (b != a) f[b] += (m >> bit++) & 1;
+        if (!wf.inside(f)) continue;
         sum += wf(f);
+        ++count;
       }
-      wc[lin] = sum / kSub;
+      wc[lin] = count > 0 ? sum / static_cast<float>(count) : 0.0f;
     });
   }
   return coarse;
@@ -57,7 +73,7 @@ MacGrid<D> coarsenFaceWeights(const MacGrid<D>& fine) {
 template <int D>
 std::vector<float> coarsenDirichletDiagonal(const std::vector<float>& fine, const IVec<D>& fineRes) {
   if (fine.empty()) return {};
-  const IVec<D> res = fineRes / 2;
+  const IVec<D> res = coarserResolution<D>(fineRes);
   std::size_t n = 1;
   for (int a = 0; a < D; ++a) n *= static_cast<std::size_t>(res[a]);
   std::vector<float> coarse(n, 0.0f);
@@ -66,11 +82,14 @@ std::vector<float> coarsenDirichletDiagonal(const std::vector<float>& fine, cons
     float sum = 0.0f;
     for (int k = 0; k < (1 << D); ++k) {
       std::size_t f = 0, stride = 1;
+      bool inside = true;
       for (int a = 0; a < D; ++a) {
-        f += static_cast<std::size_t>(2 * C[a] + ((k >> a) & 1)) * stride;
+        const int c = 2 * C[a] + ((k >> a) & 1);
+        inside = inside && c < fineRes[a];  // the last coarse cell of an odd axis has one child
+        f += static_cast<std::size_t>(c) * stride;
         stride *= static_cast<std::size_t>(fineRes[a]);
       }
-      sum += fine[f];
+      if (inside) sum += fine[f];
     }
     coarse[lin] = sum * kShare;
   });
@@ -88,7 +107,7 @@ MultigridPreconditioner<D>::MultigridPreconditioner(const PoissonMatrix<D>& fine
   IVec<D> res = fine.res();
   int levels = 1;
   while (canCoarsen<D>(res, settings.coarsestMinCells)) {
-    res /= 2;
+    res = coarserResolution<D>(res);
     ++levels;
   }
   coarse_.reserve(levels - 1);  // matrices_ points into coarse_, which must not reallocate

@@ -31,10 +31,13 @@ struct MultigridSettings {
   int boundaryBand = 2;       // cells within this many face steps of a partly or fully closed face
 };
 
-// Face weights of the grid with half the resolution (res must be even on every axis).
+// Face weights of the grid with half the resolution (an odd cell count rounds up: the last coarse
+// cell covers one fine cell, and its side on the domain's border takes the fine border face's
+// weight).
 template <int D>
 MacGrid<D> coarsenFaceWeights(const MacGrid<D>& fine);
-// Dirichlet diagonal terms of the grid with half the resolution: the children's sum over 2^(D-1).
+// Dirichlet diagonal terms of the grid with half the resolution: the children's sum over 2^(D-1)
+// (one or two children fewer in the last cell of an odd axis).
 template <int D>
 std::vector<float> coarsenDirichletDiagonal(const std::vector<float>& fine, const IVec<D>& fineRes);
 
