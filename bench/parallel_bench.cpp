@@ -1,8 +1,8 @@
 // The 3D smoke plume of scenes/plume_3d.json stepped on a grid split among MPI processes
 // (msim/parallel), through the smoke phenomenon exactly as `mpirun -np N msim run` does. Run
 // under mpirun, e.g.
-//   mpirun -np 1 build/release/bench/parallel_bench --benchmark_filter=Strong/r:224/threads:1
-//   mpirun -np 2 build/release/bench/parallel_bench --benchmark_filter=Strong/r:224/threads:1
+//   mpirun -np 1 build/release/bench/parallel_bench --benchmark_filter=Strong/r:336/threads:1
+//   mpirun -np 2 build/release/bench/parallel_bench --benchmark_filter=Strong/r:336/threads:1
 // Every rank times the same steps between barriers; rank 0 reports. Two warm-up steps first, so
 // the plume has risen and the pressure solve has work.
 #include <benchmark/benchmark.h>
@@ -44,13 +44,13 @@ void runPlume(benchmark::State& state, const std::vector<std::string>& overrides
   state.counters["cells_per_rank"] = static_cast<double>(s.cellCount()) / parallel::worldSize();
 }
 
-// Strong scaling: the plume at `r` cells along its tallest axis (r x 1.5 r x r cells: r = 224 is
-// 16.9M cells), whatever the process count.
+// Strong scaling: the plume at `r` cells along its tallest axis (2/3 r x r x 2/3 r cells: r = 336
+// is 16.9M cells, as many as 256^3), whatever the process count.
 void BM_Strong(benchmark::State& state) {
   runPlume(state, {fmt::format("domain.resolution={}", state.range(0))}, static_cast<int>(state.range(1)));
 }
 BENCHMARK(BM_Strong)
-    ->ArgsProduct({{64, 128, 224}, {1, 2}})
+    ->ArgsProduct({{64, 128, 336}, {1, 2}})
     ->ArgNames({"r", "threads"})
     ->UseManualTime()
     ->Iterations(3)

@@ -39,6 +39,23 @@ TEST(GhostExchange, FillsEveryGhostWithItsOwnersValueOnEveryLayout) {
   }
 }
 
+// The communication model of docs/parallel.md: two blocks of an n^3 grid split across x receive,
+// per exchange, g n^2 cell samples and g n (n + 1) of each face component across the cut; along
+// it, the lower block g + 1 layers (the face on the cut is the upper block's), the upper g.
+TEST(GhostExchange, ReceivesTheVolumeTheCommunicationModelCounts) {
+  if (worldSize() != 2) GTEST_SKIP() << "the model's case is two blocks";
+  const int n = 24, g = 3;
+  const GridSpec<3> global(Vec<3>::Zero(), 1.0 / n, IVec<3>::Constant(n));
+  const GridBlock<3> block(global, BlockDecomposition<3>(global.res, IVec<3>(2, 1, 1), g, "test"), worldRank(), g);
+  const GhostExchange<float, 3> cells(block, IVec<3>::Zero(), MPI_COMM_WORLD);
+  const GhostExchange<float, 3> facesAlong(block, IVec<3>::Unit(0), MPI_COMM_WORLD);
+  const int along = worldRank() == 0 ? g + 1 : g;
+  EXPECT_EQ(cells.receivedSamples(), std::size_t(g * n * n));
+  EXPECT_EQ(facesAlong.receivedSamples(), std::size_t(along * n * n));
+  EXPECT_EQ(MacGhostExchange<3>(block, MPI_COMM_WORLD).receivedSamples(),
+            std::size_t(along * n * n + 2 * g * n * (n + 1)));
+}
+
 TEST(BlockDecomposition, ChoosesTheLatticeOfLeastInterface) {
   // 8 ranks on a long grid: slabs across the long axis cut the fewest faces.
   EXPECT_EQ(BlockDecomposition<3>(IVec<3>(256, 32, 32), 8, 4, "k").blocks(), IVec<3>(8, 1, 1));

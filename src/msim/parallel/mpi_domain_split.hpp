@@ -22,14 +22,8 @@ class MpiDomainSplit final : public DomainSplit<3> {
   int ghostLayers() const override { return block_.ghost; }
   IVec<3> ownedLo() const override { return block_.ownedLocal().lo; }
   IVec<3> ownedHi() const override { return block_.ownedLocal().hi; }
-  void exchange(Grid<float, 3>& cells) override {
-    cells_.exchange(cells);
-    receivedBytes_ += cells_.receivedSamples() * sizeof(float);
-  }
-  void exchange(MacGrid<3>& faces) override {
-    faces_.exchange(faces);
-    receivedBytes_ += faces_.receivedSamples() * sizeof(float);
-  }
+  void exchange(Grid<float, 3>& cells) override { cells_.exchange(cells); }
+  void exchange(MacGrid<3>& faces) override { faces_.exchange(faces); }
   void gather(const Grid<float, 3>& local, Grid<float, 3>& global) override;
   void gather(const MacGrid<3>& local, MacGrid<3>& global) override;
   bool root() const override { return block_.rank == 0; }
@@ -37,9 +31,6 @@ class MpiDomainSplit final : public DomainSplit<3> {
   SplitSolveStats project(MacGrid<3>& velocity, double dt, double density) override;
 
   const GridBlock<3>& block() const { return block_; }
-  // Bytes the ghost exchanges have brought into this rank so far (the pressure solve's traffic,
-  // inside hypre, is not counted).
-  std::size_t receivedGhostBytes() const { return receivedBytes_; }
   MPI_Comm comm() const { return comm_; }
 
  private:
@@ -48,7 +39,6 @@ class MpiDomainSplit final : public DomainSplit<3> {
   GhostExchange<float, 3> cells_;
   MacGhostExchange<3> faces_;
   DistributedProjection projection_;
-  std::size_t receivedBytes_ = 0;
 };
 
 }  // namespace msim::parallel
