@@ -1,5 +1,5 @@
-// A 3D smoke plume (sources with inflow, buoyancy, vorticity confinement, MacCormack, open top)
-// run for 50 steps split among the ranks gives the density of the same run on one rank within
+// A 3D smoke plume (sources with inflow, buoyancy, vorticity confinement, MacCormack, open top),
+// alone and split by a ball, run for 50 steps split among the ranks gives the density of the same run on one rank within
 // 1e-4 relative (the check), and stays close to the serial solver with its own MG-PCG.
 #include <gtest/gtest.h>
 
@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "msim/fluid/smoke/smoke_solver.hpp"
+#include "msim/numerics/pressure/face_fractions.hpp"
 #include "msim/parallel/ghost_layers.hpp"
 #include "msim/parallel/mpi_domain_split.hpp"
 #include "msim/parallel/mpi_session.hpp"
@@ -53,8 +54,12 @@ fluid::SmokeSource<3> plumeSource(const GridSpec<3>& spec) {
   return src;
 }
 
-Grid<float, 3> runPlume(const GridSpec<3>& spec, DomainSplit<3>* split) {
+// The ball the plume splits around in the obstacle variant (negative inside).
+double ballDistance(const Vec<3>& x) { return (x - Vec<3>(0.5, 0.55, 0.45)).norm() - 0.13; }
+
+Grid<float, 3> runPlume(const GridSpec<3>& spec, DomainSplit<3>* split, bool ball) {
   fluid::SmokeSolver<3> solver(spec, plumeParams());
+  if (ball) solver.setObstacles(numerics::sampleNodes<3>(spec, ballDistance));
   solver.addSource(plumeSource(spec));
   solver.setDomainSplit(split);
   for (int s = 0; s < kSteps; ++s) {
@@ -64,12 +69,12 @@ Grid<float, 3> runPlume(const GridSpec<3>& spec, DomainSplit<3>* split) {
   return solver.density();
 }
 
-Grid<float, 3> runSplit(MPI_Comm comm) {
+Grid<float, 3> runSplit(MPI_Comm comm, bool ball) {
   const fluid::SmokeParams<3> params = plumeParams();
   const GridBlock<3> block(kGlobal, BlockDecomposition<3>(kGlobal.res, sizeOf(comm), 4, "test"), rankOf(comm),
                            smokeGhostLayers(params.advection, 1.0));
   MpiDomainSplit split(block, params.sides, params.projection.pcg, comm);
-  return gatherToRoot(runPlume(block.localSpec(), &split), block, comm);
+  return gatherToRoot(runPlume(block.localSpec(), &split, ball), block, comm);
 }
 
 double maxAbs(const Grid<float, 3>& g) {
@@ -84,23 +89,26 @@ double maxDifference(const Grid<float, 3>& a, const Grid<float, 3>& b) {
   return m;
 }
 
-TEST(DistributedSmoke, FiftyStepsMatchOneRankWithin1e4Relative) {
+class DistributedSmoke : public ::testing::TestWithParam<bool> {};
+
+TEST_P(DistributedSmoke, FiftyStepsMatchOneRankWithin1e4Relative) {
+  const bool ball = GetParam();  // the plume alone, or split by a ball (static obstacle)
   // The one-rank run on rank 0 alone, the split run on every rank, the serial solver on rank 0.
   MPI_Comm alone;
   MPI_Comm_split(MPI_COMM_WORLD, worldRank() == 0 ? 0 : MPI_UNDEFINED, 0, &alone);
   std::optional<Grid<float, 3>> one, serial;
   if (worldRank() == 0) {
-    one = runSplit(alone);
-    serial = runPlume(kGlobal, nullptr);
+    one = runSplit(alone, ball);
+    serial = runPlume(kGlobal, nullptr, ball);
     MPI_Comm_free(&alone);
   }
-  const Grid<float, 3> split = runSplit(MPI_COMM_WORLD);
+  const Grid<float, 3> split = runSplit(MPI_COMM_WORLD, ball);
   bool ok = true;
   if (worldRank() == 0) {
     const double scale = maxAbs(*one);
     const double toOne = maxDifference(split, *one) / scale, toSerial = maxDifference(split, *serial) / scale;
-    std::printf("smoke plume, %d steps on %d ranks: max density %.3f; relative difference to 1 rank %.1e, to the "
-                "serial MG-PCG solver %.1e\n", kSteps, worldSize(), scale, toOne, toSerial);
+    std::printf("smoke plume%s, %d steps on %d ranks: max density %.3f; relative difference to 1 rank %.1e, to the "
+                "serial MG-PCG solver %.1e\n", ball ? " around a ball" : "", kSteps, worldSize(), scale, toOne, toSerial);
     EXPECT_GT(scale, 0.5);
     EXPECT_LT(toOne, 1e-4);
     EXPECT_LT(toSerial, 1e-2);
@@ -108,6 +116,8 @@ TEST(DistributedSmoke, FiftyStepsMatchOneRankWithin1e4Relative) {
   }
   EXPECT_TRUE(fromRoot(ok));
 }
+
+INSTANTIATE_TEST_SUITE_P(Obstacle, DistributedSmoke, ::testing::Values(false, true));
 
 }  // namespace
 }  // namespace msim::parallel

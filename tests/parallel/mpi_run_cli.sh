@@ -27,6 +27,17 @@ for key in ("smoke_mass_kg", "kinetic_energy_J", "max_speed_m_s", "enstrophy"):
     assert rel < 1e-4, key
 PY
 [[ $(ls "$tmp/two/vdb" | wc -l) -eq 6 && $(ls "$tmp/two/png" | wc -l) -eq 6 ]] || { echo "expected 6 frames"; exit 1; }
+# Around a static obstacle.
+"$msim" run "$scenes/smoke_sphere.json" --out "$tmp/sphere_one" "${short[@]}"
+"${two[@]}" run "$scenes/smoke_sphere.json" --out "$tmp/sphere_two" "${short[@]}"
+python3 - "$tmp/sphere_one/run.json" "$tmp/sphere_two/run.json" <<'PY'
+import json, sys
+a, b = (json.load(open(p))["frames"][-1] for p in sys.argv[1:3])
+for key in ("smoke_mass_kg", "kinetic_energy_J", "enstrophy"):
+    rel = abs(a[key] - b[key]) / abs(a[key])
+    print(f"smoke_sphere {key}: relative difference {rel:.1e}")
+    assert rel < 1e-4, key
+PY
 
 expect_failure() {  # expect_failure CODE PATTERN ARGS...: exit CODE, PATTERN in one message
   local code=$1 pattern=$2
@@ -41,6 +52,7 @@ expect_failure() {  # expect_failure CODE PATTERN ARGS...: exit CODE, PATTERN in
 }
 expect_failure 2 "smoke.viscosity" run "$scenes/plume_3d.json" --out "$tmp/bad" --set smoke.viscosity=0.001 -q
 expect_failure 2 "cannot split" run "$scenes/plume_3d.json" --out "$tmp/bad" --set domain.resolution=4 -q
+expect_failure 2 "obstacles" run "$scenes/smoke_sphere.json" --out "$tmp/bad" --set 'obstacles[0].velocity=[0.1,0,0]' -q
 expect_failure 2 "mpi.ghost_layers" run "$scenes/plume_3d.json" --out "$tmp/bad" --set mpi.ghost_layers=2 -q
 expect_failure 2 "mpi.blocks" run "$scenes/plume_3d.json" --out "$tmp/bad" --set 'mpi.blocks=[3,1,1]' -q
 [[ ! -e "$tmp/bad" ]] || { echo "bad input left $tmp/bad behind"; exit 1; }

@@ -40,8 +40,10 @@ class DomainSplit {
   virtual bool root() const = 0;
   // The largest of `value` over every rank. Collective.
   virtual double maxOverRanks(double value) = 0;
-  // The pressure projection of the global grid on the local velocity (walls at rest, no solids
-  // inside): u = u* - (dt / rho) grad p with div u = 0 on the owned cells. Collective.
+  // Static solids for the pressure solve: the open fraction of every local face. Collective.
+  virtual void setOpenFractions(const MacGrid<D>& openFraction) = 0;
+  // The pressure projection of the global grid on the local velocity (walls and solids at rest):
+  // u = u* - (dt / rho) grad p with div u = 0 on the owned cells. Collective.
   virtual SplitSolveStats project(MacGrid<D>& velocity, double dt, double density) = 0;
 };
 

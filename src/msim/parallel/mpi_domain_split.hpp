@@ -28,6 +28,7 @@ class MpiDomainSplit final : public DomainSplit<3> {
   void gather(const MacGrid<3>& local, MacGrid<3>& global) override;
   bool root() const override { return block_.rank == 0; }
   double maxOverRanks(double value) override;
+  void setOpenFractions(const MacGrid<3>& openFraction) override { projection_.setOpenFractions(openFraction); }
   SplitSolveStats project(MacGrid<3>& velocity, double dt, double density) override;
 
   const GridBlock<3>& block() const { return block_; }

@@ -173,10 +173,10 @@ class SmokeSolver {
   VortexLayer<D>* vortexLayer() { return vortex_.get(); }
   // Runs the solver on one block of a grid split among processes (msim/parallel): the solver's
   // spec is the block's local grid, ghosts are exchanged where stencils read them, scalars are
-  // reduced over the ranks and the pressure solve is the split's. Obstacles, vortex particles,
-  // viscosity, conservative scalar transport, expanding sources, moving walls and procedural
-  // turbulence are not distributed: step() throws InputError naming the one in use. `split`
-  // must outlive the solver.
+  // reduced over the ranks and the pressure solve is the split's (with the static obstacles).
+  // Moving obstacles, vortex particles, viscosity, conservative scalar transport, expanding
+  // sources, moving walls and procedural turbulence are not distributed: step() throws
+  // InputError naming the one in use. `split` must outlive the solver.
   void setDomainSplit(DomainSplit<D>* split);
   // The clock the winds are sampled at [s]; step() advances it, a resumed run sets it.
   void setTime(double time) { time_ = time; }
@@ -209,6 +209,8 @@ class SmokeSolver {
   const std::string& scalarName(std::size_t i) const { return scalars_[i].name; }
   std::size_t scalarCount() const { return scalars_.size(); }
   const Grid<float, D>& solid() const { return solid_; }
+  // The projection's face weights: open fractions after thresholding, 0 on domain walls.
+  const MacGrid<D>& faceWeights() const { return projection_.faceWeights(); }
   const numerics::PressureProjection<D>& projection() const { return projection_; }
   // The last pressure [Pa]; it warm-starts the next projection, so a resumed run restores it.
   Grid<float, D>& pressure() { return projection_.pressure(); }
@@ -278,6 +280,7 @@ class SmokeSolver {
   ViscousDiffusion<D> viscosity_;
   StageTimers timers_;
   DomainSplit<D>* split_ = nullptr;
+  bool movingObstacles_ = false;  // setObstacleVelocity was called
   double maxDivergence_ = 0.0;
   int pressureIterations_ = 0, viscosityIterations_ = 0;
   long steps_ = 0;

@@ -68,7 +68,6 @@ std::unique_ptr<DomainSplit<D>> smokeSplit(const Scene& scene) {
   if constexpr (D != 3) {
     refuseSplit(file, "domain.resolution", "a 2D grid");
   } else {
-    if (!r.at("obstacles").empty()) refuse("obstacles", "smoke around obstacles");
     if (smoke.at("turbulence").at("enabled").get<bool>()) refuse("smoke.turbulence.enabled", "sub-grid turbulence");
     if (smoke.at("vortex_particles").at("enabled").get<bool>())
       refuse("smoke.vortex_particles.enabled", "the vortex particles");
@@ -120,6 +119,9 @@ struct GatheredSmoke {
   Grid<float, D> density, temperature, pressure;
   MacGrid<D> velocity;
   std::vector<Grid<float, D>> scalars;
+  Grid<float, D> solid;    // with obstacles: gathered once (they do not move)
+  MacGrid<D> faceWeights;  // the projection's face weights, likewise
+  bool solidsGathered = false;
 };
 
 template <int D>
@@ -130,7 +132,7 @@ class SmokePhenomenon final : public Phenomenon {
         name_(scene.name()),
         timers_(timers),
         split_(smokeSplit<D>(scene)),
-        obstacles_(scene, scene.gridSpec<D>()),
+        obstacles_(scene, split_ ? split_->localSpec() : scene.gridSpec<D>()),
         solver_(split_ ? split_->localSpec() : scene.gridSpec<D>(), smokeParams<D>(scene)),
         timeCfl_(scene.resolved.at("time").at("cfl").get<double>()) {
     const json& r = scene.resolved;
@@ -140,7 +142,10 @@ class SmokePhenomenon final : public Phenomenon {
     for (int a = 0; a < D; ++a) solver_.velocity().component(a).fill(static_cast<float>(u0[a]));
     // Vortex particles before the obstacles, which the solver hands them.
     solver_.setVortexLayer(vortexLayer<D>(scene, "smoke"));
+    if (split_ && obstacles_.moving()) refuseSplit(source_, "obstacles", "a moving obstacle");
     if (!obstacles_.empty()) placeObstacles(0.0);
+    // Rank 0 writes the obstacles of the whole grid with each frame of a split run.
+    if (split_ && split_->root() && !obstacles_.empty()) wholeObstacles_.emplace(scene, scene.gridSpec<D>());
 
     if (r.at("fire").at("enabled").get<bool>()) {
       combustion_ = combustionParams(r);
@@ -238,6 +243,11 @@ class SmokePhenomenon final : public Phenomenon {
     split_->gather(solver_.velocity(), g.velocity);
     g.scalars.resize(solver_.scalarCount());
     for (std::size_t i = 0; i < solver_.scalarCount(); ++i) split_->gather(solver_.scalar(i), g.scalars[i]);
+    if (!obstacles_.empty() && !g.solidsGathered) {  // static: once (decided alike on every rank)
+      split_->gather(solver_.solid(), g.solid);
+      split_->gather(solver_.faceWeights(), g.faceWeights);
+      g.solidsGathered = true;
+    }
   }
 
   void writeVolume(io::VdbWriter& writer) const override {
@@ -254,7 +264,8 @@ class SmokePhenomenon final : public Phenomenon {
     }
     writeFaceVelocities(writer, velocity());
     writer.addFloatGrid("pressure", split_ ? gathered_.pressure : solver_.pressure());
-    if (!obstacles_.empty()) writer.addLevelSet("obstacle_distance", obstacles_.cellDistance(time_));
+    if (!obstacles_.empty())
+      writer.addLevelSet("obstacle_distance", (wholeObstacles_ ? *wholeObstacles_ : obstacles_).cellDistance(time_));
     if (solver_.vortexLayer())
       writer.addPoints(kVortexPoints, vortexParticleCloud(solver_.vortexLayer()->particles()), solver_.spec().dx);
   }
@@ -272,7 +283,7 @@ class SmokePhenomenon final : public Phenomenon {
     if (turbulence_)
       return render::renderDensityPreview(turbulence_->density(), preview_,
                                           obstacles_.empty() ? nullptr : &turbulence_->fineSolid());
-    const Grid<float, D>* solid = obstacles_.empty() ? nullptr : &solver_.solid();
+    const Grid<float, D>* solid = obstacles_.empty() ? nullptr : (split_ ? &gathered_.solid : &solver_.solid());
     render::PreviewEmission<D> emission;
     if (combustion_) emission = {&scalar(flame_), &temperature()};
     return render::renderDensityPreview(density(), preview_, solid, emission);
@@ -310,8 +321,10 @@ class SmokePhenomenon final : public Phenomenon {
   json statistics() const override {
     fluid::SmokeStatistics s = solver_.statistics();
     if (split_) {  // measured on the gathered fields; the solver's own numbers are already reduced
+      const bool solids = !obstacles_.empty();
       const fluid::SmokeStatistics whole =
-          fluid::measureSmoke<D>(gathered_.velocity, nullptr, gathered_.density, nullptr, solver_.params().fluidDensity);
+          fluid::measureSmoke<D>(gathered_.velocity, solids ? &gathered_.faceWeights : nullptr, gathered_.density,
+                                 solids ? &gathered_.solid : nullptr, solver_.params().fluidDensity);
       s.kineticEnergy = whole.kineticEnergy;
       s.maxSpeed = whole.maxSpeed;
       s.totalDensity = whole.totalDensity;
@@ -434,7 +447,8 @@ class SmokePhenomenon final : public Phenomenon {
   StageTimers& timers_;
   std::unique_ptr<DomainSplit<D>> split_;  // null on one process
   GatheredSmoke<D> gathered_;              // split runs, rank 0: the last frame's fields
-  SceneObstacles<D> obstacles_;
+  SceneObstacles<D> obstacles_;                        // over the solver's grid (a block when split)
+  std::optional<SceneObstacles<D>> wholeObstacles_;     // split runs, rank 0: over the whole grid
   fluid::SmokeSolver<D> solver_;
   double timeCfl_;
   double time_ = 0.0;
