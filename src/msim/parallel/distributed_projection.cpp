@@ -73,7 +73,36 @@ void DistributedProjection::setOpenFractions(const MacGrid<3>& openFraction) {
     }
   }
   weightGhosts_.exchange(weights_);
+  if (inverseTheta_.spec() != weights_.spec()) inverseTheta_ = MacGrid<3>(block_.localSpec(), 1.0f);
   assemble();
+}
+
+void DistributedProjection::setFreeSurface(const Grid<float, 3>& liquidPhi, float minTheta) {
+  liquidPhi_ = liquidPhi;
+  GhostExchange<float, 3>(block_, IVec<3>::Zero(), comm_).exchange(*liquidPhi_);
+  const Grid<float, 3>& phi = *liquidPhi_;
+  for (int a = 0; a < 3; ++a) {
+    Grid<float, 3>& it = inverseTheta_.component(a);
+    for (std::size_t i = 0; i < it.count(); ++i) {
+      const IVec<3> f = it.coord(i), low = f - IVec<3>::Unit(a);
+      it[i] = 1.0f;
+      if (!phi.inside(f) || !phi.inside(low)) continue;
+      const float up = phi(f), lo = phi(low);
+      if ((up < 0.0f) == (lo < 0.0f)) continue;
+      const float wet = up < 0.0f ? up : lo, dry = up < 0.0f ? lo : up;
+      it[i] = 1.0f / std::max(minTheta, wet / (wet - dry));  // as the serial projection's theta
+    }
+  }
+  assemble();
+}
+
+DistributedProjection::FaceTerm DistributedProjection::faceTerm(const IVec<3>& l, int axis, int side) const {
+  const IVec<3> face = side ? (l + IVec<3>::Unit(axis)).eval() : l;
+  const IVec<3> g = l + block_.cellOrigin();
+  const bool inDomain = side ? g[axis] + 1 < block_.global.res[axis] : g[axis] > 0;
+  const IVec<3> across = side ? (l + IVec<3>::Unit(axis)).eval() : (l - IVec<3>::Unit(axis)).eval();
+  const bool coupled = inDomain && (!liquidPhi_ || (*liquidPhi_)(across) < 0.0f);
+  return {weights_.component(axis)(face), coupled, inverseTheta_.component(axis)(face)};
 }
 
 void DistributedProjection::assemble() {
@@ -83,20 +112,19 @@ void DistributedProjection::assemble() {
   const std::size_t cells = static_cast<std::size_t>(owned.count());
   coefficients_.assign(cells * kStencilSize, 0.0);
   fluid_.assign(cells, 0);
-  int dirichlet = 0;  // some face of an owned cell opens onto an open domain side
+  int dirichlet = 0;  // some face of an owned cell opens onto an open domain side or air
   forOwnedCells(block_, [&](const IVec<3>& l, std::size_t k) {
     double* row = coefficients_.data() + k * kStencilSize;
-    const IVec<3> g = l + origin;
-    for (int a = 0; a < 3; ++a) {
-      const IVec<3> up = l + IVec<3>::Unit(a);
-      const double wLow = weights_.component(a)(l), wUp = weights_.component(a)(up);
-      row[0] += wLow + wUp;
-      row[1 + 2 * a] = g[a] > 0 ? -wLow : 0.0;
-      row[2 + 2 * a] = g[a] + 1 < res[a] ? -wUp : 0.0;
-      dirichlet |= (g[a] == 0 && wLow > 0.0) || (g[a] + 1 == res[a] && wUp > 0.0);
-    }
+    const bool air = liquidPhi_ && (*liquidPhi_)(l) >= 0.0f;
+    for (int a = 0; a < 3 && !air; ++a)
+      for (int side = 0; side < 2; ++side) {
+        const FaceTerm t = faceTerm(l, a, side);
+        row[0] += t.weight * (t.coupled ? 1.0 : t.scale);
+        row[1 + 2 * a + side] = t.coupled ? -t.weight : 0.0;
+        dirichlet |= !t.coupled && t.weight > 0.0;
+      }
     fluid_[k] = row[0] > 0.0;
-    if (!fluid_[k]) row[0] = 1.0;  // inside a solid: no unknown, p^ = 0
+    if (!fluid_[k]) row[0] = 1.0;  // inside a solid or air: no unknown, p^ = 0
   });
   // Without a Dirichlet face anywhere the constants are a null space: pin the first fluid cell.
   int anyDirichlet = 0;
@@ -157,18 +185,17 @@ void DistributedProjection::assemble() {
 
 double DistributedProjection::maxResidual() {
   cellGhosts_.exchange(scaled_);
-  const IVec<3> origin = block_.cellOrigin(), res = block_.global.res;
   double worst = 0.0;
   forOwnedCells(block_, [&](const IVec<3>& l, std::size_t k) {
     if (!fluid_[k]) return;
-    const IVec<3> g = l + origin;
     const double x = scaled_(l);
     double ax = 0.0;
-    for (int a = 0; a < 3; ++a) {
-      const IVec<3> up = l + IVec<3>::Unit(a), low = l - IVec<3>::Unit(a);
-      ax += weights_.component(a)(l) * (x - (g[a] > 0 ? scaled_(low) : 0.0));
-      ax += weights_.component(a)(up) * (x - (g[a] + 1 < res[a] ? scaled_(up) : 0.0));
-    }
+    for (int a = 0; a < 3; ++a)
+      for (int side = 0; side < 2; ++side) {
+        const FaceTerm t = faceTerm(l, a, side);
+        const IVec<3> across = side ? (l + IVec<3>::Unit(a)).eval() : (l - IVec<3>::Unit(a)).eval();
+        ax += t.coupled ? t.weight * (x - scaled_(across)) : t.weight * t.scale * x;
+      }
     worst = std::max(worst, std::abs(rhs_[k] - ax));
   });
   MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPI_DOUBLE, MPI_MAX, comm_);
@@ -264,8 +291,10 @@ DistributedProjectionStats DistributedProjection::project(MacGrid<3>& velocity, 
             u(l) = 0.0f;
             continue;
           }
+          // Air cells and the ghosts beyond open sides hold p^ = 0; across a liquid-air face the
+          // difference is divided by theta (the ghost-fluid extrapolation to the surface).
           const double pUp = g[a] < res[a] ? scaled_(l) : 0.0, pLow = g[a] > 0 ? scaled_(low) : 0.0;
-          u(l) = static_cast<float>(u(l) - (pUp - pLow));
+          u(l) = static_cast<float>(u(l) - (pUp - pLow) * inverseTheta_.component(a)(l));
         }
   }
   forOwnedCells(block_, [&](const IVec<3>& l, std::size_t) { pressure_(l) = static_cast<float>(scaled_(l) / toScaled); });

@@ -17,6 +17,7 @@
 #include <HYPRE_struct_ls.h>
 #include <mpi.h>
 
+#include <optional>
 #include <vector>
 
 #include "msim/core/grid.hpp"
@@ -44,6 +45,12 @@ class DistributedProjection {
   // Open fraction of every local face (block.localSpec()'s MAC layout; ghosts need not be
   // filled); rebuilds the matrix and the multigrid hierarchy. Collective.
   void setOpenFractions(const MacGrid<3>& openFraction);
+  // A free surface, as numerics::PressureProjection::setFreeSurface: cells with liquidPhi >= 0
+  // are air at pressure 0 with no unknown; a liquid cell's face towards air adds w / theta to its
+  // diagonal (the surface at theta = phi_i / (phi_i - phi_j), at least minTheta, ghost fluid
+  // method) and the update across it is divided by theta. liquidPhi is the local cell-centred
+  // field; its ghosts are exchanged here. Rebuilds the matrix. Collective.
+  void setFreeSurface(const Grid<float, 3>& liquidPhi, float minTheta = 1e-3f);
   // Makes the owned faces of `velocity` (a local MAC grid) divergence free; its ghosts are
   // exchanged first and are stale afterwards. Collective.
   DistributedProjectionStats project(MacGrid<3>& velocity, double dt, double density);
@@ -53,6 +60,13 @@ class DistributedProjection {
   const MacGrid<3>& faceWeights() const { return weights_; }
 
  private:
+  // How face `side` (0 lower, 1 upper) along `axis` of local cell l enters the equations.
+  struct FaceTerm {
+    double weight;  // w_f
+    bool coupled;   // the neighbour across has an unknown
+    double scale;   // 1 / theta across a liquid-air face, else 1
+  };
+  FaceTerm faceTerm(const IVec<3>& l, int axis, int side) const;
   void assemble();
   void destroyHypre();
   // |b - A x|_inf over every rank, for x = scaled_ with its ghosts filled.
@@ -64,6 +78,8 @@ class DistributedProjection {
   MPI_Comm comm_;
   float minOpenFraction_;
   MacGrid<3> weights_;
+  std::optional<Grid<float, 3>> liquidPhi_;  // with ghosts; empty without a free surface
+  MacGrid<3> inverseTheta_;                  // 1 / theta on liquid-air faces, 1 elsewhere
   MacGhostExchange<3> velocityGhosts_, weightGhosts_;
   GhostExchange<double, 3> cellGhosts_;
   Grid<float, 3> pressure_;
