@@ -40,13 +40,19 @@ void PressureProjection<D>::setSolids(const MacGrid<D>& openFraction) {
   floating_ = FloatingRegions<D>(weights_);
   freeSurface_ = false;
   inverseTheta_ = MacGrid<D>();
-  buildPreconditioner();
+  invalidatePreconditioner();
+}
+
+template <int D>
+void PressureProjection<D>::invalidatePreconditioner() {
+  mic0_.reset();
+  multigrid_.reset();
+  preconditionerStale_ = true;
 }
 
 template <int D>
 void PressureProjection<D>::buildPreconditioner() {
-  mic0_.reset();
-  multigrid_.reset();
+  preconditionerStale_ = false;
   if (settings_.preconditioner == PressurePreconditioner::Mic0)
     mic0_ = std::make_unique<Mic0Preconditioner<D>>(matrix_, settings_.mic0);
   else if (freeSurface_)
@@ -113,7 +119,7 @@ void PressureProjection<D>::setFreeSurface(const Grid<float, D>& liquidPhi, floa
   freeSurface_ = true;
   matrix_ = PoissonMatrix<D>(coupling, dirichlet);
   floating_ = FloatingRegions<D>(coupling, dirichlet);
-  buildPreconditioner();
+  invalidatePreconditioner();
 }
 
 template <int D>
@@ -233,6 +239,7 @@ PcgStats PressureProjection<D>::project(MacGrid<D>& velocity, double dt, double 
     rhs_[i] = diag[i] > 0.0f ? outflow - rhs_[i] : 0.0f;
     scaledPressure_[i] = pressure_[i] * toScaled;
   });
+  if (preconditionerStale_) buildPreconditioner();
   Preconditioner& M = multigrid_ ? static_cast<Preconditioner&>(*multigrid_) : *mic0_;
   const PcgStats stats = pcg_.solve(matrix_, floating_, M, rhs_, scaledPressure_, settings_.pcg);
 

@@ -112,7 +112,9 @@ class PressureProjection {
   const MacGrid<D>& solidVelocity() const { return solidVelocity_; }
   const PoissonMatrix<D>& matrix() const { return matrix_; }
   const FloatingRegions<D>& floatingRegions() const { return floating_; }
-  // Levels of the multigrid hierarchy (1 when the MIC(0) preconditioner is used).
+  // Levels of the multigrid hierarchy (1 when the MIC(0) preconditioner is used). The hierarchy
+  // is built by the first projection after the matrix changed, so a projection whose solve runs
+  // elsewhere (a grid split among processes) never pays for it.
   int multigridLevels() const { return multigrid_ ? multigrid_->levelCount() : 1; }
   const ProjectionSettings& settings() const { return settings_; }
 
@@ -125,8 +127,11 @@ class PressureProjection {
   GridSpec<D> spec_;
   DomainSides<D> sides_;
   ProjectionSettings settings_;
-  // Builds the preconditioner chosen by the settings for matrix_.
+  // Builds the preconditioner chosen by the settings for matrix_; invalidate drops it after the
+  // matrix changed, and the next projection builds it again.
   void buildPreconditioner();
+  void invalidatePreconditioner();
+  bool preconditionerStale_ = true;
 
   MacGrid<D> weights_;
   MacGrid<D> solidVelocity_;
