@@ -79,7 +79,8 @@ TEST_P(DistributedProjectionTest, MatchesTheSerialProjectionWithinTheTolerance) 
   MacGrid<3> local = localPart(divergentVelocity(), block);
   DistributedProjection projection(block, c.sides, pcg, MPI_COMM_WORLD);
   projection.setOpenFractions(localPart(open, block));
-  const DistributedProjectionStats stats = projection.project(local, dt, density);
+  Grid<float, 3> pressure(block.localSpec());
+  const DistributedProjectionStats stats = projection.project(local, pressure, dt, density);
   const MacGrid<3> split = gatherToRoot(local, block, MPI_COMM_WORLD);
 
   bool ok = true;
@@ -135,7 +136,8 @@ TEST(DistributedProjection, FreeSurfaceMatchesTheSerialProjection) {
   MacGrid<3> local = localPart(divergentVelocity(), block);
   DistributedProjection projection(block, DomainSides<3>::allWalls(), pcg, MPI_COMM_WORLD);
   projection.setFreeSurface(liquidPhi(block.localSpec()));
-  const DistributedProjectionStats stats = projection.project(local, dt, density);
+  Grid<float, 3> pressure(block.localSpec());
+  const DistributedProjectionStats stats = projection.project(local, pressure, dt, density);
   const MacGrid<3> split = gatherToRoot(local, block, MPI_COMM_WORLD);
   if (worldRank() == 0) {
     EXPECT_TRUE(stats.converged) << stats.relativeResidual;

@@ -43,8 +43,9 @@ class DomainSplit {
   // Static solids for the pressure solve: the open fraction of every local face. Collective.
   virtual void setOpenFractions(const MacGrid<D>& openFraction) = 0;
   // The pressure projection of the global grid on the local velocity (walls and solids at rest):
-  // u = u* - (dt / rho) grad p with div u = 0 on the owned cells. Collective.
-  virtual SplitSolveStats project(MacGrid<D>& velocity, double dt, double density) = 0;
+  // u = u* - (dt / rho) grad p with div u = 0 on the owned cells; `pressure` [Pa] warm-starts
+  // the solve and receives p on the owned cells. Collective.
+  virtual SplitSolveStats project(MacGrid<D>& velocity, Grid<float, D>& pressure, double dt, double density) = 0;
 };
 
 }  // namespace msim

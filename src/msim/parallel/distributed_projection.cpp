@@ -36,7 +36,6 @@ DistributedProjection::DistributedProjection(const GridBlock<3>& block, const nu
       velocityGhosts_(block, comm),
       weightGhosts_(block, comm),
       cellGhosts_(block, IVec<3>::Zero(), comm),
-      pressure_(block.localSpec()),
       scaled_(block.localSpec()) {
   if (block.ghost < 1) throw std::invalid_argument("distributed projection: blocks need at least one ghost layer");
   setOpenFractions(MacGrid<3>(block.localSpec(), 1.0f));
@@ -202,7 +201,8 @@ double DistributedProjection::maxResidual() {
   return worst;
 }
 
-DistributedProjectionStats DistributedProjection::project(MacGrid<3>& velocity, double dt, double density) {
+DistributedProjectionStats DistributedProjection::project(MacGrid<3>& velocity, Grid<float, 3>& pressure, double dt,
+                                                         double density) {
   if (!(dt > 0.0) || !(density > 0.0))
     throw std::invalid_argument("pressure projection: the step and the density must be positive");
   const double toScaled = dt / (density * block_.global.dx);
@@ -232,7 +232,7 @@ DistributedProjectionStats DistributedProjection::project(MacGrid<3>& velocity, 
   MPI_Allreduce(MPI_IN_PLACE, &bMax, 1, MPI_DOUBLE, MPI_MAX, comm_);
 
   // Warm start from the last pressure, as the serial projection does.
-  forOwnedCells(block_, [&](const IVec<3>& l, std::size_t k) { values_[k] = fluid_[k] ? pressure_(l) * toScaled : 0.0; });
+  forOwnedCells(block_, [&](const IVec<3>& l, std::size_t k) { values_[k] = fluid_[k] ? pressure(l) * toScaled : 0.0; });
   const IndexBox<3> owned = block_.owned();
   int lower[3], upper[3];
   for (int a = 0; a < 3; ++a) {
@@ -297,7 +297,7 @@ DistributedProjectionStats DistributedProjection::project(MacGrid<3>& velocity, 
           u(l) = static_cast<float>(u(l) - (pUp - pLow) * inverseTheta_.component(a)(l));
         }
   }
-  forOwnedCells(block_, [&](const IVec<3>& l, std::size_t) { pressure_(l) = static_cast<float>(scaled_(l) / toScaled); });
+  forOwnedCells(block_, [&](const IVec<3>& l, std::size_t) { pressure(l) = static_cast<float>(scaled_(l) / toScaled); });
   return stats;
 }
 

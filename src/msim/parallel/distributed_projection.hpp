@@ -52,11 +52,11 @@ class DistributedProjection {
   // field; its ghosts are exchanged here. Rebuilds the matrix. Collective.
   void setFreeSurface(const Grid<float, 3>& liquidPhi, float minTheta = 1e-3f);
   // Makes the owned faces of `velocity` (a local MAC grid) divergence free; its ghosts are
-  // exchanged first and are stale afterwards. Collective.
-  DistributedProjectionStats project(MacGrid<3>& velocity, double dt, double density);
+  // exchanged first and are stale afterwards. `pressure` [Pa] (local, cell-centred) warm-starts
+  // the solve and receives its result on the owned cells, as the serial projection keeps its
+  // own (so a resumed run starts from the saved one). Collective.
+  DistributedProjectionStats project(MacGrid<3>& velocity, Grid<float, 3>& pressure, double dt, double density);
 
-  // p [Pa] on the local grid (owned cells; ghosts hold the neighbours' after project()).
-  const Grid<float, 3>& pressure() const { return pressure_; }
   const MacGrid<3>& faceWeights() const { return weights_; }
 
  private:
@@ -82,7 +82,6 @@ class DistributedProjection {
   MacGrid<3> inverseTheta_;                  // 1 / theta on liquid-air faces, 1 elsewhere
   MacGhostExchange<3> velocityGhosts_, weightGhosts_;
   GhostExchange<double, 3> cellGhosts_;
-  Grid<float, 3> pressure_;
   Grid<double, 3> scaled_;  // p^ with ghosts, in hypre's precision: the residual test reads it
   std::vector<double> rhs_, values_, coefficients_;
   std::vector<unsigned char> fluid_;  // owned cells with an unknown (some face open)

@@ -25,8 +25,8 @@ double MpiDomainSplit::maxOverRanks(double value) {
   return value;
 }
 
-SplitSolveStats MpiDomainSplit::project(MacGrid<3>& velocity, double dt, double density) {
-  const DistributedProjectionStats s = projection_.project(velocity, dt, density);
+SplitSolveStats MpiDomainSplit::project(MacGrid<3>& velocity, Grid<float, 3>& pressure, double dt, double density) {
+  const DistributedProjectionStats s = projection_.project(velocity, pressure, dt, density);
   return {s.iterations, s.relativeResidual, s.converged};
 }
 

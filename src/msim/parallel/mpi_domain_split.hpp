@@ -29,7 +29,7 @@ class MpiDomainSplit final : public DomainSplit<3> {
   bool root() const override { return block_.rank == 0; }
   double maxOverRanks(double value) override;
   void setOpenFractions(const MacGrid<3>& openFraction) override { projection_.setOpenFractions(openFraction); }
-  SplitSolveStats project(MacGrid<3>& velocity, double dt, double density) override;
+  SplitSolveStats project(MacGrid<3>& velocity, Grid<float, 3>& pressure, double dt, double density) override;
 
   const GridBlock<3>& block() const { return block_; }
   MPI_Comm comm() const { return comm_; }

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "msim/core/error.hpp"
+#include "msim/core/parallel.hpp"
 #include "msim/geometry/occupancy.hpp"
 #include "msim/geometry/shape_factory.hpp"
 #include "msim/io/vdb.hpp"
@@ -25,14 +26,28 @@ void requireFinite(const Grid<float, D>& g, const std::string& field, long stepI
 
 template <int D>
 void restoreGrid(const io::VdbFile& file, const std::string& name, Grid<float, D>& target,
-                 const std::string& sceneSource) {
+                 const std::string& sceneSource, const BlockPlacement<D>& placement) {
   const Grid<float, 3> saved = file.floatGrid(name);
-  bool same = saved.spec().dx == target.spec().dx && saved.count() == target.count();
-  for (int a = 0; a < D; ++a) same = same && saved.size()[a] == target.size()[a];
-  if (!same)
+  // The file holds the whole grid; a block of a split run takes its part of it.
+  const IVec<D> whole = placement.whole() ? target.size() : (placement.globalRes + target.size() - target.spec().res).eval();
+  std::size_t count = 1;
+  bool same = saved.spec().dx == target.spec().dx;
+  for (int a = 0; a < D; ++a) {
+    same = same && saved.size()[a] == whole[a];
+    count *= static_cast<std::size_t>(whole[a]);
+  }
+  if (!same || saved.count() != count)
     throw InputError(fmt::format("{}: cannot resume from '{}': its grid '{}' does not match the scene's domain",
                                  sceneSource, file.path().string(), name));
-  std::copy(saved.data().begin(), saved.data().end(), target.data().begin());
+  if (placement.whole()) {
+    std::copy(saved.data().begin(), saved.data().end(), target.data().begin());
+    return;
+  }
+  parallelForCells<D>(target.size(), [&](const IVec<D>& c, std::size_t i) {
+    IVec3 g = IVec3::Zero();
+    for (int a = 0; a < D; ++a) g[a] = c[a] + placement.cellOrigin[a];
+    target[i] = saved(g);
+  });
 }
 
 const std::vector<float>& savedPointAttribute(const io::PointCloud& cloud, const std::string& name,
@@ -77,8 +92,9 @@ void writeFaceVelocities(io::VdbWriter& writer, const MacGrid<D>& velocity) {
 }
 
 template <int D>
-void restoreFaceVelocities(const io::VdbFile& saved, MacGrid<D>& velocity, const std::string& sceneSource) {
-  for (int a = 0; a < D; ++a) restoreGrid(saved, faceGridName(a), velocity.component(a), sceneSource);
+void restoreFaceVelocities(const io::VdbFile& saved, MacGrid<D>& velocity, const std::string& sceneSource,
+                           const BlockPlacement<D>& placement) {
+  for (int a = 0; a < D; ++a) restoreGrid(saved, faceGridName(a), velocity.component(a), sceneSource, placement);
 }
 
 template <int D>
@@ -105,9 +121,10 @@ std::vector<std::pair<std::size_t, float>> coveredOpenCells(const Scene& scene, 
 #define MSIM_INSTANTIATE(D)                                                                                        \
   template void requireFinite<D>(const Grid<float, D>&, const std::string&, long, double);                          \
   template void restoreGrid<D>(const io::VdbFile&, const std::string&, Grid<float, D>&,                             \
-                               const std::string&);                                                              \
+                               const std::string&, const BlockPlacement<D>&);                                    \
   template void writeFaceVelocities<D>(io::VdbWriter&, const MacGrid<D>&);                                         \
-  template void restoreFaceVelocities<D>(const io::VdbFile&, MacGrid<D>&, const std::string&);                      \
+  template void restoreFaceVelocities<D>(const io::VdbFile&, MacGrid<D>&, const std::string&,                       \
+                                         const BlockPlacement<D>&);                                              \
   template std::unique_ptr<geometry::Shape<D>> sceneShape<D>(const Scene&, const nlohmann::json&,                  \
                                                              const std::string&);                                 \
   template std::vector<std::pair<std::size_t, float>> coveredOpenCells<D>(const Scene&, const geometry::Shape<D>&, \

@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "msim/core/block_placement.hpp"
 #include "msim/core/domain_split.hpp"
 #include "msim/core/grid.hpp"
 #include "msim/core/mac_grid.hpp"
@@ -28,17 +29,19 @@ template <int D>
 void requireFinite(const Grid<float, D>& grid, const std::string& field, long stepIndex, double time);
 
 // Copies grid `name` of a saved frame into `target` (a cell or face grid); InputError naming the
-// scene and file when the grid is missing or its size differs.
+// scene and file when the grid is missing or its size differs. A block of a run split among
+// processes (`placement`) takes its part of the saved whole grid.
 template <int D>
 void restoreGrid(const io::VdbFile& saved, const std::string& name, Grid<float, D>& target,
-                 const std::string& sceneSource);
+                 const std::string& sceneSource, const BlockPlacement<D>& placement = {});
 
 // MAC face velocities in a frame for --resume: component a as the cell grid "vel_face_<x|y|z>"
 // of its own size (VDB files hold cell grids; tools should use the cell-centred "vel").
 template <int D>
 void writeFaceVelocities(io::VdbWriter& writer, const MacGrid<D>& velocity);
 template <int D>
-void restoreFaceVelocities(const io::VdbFile& saved, MacGrid<D>& velocity, const std::string& sceneSource);
+void restoreFaceVelocities(const io::VdbFile& saved, MacGrid<D>& velocity, const std::string& sceneSource,
+                           const BlockPlacement<D>& placement = {});
 
 // Point attribute `name` of a cloud read back from a saved frame for --resume; InputError naming
 // the scene and file when the cloud has points but not the attribute (an empty list for an empty

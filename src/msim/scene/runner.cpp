@@ -187,8 +187,6 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
   if (ranks > 1 && !scene.type->splitsAmongProcesses)
     throw InputError(fmt::format("{}: 'phenomenon' {} runs on one process; run it without mpirun (-np {})",
                                  scene.file.string(), scene.type->name, ranks));
-  if (ranks > 1 && options.resume)
-    throw InputError(scene.file.string() + ": --resume is not available under mpirun; rerun the scene");
 
   // Build first: a scene that fails here (a mesh that does not load, a source outside the
   // domain) must not leave even an empty output folder behind.

@@ -250,7 +250,7 @@ void SmokeSolver<D>::step(double dt) {
     applyInflow();
     updateExpansion();
     if (split_) {
-      pressureIterations_ = split_->project(velocity_, dt, params_.fluidDensity).iterations;
+      pressureIterations_ = split_->project(velocity_, projection_.pressure(), dt, params_.fluidDensity).iterations;
       split_->exchange(velocity_);  // the divergence below and the scalars' advection read ghosts
       maxDivergence_ = splitDivergence();
     } else {

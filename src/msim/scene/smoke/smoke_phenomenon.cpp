@@ -291,6 +291,8 @@ class SmokePhenomenon final : public Phenomenon {
 
   void restore(const std::filesystem::path& vdbFile, double time) override {
     const io::VdbFile saved(vdbFile, io::VdbProvenance::MsimRun);
+    // A split run's ranks each read the whole frame and keep their block of it.
+    const BlockPlacement<D> block = split_ ? split_->placement() : BlockPlacement<D>{};
     time_ = time;
     solver_.setTime(time);
     if (obstacles_.moving()) placeObstacles(time_);
@@ -302,13 +304,13 @@ class SmokePhenomenon final : public Phenomenon {
       turbulence_->downsample(solver_.density(), solver_.temperature());
       turbulence_->reseedParticles();
     } else {
-      restoreGrid(saved, "density", solver_.density(), source_);
-      restoreGrid(saved, "temperature", solver_.temperature(), source_);
+      restoreGrid(saved, "density", solver_.density(), source_, block);
+      restoreGrid(saved, "temperature", solver_.temperature(), source_, block);
     }
     for (std::size_t i = 0; i < solver_.scalarCount(); ++i)
-      restoreGrid(saved, solver_.scalarName(i), solver_.scalar(i), source_);
-    restoreFaceVelocities(saved, solver_.velocity(), source_);
-    restoreGrid(saved, "pressure", solver_.pressure(), source_);
+      restoreGrid(saved, solver_.scalarName(i), solver_.scalar(i), source_, block);
+    restoreFaceVelocities(saved, solver_.velocity(), source_, block);
+    restoreGrid(saved, "pressure", solver_.pressure(), source_, block);
     if (fluid::VortexLayer<D>* layer = solver_.vortexLayer())
       restoreVortexParticles(saved, kVortexPoints, *layer, source_);
   }
