@@ -27,17 +27,25 @@ for key in ("smoke_mass_kg", "kinetic_energy_J", "max_speed_m_s", "enstrophy"):
     assert rel < 1e-4, key
 PY
 [[ $(ls "$tmp/two/vdb" | wc -l) -eq 6 && $(ls "$tmp/two/png" | wc -l) -eq 6 ]] || { echo "expected 6 frames"; exit 1; }
-# Around a static obstacle.
-"$msim" run "$scenes/smoke_sphere.json" --out "$tmp/sphere_one" "${short[@]}"
-"${two[@]}" run "$scenes/smoke_sphere.json" --out "$tmp/sphere_two" "${short[@]}"
-python3 - "$tmp/sphere_one/run.json" "$tmp/sphere_two/run.json" <<'PY'
+# Around a static obstacle, and fire under a mesh obstacle that one rank's block does not touch.
+compare_scene() {  # compare_scene SCENE KEYS...: one and two processes agree within 1e-4
+  local scene=$1
+  shift
+  "$msim" run "$scenes/$scene.json" --out "$tmp/${scene}_one" "${short[@]}" "${extra[@]}"
+  "${two[@]}" run "$scenes/$scene.json" --out "$tmp/${scene}_two" "${short[@]}" "${extra[@]}"
+  python3 - "$tmp/${scene}_one/run.json" "$tmp/${scene}_two/run.json" "$scene" "$@" <<'PY'
 import json, sys
 a, b = (json.load(open(p))["frames"][-1] for p in sys.argv[1:3])
-for key in ("smoke_mass_kg", "kinetic_energy_J", "enstrophy"):
+for key in sys.argv[4:]:
     rel = abs(a[key] - b[key]) / abs(a[key])
-    print(f"smoke_sphere {key}: relative difference {rel:.1e}")
+    print(f"{sys.argv[3]} {key}: relative difference {rel:.1e}")
     assert rel < 1e-4, key
 PY
+}
+extra=()
+compare_scene smoke_sphere smoke_mass_kg kinetic_energy_J enstrophy
+extra=(--set smoke.viscosity=0)  # the log's scene is viscous; viscosity does not split yet
+compare_scene burning_log fuel_kg flame_kg kinetic_energy_J
 
 # --resume under mpirun: 3 frames, then on to 6 from the third's VDB (full floats, no fog cut-off:
 # the saved frame is the whole state), against the 6 frames run at once.

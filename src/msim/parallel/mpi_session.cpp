@@ -3,6 +3,8 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "msim/core/error.hpp"
+
 namespace msim::parallel {
 
 MpiSession::MpiSession(int& argc, char**& argv) {
@@ -55,6 +57,41 @@ bool anyRank(bool flag) {
   int mine = flag, any = 0;
   MPI_Allreduce(&mine, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
   return any != 0;
+}
+
+void agreeOnFailure(std::exception_ptr local, MPI_Comm comm) {
+  if (!mpiRunning()) {
+    if (local) std::rethrow_exception(local);
+    return;
+  }
+  // The kind of this rank's failure (0: none, 1: other, 2: input, 3: simulation) and its message.
+  int kind = 0;
+  std::string message;
+  if (local) {
+    try {
+      std::rethrow_exception(local);
+    } catch (const InputError& e) {
+      kind = 2, message = e.what();
+    } catch (const SimulationError& e) {
+      kind = 3, message = e.what();
+    } catch (const std::exception& e) {
+      kind = 1, message = e.what();
+    } catch (...) {
+      kind = 1, message = "unknown error";
+    }
+  }
+  const int rank = rankOf(comm), big = sizeOf(comm);
+  int first = kind ? rank : big;
+  MPI_Allreduce(MPI_IN_PLACE, &first, 1, MPI_INT, MPI_MIN, comm);
+  if (first == big) return;
+  // The lowest failing rank tells every rank what went wrong.
+  int header[2] = {kind, static_cast<int>(message.size())};
+  MPI_Bcast(header, 2, MPI_INT, first, comm);
+  message.resize(static_cast<std::size_t>(header[1]));
+  MPI_Bcast(message.data(), header[1], MPI_CHAR, first, comm);
+  if (header[0] == 2) throw InputError(message);
+  if (header[0] == 3) throw SimulationError(message);
+  throw std::runtime_error(message);
 }
 
 int rankOf(MPI_Comm comm) {

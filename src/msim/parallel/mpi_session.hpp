@@ -6,7 +6,10 @@
 // MPI_Abort, so no rank waits forever for a message that will not come.
 #include <mpi.h>
 
+#include <exception>
+#include <stdexcept>
 #include <string>
+#include <type_traits>
 
 namespace msim::parallel {
 
@@ -29,6 +32,34 @@ int worldSize();
 int ranksOnThisNode();
 // Whether `flag` holds on some rank (the flag itself without MPI). Collective.
 bool anyRank(bool flag);
+
+// Agrees on an error that may have struck some ranks only (a scene's shape that lies outside
+// one rank's block): `local` is this rank's exception or null. If any rank failed, every rank
+// throws the error of the lowest failing rank (InputError, SimulationError, or else
+// std::runtime_error, with its message), so that all stop together and rank 0 can report it;
+// otherwise it returns. Collective; without MPI it rethrows `local` if set.
+void agreeOnFailure(std::exception_ptr local, MPI_Comm comm);
+
+// Runs f on every rank of MPI_COMM_WORLD with agreeOnFailure around it.
+template <typename F>
+auto collectively(F&& f) -> decltype(f()) {
+  std::exception_ptr failure;
+  try {
+    if constexpr (std::is_void_v<decltype(f())>) {
+      f();
+      agreeOnFailure(nullptr, MPI_COMM_WORLD);
+      return;
+    } else {
+      auto result = f();
+      agreeOnFailure(nullptr, MPI_COMM_WORLD);
+      return result;
+    }
+  } catch (...) {
+    failure = std::current_exception();
+  }
+  agreeOnFailure(failure, MPI_COMM_WORLD);
+  throw std::logic_error("agreeOnFailure returned after a failure");  // not reached
+}
 
 int rankOf(MPI_Comm comm);
 int sizeOf(MPI_Comm comm);

@@ -194,7 +194,8 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
   std::unique_ptr<Phenomenon> phenomenon;
   {
     ScopedStage stage(timers, "setup");
-    phenomenon = scene.type->create(scene, timers);
+    // Under mpirun each rank builds its block, and an error may strike some ranks only.
+    phenomenon = parallel::collectively([&] { return scene.type->create(scene, timers); });
   }
   if (writer) {
     fs::create_directories(layout.root);

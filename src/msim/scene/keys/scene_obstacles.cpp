@@ -48,9 +48,11 @@ SceneObstacles<D>::SceneObstacles(const Scene& scene, const GridSpec<D>& spec) :
     o.velocity = sceneVector<D>(list[i].at("velocity"));
     o.amplitude = sceneVector<D>(list[i].at("oscillation"));
     o.frequency = list[i].at("frequency").get<double>();
-    // An obstacle must cut the domain at some frame of the run, or it is a typo.
+    // An obstacle must cut the domain at some frame of the run, or it is a typo. The domain, not
+    // `spec`: a run split among processes samples the obstacles on each rank's block only.
     const auto bounds = o.shape->bounds();
-    const Vec<D> lo = spec.origin, hi = spec.origin + spec.extent();
+    const GridSpec<D> domain = scene.gridSpec<D>();
+    const Vec<D> lo = domain.origin, hi = domain.origin + domain.extent();
     bool seen = false;
     for (int frame = 0; frame <= scene.frameCount && !seen; ++frame) {
       const Vec<D> shift = o.offset(frame / scene.fps);
@@ -75,7 +77,8 @@ void SceneObstacles<D>::warnOfClosedSides(const Scene& scene, const std::string&
   // (and, once it passes the wall, takes volume from a box that cannot give it): the steps shrink
   // tenfold or more. Not an error (the scene may end first), but worth saying before the run.
   const nlohmann::json& sides = scene.resolved.at("domain").at("boundaries");
-  const Vec<D> lo = spec_.origin, hi = spec_.origin + spec_.extent();
+  const GridSpec<D> domain = scene.gridSpec<D>();
+  const Vec<D> lo = domain.origin, hi = domain.origin + domain.extent();
   static const char* axes[] = {"x", "y", "z"};
   for (int frame = 1; frame <= scene.frameCount; ++frame) {
     const double t = frame / scene.fps;
