@@ -29,6 +29,7 @@ DistributedProjection::DistributedProjection(const GridBlock<3>& block, const nu
                                              const numerics::PcgSettings& settings, MPI_Comm comm,
                                              float minOpenFraction)
     : block_(block),
+      origin_(block.cellOrigin()),
       sides_(sides),
       settings_(settings),
       comm_(comm),
@@ -97,8 +98,8 @@ void DistributedProjection::setFreeSurface(const Grid<float, 3>& liquidPhi, floa
 
 DistributedProjection::FaceTerm DistributedProjection::faceTerm(const IVec<3>& l, int axis, int side) const {
   const IVec<3> face = side ? (l + IVec<3>::Unit(axis)).eval() : l;
-  const IVec<3> g = l + block_.cellOrigin();
-  const bool inDomain = side ? g[axis] + 1 < block_.global.res[axis] : g[axis] > 0;
+  const int g = l[axis] + origin_[axis];
+  const bool inDomain = side ? g + 1 < block_.global.res[axis] : g > 0;
   const IVec<3> across = side ? (l + IVec<3>::Unit(axis)).eval() : (l - IVec<3>::Unit(axis)).eval();
   const bool coupled = inDomain && (!liquidPhi_ || (*liquidPhi_)(across) < 0.0f);
   return {weights_.component(axis)(face), coupled, inverseTheta_.component(axis)(face)};

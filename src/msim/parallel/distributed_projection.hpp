@@ -73,6 +73,7 @@ class DistributedProjection {
   double maxResidual();
 
   GridBlock<3> block_;
+  IVec<3> origin_;  // block_.cellOrigin(), kept: the face terms read it for every face
   numerics::DomainSides<3> sides_;
   numerics::PcgSettings settings_;
   MPI_Comm comm_;

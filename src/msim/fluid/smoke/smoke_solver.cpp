@@ -226,7 +226,9 @@ void SmokeSolver<D>::step(double dt) {
   {
     ScopedStage s(timers_, "forces");
     const auto& b = params_.buoyancy;
-    if (split_) {  // buoyancy averages cells to faces, confinement differences the velocity twice
+    if (split_) {
+      // Buoyancy averages cells to faces, confinement differences the velocity twice. Density and
+      // temperature change next only in their advection, so these ghosts serve it too.
       split_->exchange(velocity_);
       split_->exchange(density_);
       split_->exchange(temperature_);
@@ -280,8 +282,7 @@ template <int D>
 void SmokeSolver<D>::advectScalars(double dt) {
   if (!scalarsElsewhere_)
     for (Grid<float, D>* f : {&density_, &temperature_}) {
-      if (split_) split_->exchange(*f);
-      border_.extend(*f);
+      border_.extend(*f);  // a split run filled their ghosts before the forces
       advector_.advect(*f, velocity_, dt);
     }
   for (auto& sc : scalars_) {
