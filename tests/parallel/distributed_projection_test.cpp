@@ -80,7 +80,7 @@ TEST_P(DistributedProjectionTest, MatchesTheSerialProjectionWithinTheTolerance) 
   DistributedProjection projection(block, c.sides, pcg, MPI_COMM_WORLD);
   projection.setOpenFractions(localPart(open, block));
   Grid<float, 3> pressure(block.localSpec());
-  const DistributedProjectionStats stats = projection.project(local, pressure, dt, density);
+  const SplitSolveStats stats = projection.project(local, pressure, dt, density);
   const MacGrid<3> split = gatherToRoot(local, block, MPI_COMM_WORLD);
 
   bool ok = true;
@@ -137,7 +137,7 @@ TEST(DistributedProjection, FreeSurfaceMatchesTheSerialProjection) {
   DistributedProjection projection(block, DomainSides<3>::allWalls(), pcg, MPI_COMM_WORLD);
   projection.setFreeSurface(liquidPhi(block.localSpec()));
   Grid<float, 3> pressure(block.localSpec());
-  const DistributedProjectionStats stats = projection.project(local, pressure, dt, density);
+  const SplitSolveStats stats = projection.project(local, pressure, dt, density);
   const MacGrid<3> split = gatherToRoot(local, block, MPI_COMM_WORLD);
   if (worldRank() == 0) {
     EXPECT_TRUE(stats.converged) << stats.relativeResidual;

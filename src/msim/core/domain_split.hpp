@@ -23,8 +23,6 @@ class DomainSplit {
   virtual BlockPlacement<D> placement() const = 0;
   // The local grid: the owned cells and the ghost layers, over which the solver's fields lie.
   virtual GridSpec<D> localSpec() const = 0;
-  // Ghost layers around the owned cells (where the domain does not end first).
-  virtual int ghostLayers() const = 0;
   // The owned cells in the local grid's coordinates: [lo, hi).
   virtual IVec<D> ownedLo() const = 0;
   virtual IVec<D> ownedHi() const = 0;

@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <vector>
 
 #include <tbb/blocked_range.h>
@@ -42,11 +43,11 @@ class QpOperator {
 // Diagonal entries of samples that couple to nothing (no stencil weight, decoupled(i) true): any
 // positive value keeps A definite, and their bounds or right-hand sides hold them at 0. They take
 // the largest real diagonal (1 if there is none): MPRGP's expansion steps have the fixed length
-// 1.9 / ||A||, so a placeholder far above the real diagonals shortens them as many times (a
-// placeholder of 1, over a hundred times the granular friction diagonals, made flowing sand's
+// 1.9 / ||A||, so a stand-in far above the real diagonals shortens them as many times (a
+// stand-in of 1, over a hundred times the granular friction diagonals, made flowing sand's
 // friction solves take a thousand steps instead of about ten). Parallel.
 template <typename Decoupled>
-void setDecoupledDiagonals(std::vector<double>& diagonal, const Decoupled& decoupled);
+void setDecoupledDiagonals(std::span<double> diagonal, const Decoupled& decoupled);
 
 // Adapter for an assembled symmetric matrix. Keeps a reference: the matrix must outlive it.
 class SparseQpOperator final : public QpOperator {
@@ -152,7 +153,7 @@ class BoundQpSolver {
 };
 
 template <typename Decoupled>
-void setDecoupledDiagonals(std::vector<double>& diagonal, const Decoupled& decoupled) {
+void setDecoupledDiagonals(std::span<double> diagonal, const Decoupled& decoupled) {
   const double largest = tbb::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, diagonal.size(), 4096), 0.0,
       [&](const tbb::blocked_range<std::size_t>& r, double m) {

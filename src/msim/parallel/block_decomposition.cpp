@@ -38,7 +38,6 @@ void searchLattices(const IVec<D>& res, int ranks, int minCells, int axis, IVec<
                     double& bestArea) {
   if (axis == D - 1) {
     blocks[axis] = ranks;
-    if (res[axis] / ranks < minCells) return;
     for (int a = 0; a < D; ++a)
       if (res[a] / blocks[a] < minCells) return;
     const double area = interfaceArea<D>(res, blocks);

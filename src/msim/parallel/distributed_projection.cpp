@@ -37,6 +37,7 @@ DistributedProjection::DistributedProjection(const GridBlock<3>& block, const nu
       velocityGhosts_(block, comm),
       weightGhosts_(block, comm),
       cellGhosts_(block, IVec<3>::Zero(), comm),
+      phiGhosts_(block, IVec<3>::Zero(), comm),
       scaled_(block.localSpec()) {
   if (block.ghost < 1) throw std::invalid_argument("distributed projection: blocks need at least one ghost layer");
   setOpenFractions(MacGrid<3>(block.localSpec(), 1.0f));
@@ -79,7 +80,7 @@ void DistributedProjection::setOpenFractions(const MacGrid<3>& openFraction) {
 
 void DistributedProjection::setFreeSurface(const Grid<float, 3>& liquidPhi, float minTheta) {
   liquidPhi_ = liquidPhi;
-  GhostExchange<float, 3>(block_, IVec<3>::Zero(), comm_).exchange(*liquidPhi_);
+  phiGhosts_.exchange(*liquidPhi_);
   const Grid<float, 3>& phi = *liquidPhi_;
   for (int a = 0; a < 3; ++a) {
     Grid<float, 3>& it = inverseTheta_.component(a);
@@ -202,7 +203,7 @@ double DistributedProjection::maxResidual() {
   return worst;
 }
 
-DistributedProjectionStats DistributedProjection::project(MacGrid<3>& velocity, Grid<float, 3>& pressure, double dt,
+SplitSolveStats DistributedProjection::project(MacGrid<3>& velocity, Grid<float, 3>& pressure, double dt,
                                                          double density) {
   if (!(dt > 0.0) || !(density > 0.0))
     throw std::invalid_argument("pressure projection: the step and the density must be positive");
@@ -242,7 +243,7 @@ DistributedProjectionStats DistributedProjection::project(MacGrid<3>& velocity, 
   }
   HYPRE_StructVectorSetBoxValues(b_, lower, upper, rhs_.data());
   HYPRE_StructVectorSetBoxValues(x_, lower, upper, values_.data());
-  DistributedProjectionStats stats;
+  SplitSolveStats stats;  // iterations: hypre's, all rounds
   const double target = settings_.tolerance * bMax;
   // hypre stops on the 2-norm; the criterion here is the max-norm, so tighten and resume until
   // it holds (usually once).

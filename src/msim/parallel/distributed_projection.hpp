@@ -20,6 +20,7 @@
 #include <optional>
 #include <vector>
 
+#include "msim/core/domain_split.hpp"
 #include "msim/core/grid.hpp"
 #include "msim/core/mac_grid.hpp"
 #include "msim/numerics/pressure/pcg.hpp"
@@ -27,12 +28,6 @@
 #include "msim/parallel/ghost_exchange.hpp"
 
 namespace msim::parallel {
-
-struct DistributedProjectionStats {
-  int iterations = 0;              // hypre PCG iterations, all rounds
-  double relativeResidual = 0.0;   // |b - A p^|_inf / |b|_inf over all ranks
-  bool converged = false;
-};
 
 class DistributedProjection {
  public:
@@ -55,7 +50,7 @@ class DistributedProjection {
   // exchanged first and are stale afterwards. `pressure` [Pa] (local, cell-centred) warm-starts
   // the solve and receives its result on the owned cells, as the serial projection keeps its
   // own (so a resumed run starts from the saved one). Collective.
-  DistributedProjectionStats project(MacGrid<3>& velocity, Grid<float, 3>& pressure, double dt, double density);
+  SplitSolveStats project(MacGrid<3>& velocity, Grid<float, 3>& pressure, double dt, double density);
 
   const MacGrid<3>& faceWeights() const { return weights_; }
 
@@ -83,6 +78,7 @@ class DistributedProjection {
   MacGrid<3> inverseTheta_;                  // 1 / theta on liquid-air faces, 1 elsewhere
   MacGhostExchange<3> velocityGhosts_, weightGhosts_;
   GhostExchange<double, 3> cellGhosts_;
+  GhostExchange<float, 3> phiGhosts_;
   Grid<double, 3> scaled_;  // p^ with ghosts, in hypre's precision: the residual test reads it
   std::vector<double> rhs_, values_, coefficients_;
   std::vector<unsigned char> fluid_;  // owned cells with an unknown (some face open)

@@ -26,8 +26,7 @@ double MpiDomainSplit::maxOverRanks(double value) {
 }
 
 SplitSolveStats MpiDomainSplit::project(MacGrid<3>& velocity, Grid<float, 3>& pressure, double dt, double density) {
-  const DistributedProjectionStats s = projection_.project(velocity, pressure, dt, density);
-  return {s.iterations, s.relativeResidual, s.converged};
+  return projection_.project(velocity, pressure, dt, density);
 }
 
 }  // namespace msim::parallel

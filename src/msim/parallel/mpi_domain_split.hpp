@@ -19,7 +19,6 @@ class MpiDomainSplit final : public DomainSplit<3> {
 
   BlockPlacement<3> placement() const override { return block_.placement(); }
   GridSpec<3> localSpec() const override { return block_.localSpec(); }
-  int ghostLayers() const override { return block_.ghost; }
   IVec<3> ownedLo() const override { return block_.ownedLocal().lo; }
   IVec<3> ownedHi() const override { return block_.ownedLocal().hi; }
   void exchange(Grid<float, 3>& cells) override { cells_.exchange(cells); }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 #include <stdexcept>
 
 namespace msim::crowd::stress {
@@ -33,8 +34,8 @@ class FrictionOperator final : public numerics::QpOperator {
   double normUpperBound() const override { return normBound_; }
 
  private:
-  // Unknowns no open face sees (D's column k empty; D is column-major) carry only their
-  // placeholder diagonal.
+  // Unknowns no open face sees (D's column k empty; D is column-major) carry only the diagonal
+  // setDecoupledDiagonals gave them: their zero right-hand side holds them at 0.
   bool decoupled(Eigen::Index k) const { return d_.outerIndexPtr()[k + 1] == d_.outerIndexPtr()[k]; }
   const Eigen::SparseMatrix<double>& d_;
   const Eigen::SparseMatrix<double>& dt_;
@@ -225,12 +226,11 @@ FrictionResult StressGrid::friction(const Eigen::VectorXd& momentum, double dt, 
   lower_ = -upper_;
   // 1/2 s^T A s - b^T s with A = dt^2 / rho_y D^T D and b = -dt / rho_y D^T m*: E(s) - E(0).
   const double scale = dt * dt / laws.yield;
-  // Unknowns no open face sees (inside walls) get the largest diagonal, as in setDecoupledDiagonals:
-  // their bounds or zero right-hand side hold them at 0 without shortening MPRGP's steps.
+  // Unknowns no open face sees (inside walls) take the largest real diagonal.
   diagonal_ = scale * columnNorms_;
-  const double largest = diagonal_.size() > 0 && diagonal_.maxCoeff() > 0.0 ? diagonal_.maxCoeff() : 1.0;
-  for (Eigen::Index k = 0; k < unknowns; ++k)
-    if (!(diagonal_[k] > 0.0)) diagonal_[k] = largest;
+  numerics::setDecoupledDiagonals(std::span<double>(diagonal_.data(), static_cast<std::size_t>(diagonal_.size())),
+                                  [&](std::size_t k) { return !(columnNorms_[static_cast<Eigen::Index>(k)] > 0.0); });
+  const double largest = diagonal_.size() > 0 ? diagonal_.maxCoeff() : 1.0;
   const double h = grid_.dx;
   const FrictionOperator op(divergence_, divergenceT_, scale, diagonal_, std::max(16.0 * scale / (h * h), largest), faces_);
   rhs_ = -(dt / laws.yield) * (divergenceT_ * momentum);

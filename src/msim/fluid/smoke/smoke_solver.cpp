@@ -174,26 +174,6 @@ void SmokeSolver<D>::checkDistributable() const {
 }
 
 template <int D>
-double SmokeSolver<D>::splitDivergence() const {
-  const IVec<D> lo = split_->ownedLo(), hi = split_->ownedHi();
-  // The face-weighted divergence of the serial measure; the local weights are right on every
-  // face of an owned cell (a block's edge lies a ghost layer away from them).
-  const MacGrid<D>& w = projection_.faceWeights();
-  const double worst = parallelMax(density_.count(), [&](std::size_t i) {
-    const IVec<D> c = density_.coord(i);
-    if ((c.array() < lo.array()).any() || (c.array() >= hi.array()).any()) return 0.0;
-    double div = 0.0;
-    for (int a = 0; a < D; ++a) {
-      IVec<D> up = c;
-      up[a] += 1;
-      div += double(w.component(a)(up)) * velocity_.component(a)(up) - double(w.component(a)(c)) * velocity_.component(a)(c);
-    }
-    return std::abs(div) / spec_.dx;
-  });
-  return split_->maxOverRanks(worst);
-}
-
-template <int D>
 void SmokeSolver<D>::step(double dt) {
   const Grid<float, D>* solid = hasObstacles_ ? &solid_ : nullptr;
   if (split_) checkDistributable();
@@ -254,11 +234,10 @@ void SmokeSolver<D>::step(double dt) {
     if (split_) {
       pressureIterations_ = split_->project(velocity_, projection_.pressure(), dt, params_.fluidDensity).iterations;
       split_->exchange(velocity_);  // the divergence below and the scalars' advection read ghosts
-      maxDivergence_ = splitDivergence();
     } else {
       pressureIterations_ = projection_.project(velocity_, dt, params_.fluidDensity).iterations;
-      maxDivergence_ = measureDivergence();
     }
+    maxDivergence_ = measureDivergence();
   }
   if (vortex_) {
     // The particles move with the divergence-free velocity (Selle ch. 3.3).
@@ -473,7 +452,16 @@ double SmokeSolver<D>::measureDivergence() {
   // Expanding sources keep their divergence on purpose; what is measured is the error.
   if (expansion_.count() != 0)
     return parallelMax(divergence_.count(), [&](std::size_t i) { return std::abs(divergence_[i] - expansion_[i]); });
-  return parallelMax(divergence_.count(), [&](std::size_t i) { return std::abs(divergence_[i]); });
+  if (!split_) return parallelMax(divergence_.count(), [&](std::size_t i) { return std::abs(divergence_[i]); });
+  // A split run: the owned cells (the local face weights are right on all their faces, a block's
+  // edge lying a ghost layer away), over every rank.
+  const IVec<D> lo = split_->ownedLo(), hi = split_->ownedHi();
+  const double worst = parallelMax(divergence_.count(), [&](std::size_t i) {
+    const IVec<D> c = divergence_.coord(i);
+    const bool owned = (c.array() >= lo.array()).all() && (c.array() < hi.array()).all();
+    return owned ? std::abs(double(divergence_[i])) : 0.0;
+  });
+  return split_->maxOverRanks(worst);
 }
 
 template <int D>
@@ -496,9 +484,9 @@ void SmokeSolver<D>::checkFinite() const {
 }
 
 template <int D>
-SmokeStatistics measureSmoke(const MacGrid<D>& velocity, const MacGrid<D>* weights, const Grid<float, D>& density,
-                             const Grid<float, D>* excluded, double fluidDensity) {
-  SmokeStatistics s;
+void measureSmoke(const MacGrid<D>& velocity, const MacGrid<D>* weights, const Grid<float, D>& density,
+                  const Grid<float, D>* excluded, double fluidDensity, SmokeStatistics& s) {
+  s.kineticEnergy = 0.0;
   const GridSpec<D>& spec = velocity.spec();
   const double dV = spec.cellVolume();
   for (int a = 0; a < D; ++a) {
@@ -515,7 +503,6 @@ SmokeStatistics measureSmoke(const MacGrid<D>& velocity, const MacGrid<D>* weigh
   Vorticity<D> vorticity(spec);
   computeVorticity(velocity, vorticity);
   s.enstrophy = enstrophy<D>(vorticity, [](std::size_t) { return true; });
-  return s;
 }
 
 template <int D>
@@ -523,7 +510,14 @@ SmokeStatistics SmokeSolver<D>::statistics() const {
   // The cells each transport keeps scalars in: the Advector overwrites solid cells with their
   // neighbours' mean every step, the conservative transport owns every cell with an open face.
   const Grid<float, D>& excluded = params_.scalarTransport == ScalarTransport::Conservative ? sealed_ : solid_;
-  SmokeStatistics s = measureSmoke<D>(velocity_, &projection_.faceWeights(), density_, &excluded, params_.fluidDensity);
+  SmokeStatistics s = counters();
+  measureSmoke<D>(velocity_, &projection_.faceWeights(), density_, &excluded, params_.fluidDensity, s);
+  return s;
+}
+
+template <int D>
+SmokeStatistics SmokeSolver<D>::counters() const {
+  SmokeStatistics s;
   s.vortexParticles = vortex_ ? vortex_->particles().size() : 0;
   s.maxDivergence = maxDivergence_;
   s.pressureIterations = pressureIterations_;
@@ -564,10 +558,10 @@ void SmokeSolver<D>::applyWinds(double dt) {
   }
 }
 
-template SmokeStatistics measureSmoke<2>(const MacGrid<2>&, const MacGrid<2>*, const Grid<float, 2>&,
-                                         const Grid<float, 2>*, double);
-template SmokeStatistics measureSmoke<3>(const MacGrid<3>&, const MacGrid<3>*, const Grid<float, 3>&,
-                                         const Grid<float, 3>*, double);
+template void measureSmoke<2>(const MacGrid<2>&, const MacGrid<2>*, const Grid<float, 2>&, const Grid<float, 2>*,
+                              double, SmokeStatistics&);
+template void measureSmoke<3>(const MacGrid<3>&, const MacGrid<3>*, const Grid<float, 3>&, const Grid<float, 3>*,
+                              double, SmokeStatistics&);
 template void dissipateSmoke<2>(Grid<float, 2>&, Grid<float, 2>&, double, double, double, double);
 template void dissipateSmoke<3>(Grid<float, 3>&, Grid<float, 3>&, double, double, double, double);
 template class SmokeSolver<2>;

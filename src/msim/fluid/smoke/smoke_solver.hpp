@@ -126,13 +126,13 @@ struct SmokeStatistics {
   std::size_t vortexParticles = 0;
 };
 
-// The measures of a smoke state that SmokeSolver::statistics() reports, from its fields: kinetic
-// energy (faces weighted by `weights`; all open when null), fastest face, smoke mass outside the
-// `excluded` cells (all cells when null) and enstrophy. A run split among processes measures the
-// fields gathered on rank 0 with it.
+// The measures of a smoke state that SmokeSolver::statistics() reports, from its fields, into
+// `out`: kinetic energy (faces weighted by `weights`; all open when null), fastest face, smoke
+// mass outside the `excluded` cells (all cells when null) and enstrophy. A run split among
+// processes measures the fields gathered on rank 0 with it.
 template <int D>
-SmokeStatistics measureSmoke(const MacGrid<D>& velocity, const MacGrid<D>* weights, const Grid<float, D>& density,
-                             const Grid<float, D>* excluded, double fluidDensity);
+void measureSmoke(const MacGrid<D>& velocity, const MacGrid<D>* weights, const Grid<float, D>& density,
+                  const Grid<float, D>* excluded, double fluidDensity, SmokeStatistics& out);
 
 // Smoke decays as exp(-densityRate dt) per step and T - T_ambient as exp(-temperatureRate dt)
 // (params.densityDissipation, temperatureDissipation), on whichever grid carries them.
@@ -197,6 +197,9 @@ class SmokeSolver {
   int advance(double dt);
 
   SmokeStatistics statistics() const;
+  // The solver's own counts (the last solves, steps, vortex particles) without the measures of
+  // its fields (measureSmoke): a split run measures the fields gathered on rank 0 instead.
+  SmokeStatistics counters() const;
 
   MacGrid<D>& velocity() { return velocity_; }
   const MacGrid<D>& velocity() const { return velocity_; }
@@ -249,8 +252,8 @@ class SmokeSolver {
   void checkFinite() const;
   // Split runs: throws InputError if a feature that is not distributed is in use.
   void checkDistributable() const;
-  // Split runs: max |div u| over the owned cells of every rank (velocity ghosts filled).
-  double splitDivergence() const;
+  // max |div u - expansion| after the projection (split runs: over the owned cells of every
+  // rank, velocity ghosts filled).
   double measureDivergence();
 
   GridSpec<D> spec_;

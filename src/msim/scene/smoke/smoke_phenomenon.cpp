@@ -321,16 +321,11 @@ class SmokePhenomenon final : public Phenomenon {
   }
 
   json statistics() const override {
-    fluid::SmokeStatistics s = solver_.statistics();
-    if (split_) {  // measured on the gathered fields; the solver's own numbers are already reduced
+    fluid::SmokeStatistics s = split_ ? solver_.counters() : solver_.statistics();
+    if (split_) {  // measured on the gathered fields; the solver's own counts are already reduced
       const bool solids = !obstacles_.empty();
-      const fluid::SmokeStatistics whole =
-          fluid::measureSmoke<D>(gathered_.velocity, solids ? &gathered_.faceWeights : nullptr, gathered_.density,
-                                 solids ? &gathered_.solid : nullptr, solver_.params().fluidDensity);
-      s.kineticEnergy = whole.kineticEnergy;
-      s.maxSpeed = whole.maxSpeed;
-      s.totalDensity = whole.totalDensity;
-      s.enstrophy = whole.enstrophy;
+      fluid::measureSmoke<D>(gathered_.velocity, solids ? &gathered_.faceWeights : nullptr, gathered_.density,
+                             solids ? &gathered_.solid : nullptr, solver_.params().fluidDensity, s);
     }
     json j = {{"smoke_mass_kg", s.totalDensity},
               {"kinetic_energy_J", s.kineticEnergy},
