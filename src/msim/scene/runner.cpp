@@ -125,6 +125,32 @@ json timingJson(const StageTimers& timers) {
   return stages;
 }
 
+// The frame's files: per-frame data, the VDB, its render, the preview.
+void writeFrameFiles(const Layout& layout, const Phenomenon& phenomenon, StageTimers& timers, int frame,
+                     double frameEnd, int lastFrame) {
+  {
+    ScopedStage stage(timers, "write frame data");
+    phenomenon.writeFrameData(layout.root, frame);
+  }
+  if (layout.vdb) {
+    ScopedStage stage(timers, "write vdb");
+    io::VdbWriter writer(layout.vdbOptions);
+    phenomenon.writeVolume(writer);
+    const io::VdbFrameInfo info{layout.name, frame, frameEnd};
+    writer.write(frameFile(layout.vdbDir, layout.name, frame, "vdb"), &info);
+  }
+  if (layout.render.enabled && (!layout.render.lastFrameOnly || frame == lastFrame)) {
+    // From the file just written, exactly as 'msim render' would make it later.
+    ScopedStage stage(timers, "render frame");
+    renderSavedFrame(io::VdbFile(frameFile(layout.vdbDir, layout.name, frame, "vdb"), io::VdbProvenance::MsimRun),
+                     layout.render, frameFile(layout.renderDir, layout.name, frame, "png"));
+  }
+  if (layout.png) {
+    ScopedStage stage(timers, "write png");
+    io::writePng(frameFile(layout.pngDir, layout.name, frame, "png"), phenomenon.preview());
+  }
+}
+
 class RunRecord {
  public:
   RunRecord(const Scene& scene, const RunOptions& options, const Layout& layout)
@@ -183,7 +209,7 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
     throw InputError(scene.file.string() + ": --resume needs the VDB frames, but 'outputs.vdb' is false");
   // Under mpirun every rank runs this loop; rank 0 alone writes files and reports.
   const int ranks = parallel::worldSize();
-  const bool writer = parallel::worldRank() == 0;
+  const bool writesFiles = parallel::worldRank() == 0;
   if (ranks > 1 && !scene.type->splitsAmongProcesses)
     throw InputError(fmt::format("{}: 'phenomenon' {} runs on one process; run it without mpirun (-np {})",
                                  scene.file.string(), scene.type->name, ranks));
@@ -197,7 +223,7 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
     // Under mpirun each rank builds its block, and an error may strike some ranks only.
     phenomenon = parallel::collectively([&] { return scene.type->create(scene, timers); });
   }
-  if (writer) {
+  if (writesFiles) {
     fs::create_directories(layout.root);
     if (layout.vdb) fs::create_directories(layout.vdbDir);
     if (layout.png) fs::create_directories(layout.pngDir);
@@ -224,7 +250,7 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
     }
     firstFrame = done + 1;
     logger().info("resuming after frame {} of {}", done, lastFrame);
-  } else if (writer) {
+  } else if (writesFiles) {
     clearFrames(layout);
   }
 
@@ -259,40 +285,14 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
         phenomenon->checkFinite(stepIndex, frameEnd);
       }
       phenomenon->endFrame();
-      if (!writer) {
-        if (parallel::anyRank(interruptRequested()) && frame < lastFrame) {
-          status = RunStatus::Interrupted;
-          break;
-        }
-        continue;
+      if (writesFiles) {
+        writeFrameFiles(layout, *phenomenon, timers, frame, frameEnd, lastFrame);
+        json stats = {{"frame", frame}, {"time_s", frameEnd}, {"substeps", substeps}};
+        stats.update(phenomenon->statistics());
+        record.addFrame(std::move(stats));
+        record.save(frame == lastFrame ? "complete" : "running", timers, wall());
+        if (options.showProgress) progress.update(frame, substeps);
       }
-      {
-        ScopedStage stage(timers, "write frame data");
-        phenomenon->writeFrameData(layout.root, frame);
-      }
-      if (layout.vdb) {
-        ScopedStage stage(timers, "write vdb");
-        io::VdbWriter writer(layout.vdbOptions);
-        phenomenon->writeVolume(writer);
-        const io::VdbFrameInfo info{layout.name, frame, frameEnd};
-        writer.write(frameFile(layout.vdbDir, layout.name, frame, "vdb"), &info);
-      }
-      if (layout.render.enabled && (!layout.render.lastFrameOnly || frame == lastFrame)) {
-        // From the file just written, exactly as 'msim render' would make it later.
-        ScopedStage stage(timers, "render frame");
-        renderSavedFrame(io::VdbFile(frameFile(layout.vdbDir, layout.name, frame, "vdb"), io::VdbProvenance::MsimRun),
-                         layout.render,
-                         frameFile(layout.renderDir, layout.name, frame, "png"));
-      }
-      if (layout.png) {
-        ScopedStage stage(timers, "write png");
-        io::writePng(frameFile(layout.pngDir, layout.name, frame, "png"), phenomenon->preview());
-      }
-      json stats = {{"frame", frame}, {"time_s", frameEnd}, {"substeps", substeps}};
-      stats.update(phenomenon->statistics());
-      record.addFrame(std::move(stats));
-      record.save(frame == lastFrame ? "complete" : "running", timers, wall());
-      if (options.showProgress) progress.update(frame, substeps);
       if (parallel::anyRank(interruptRequested()) && frame < lastFrame) {
         status = RunStatus::Interrupted;
         break;
@@ -300,14 +300,14 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
     }
   } catch (const std::exception& e) {
     if (options.showProgress) progress.finish();
-    if (writer) {
+    if (writesFiles) {
       record.note("error", e.what());
       record.save("failed", timers, wall());
     }
     throw;
   }
   if (options.showProgress) progress.finish();
-  if (!writer) return status;
+  if (!writesFiles) return status;
 
   if (status == RunStatus::Complete) {
     ScopedStage stage(timers, "finish run");
