@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cstring>
 
-#include "msim/core/parallel.hpp"
+#include "msim/core/grid_window.hpp"
 
 namespace msim::parallel {
 
@@ -144,8 +144,8 @@ Grid<T, D> localPart(const Grid<T, D>& global, const GridBlock<D>& block) {
   const IVec<D> extra = extraSamples(global);
   const GridSpec<D> spec = block.localSpec();
   Grid<T, D> local(spec, spec.res + extra, global.offset());
-  const IVec<D> origin = block.cellOrigin();
-  parallelForCells<D>(local.size(), [&](const IVec<D>& c, std::size_t i) { local[i] = global.clamped(c + origin); });
+  forEachWindowRow<D>(global, block.cellOrigin(), local,
+                      [](const T* row, T* localRow, std::size_t n) { std::copy_n(row, n, localRow); });
   return local;
 }
 

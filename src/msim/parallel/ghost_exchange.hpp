@@ -72,7 +72,7 @@ template <int D>
 MacGrid<D> gatherToRoot(const MacGrid<D>& local, const GridBlock<D>& block, MPI_Comm comm);
 
 // The block's local part of a global field every rank holds (initial conditions given as whole
-// fields); stored samples outside the domain take the nearest border sample.
+// fields).
 template <typename T, int D>
 Grid<T, D> localPart(const Grid<T, D>& global, const GridBlock<D>& block);
 template <int D>

@@ -2,11 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
 #include "msim/core/error.hpp"
-#include "msim/core/parallel.hpp"
+#include "msim/core/grid_window.hpp"
 #include "msim/geometry/occupancy.hpp"
 #include "msim/geometry/shape_factory.hpp"
 #include "msim/io/vdb.hpp"
@@ -43,11 +44,11 @@ void restoreGrid(const io::VdbFile& file, const std::string& name, Grid<float, D
     std::copy(saved.data().begin(), saved.data().end(), target.data().begin());
     return;
   }
-  parallelForCells<D>(target.size(), [&](const IVec<D>& c, std::size_t i) {
-    IVec3 g = IVec3::Zero();
-    for (int a = 0; a < D; ++a) g[a] = c[a] + placement.cellOrigin[a];
-    target[i] = saved(g);
-  });
+  if constexpr (D == 3)  // runs split among processes are 3D
+    forEachWindowRow<3>(saved, placement.cellOrigin, target,
+                        [](const float* row, float* block, std::size_t n) { std::copy_n(row, n, block); });
+  else
+    throw std::logic_error("restoreGrid: a block of a 2D grid");
 }
 
 const std::vector<float>& savedPointAttribute(const io::PointCloud& cloud, const std::string& name,
