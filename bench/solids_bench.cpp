@@ -14,6 +14,7 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <array>
 #include <random>
 
 #include "msim/solids/cloth_mesh.hpp"
@@ -83,6 +84,31 @@ void BM_ClothCollisionPairs(benchmark::State& state) {
   state.counters["triangles"] = static_cast<double>(mesh.triangles.size());
 }
 
+// Step B.2's self-repulsion on the pleated cloth shaken by up to 0.3 thicknesses, every particle
+// elsewhere at each call (two shakes in turn, so every pair is examined again): finding the pairs
+// closer than the thickness among step A's candidates, then the impulses (twice per inner step).
+void BM_ClothRepulsionPass(benchmark::State& state) {
+  const TriangleMesh mesh = pleatedCloth(static_cast<int>(state.range(0)));
+  solids::CollisionPairs pairs(mesh.triangles, mesh.vertices.size());
+  solids::RepulsionSettings settings;
+  settings.thickness = kThickness;
+  solids::SelfRepulsion repulsion(settings);
+  repulsion.findPairs(pairs, mesh.vertices, mesh.vertices);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> shake(-0.3 * kThickness, 0.3 * kThickness);
+  std::array<std::vector<Vec3>, 2> shaken{mesh.vertices, mesh.vertices};
+  for (auto& x : shaken)
+    for (Vec3& p : x) p += Vec3(shake(rng), shake(rng), shake(rng));
+  const std::vector<double> inverseMass(mesh.vertices.size(), 1e4);
+  std::vector<Vec3> v(mesh.vertices.size(), Vec3::Zero());
+  int contacts = 0;
+  std::size_t call = 0;
+  for (auto _ : state) contacts = repulsion.repelPositionVelocity(shaken[call++ % 2], v, inverseMass, 1.0 / 384.0);
+  state.counters["pairs"] = repulsion.stats().pointTrianglePairs + repulsion.stats().edgeEdgePairs;
+  state.counters["contacts"] = contacts;
+  state.counters["triangles"] = static_cast<double>(mesh.triangles.size());
+}
+
 void BM_ClothContinuousCollisions(benchmark::State& state) {
   const TriangleMesh mesh = pleatedCloth(static_cast<int>(state.range(0)));
   solids::CollisionPairs pairs(mesh.triangles, mesh.vertices.size());
@@ -117,5 +143,6 @@ void BM_IntersectionReferee(benchmark::State& state) {
 BENCHMARK(BM_ClothNewmarkStep)->ArgsProduct({{64, 224}, {0, 1}, {1}})->MinTime(3.0)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_ClothNewmarkStep)->Args({224, 0, 16})->MinTime(3.0)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_ClothCollisionPairs)->Arg(224)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ClothRepulsionPass)->Arg(224)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ClothContinuousCollisions)->Arg(224)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_IntersectionReferee)->Arg(224)->Unit(benchmark::kMillisecond);

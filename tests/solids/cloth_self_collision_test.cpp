@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <random>
 
 #include <Eigen/Geometry>
 
@@ -76,6 +77,45 @@ TEST(SelfRepulsion, InelasticImpulseStopsTheApproachAndKeepsMomentum) {
   // Coulomb friction: mu times the 1.05 m/s of normal speed removed (0.315) exceeds the 0.283
   // m/s of sliding, which stops.
   EXPECT_NEAR(std::hypot(relative[0], relative[2]), 0.0, 1e-12);
+}
+
+// A gathering after only some particles moved re-examines only their pairs (self_repulsion.hpp):
+// its impulses must equal those of a repulsion that examines every pair at the new positions.
+TEST(SelfRepulsion, PairsOfParticlesThatStayedKeepWhatWasFound) {
+  // Two 12 x 12 sheets 0.4 thicknesses apart, jittered: hundreds of point-face and edge pairs.
+  const double thickness = 0.01;
+  TriangleMesh lower = clothPatch(Vec3::Zero(), Vec3(0.2, 0.0, 0.0), Vec3(0.0, 0.0, 0.2), 12, 12);
+  const TriangleMesh upper = clothPatch(Vec3(0.004, 0.4 * thickness, 0.003), Vec3(0.2, 0.0, 0.0), Vec3(0.0, 0.0, 0.2), 12, 12);
+  const int offset = static_cast<int>(lower.vertices.size());
+  lower.vertices.insert(lower.vertices.end(), upper.vertices.begin(), upper.vertices.end());
+  for (auto t : upper.triangles) lower.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> jitter(-0.2 * thickness, 0.2 * thickness);
+  std::vector<Vec3> start = lower.vertices;
+  for (Vec3& x : start) x += Vec3(jitter(rng), 0.3 * jitter(rng), jitter(rng));
+  std::vector<Vec3> later = start;  // every seventh particle moves on
+  for (std::size_t v = 0; v < later.size(); v += 7) later[v] += Vec3(jitter(rng), jitter(rng), jitter(rng));
+
+  RepulsionSettings settings;
+  settings.thickness = thickness;
+  settings.stiffness = 50.0;
+  CollisionPairs pairs(lower.triangles, start.size());
+  const std::vector<double> inverseMass(start.size(), 1e3);
+  std::uniform_real_distribution<double> speed(-0.05, 0.05);
+  std::vector<Vec3> v0(start.size());
+  for (Vec3& u : v0) u = Vec3(speed(rng), speed(rng), speed(rng));
+
+  SelfRepulsion incremental(settings), afresh(settings);
+  incremental.findPairs(pairs, start, start);
+  std::vector<Vec3> first = v0;
+  const int atStart = incremental.repelPositionVelocity(start, first, inverseMass, 1e-3);
+  ASSERT_GT(atStart, 100);
+  std::vector<Vec3> viaIncremental = v0, viaAfresh = v0;
+  const int found = incremental.repelPositionVelocity(later, viaIncremental, inverseMass, 1e-3);
+  afresh.findPairs(pairs, start, start);
+  EXPECT_EQ(found, afresh.repelPositionVelocity(later, viaAfresh, inverseMass, 1e-3));
+  EXPECT_NE(found, atStart) << "the moved particles changed the contacts";
+  for (std::size_t p = 0; p < v0.size(); ++p) ASSERT_EQ(viaIncremental[p], viaAfresh[p]) << "particle " << p;
 }
 
 namespace {

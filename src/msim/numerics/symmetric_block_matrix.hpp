@@ -55,7 +55,7 @@ class SymmetricBlockMatrix {
  private:
   std::vector<int> rowStart_, columns_;
   std::vector<SymmetricBlock<double>> diagonal_;
-  std::vector<SymmetricBlock<float>> blocks_;
+  std::vector<SymmetricBlock<float>> blocks_;  // the pattern's, and one of padding (multiply's wide loads)
 };
 
 }  // namespace msim::numerics

@@ -76,8 +76,21 @@ void NewmarkStepper::gatherTerms(const MassSpringSystem& system, const std::vect
     shortestSpring_ = std::min(shortestSpring_, l0);
     addTerm(t.v.data(), choice.weights.data(), 4, choice.normal, t.damping, reach * t.stiffness / l0, 0.0);
   }
-  gatherIncidence(system.size());
-  matrix_.assemble(system, terms_, incidenceStart_, incidence_);
+  // The terms' particles are the same from one linearisation to the next unless a spring vanished or
+  // an altitude spring chose another candidate: the incidence (and the matrix's slots for it) is
+  // rebuilt only then.
+  const bool sameParticles =
+      incidenceStart_.size() == system.size() + 1 && termParticles_.size() == terms_.size() &&
+      std::equal(terms_.begin(), terms_.end(), termParticles_.begin(), [](const SpringTerm& t, const TermParticles& known) {
+        return t.count == known.count && t.node == known.node;
+      });
+  if (!sameParticles) {
+    termParticles_.resize(terms_.size());
+    for (std::size_t k = 0; k < terms_.size(); ++k) termParticles_[k] = {terms_[k].count, terms_[k].node};
+    gatherIncidence(system.size());
+    ++incidenceVersion_;
+  }
+  matrix_.assemble(system, terms_, incidenceStart_, incidence_, incidenceVersion_);
   if (settings_.preconditioner == SolvePreconditioner::Jacobi) jacobi_.setup(matrix_.matrix());
 }
 
@@ -91,7 +104,7 @@ void NewmarkStepper::gatherIncidence(std::size_t particles) {
   next.assign(incidenceStart_.begin(), incidenceStart_.end() - 1);
   for (std::size_t k = 0; k < terms_.size(); ++k)
     for (int i = 0; i < terms_[k].count; ++i)
-      incidence_[static_cast<std::size_t>(next[static_cast<std::size_t>(terms_[k].node[i])]++)] = {static_cast<int>(k), terms_[k].weight[i]};
+      incidence_[static_cast<std::size_t>(next[static_cast<std::size_t>(terms_[k].node[i])]++)] = {static_cast<int>(k), i};
   termForces_.resize(terms_.size());
 }
 
@@ -109,8 +122,8 @@ void NewmarkStepper::applyElastic(const double* u, double* y) const {
   parallelFor(0, incidenceStart_.size() - 1, [&](std::size_t p) {
     Vec3 sum = Vec3::Zero();
     for (int j = incidenceStart_[p]; j < incidenceStart_[p + 1]; ++j) {
-      const auto& [term, weight] = incidence_[static_cast<std::size_t>(j)];
-      sum += weight * termForces_[static_cast<std::size_t>(term)];
+      const auto& [term, slot] = incidence_[static_cast<std::size_t>(j)];
+      sum += terms_[static_cast<std::size_t>(term)].weight[static_cast<std::size_t>(slot)] * termForces_[static_cast<std::size_t>(term)];
     }
     Eigen::Map<Vec3>(y + 3 * p) += sum;
   }, kTermGrain / 2);

@@ -94,7 +94,13 @@ class NewmarkStepper {
   std::vector<double> inverseMass_;
   std::vector<SpringTerm> terms_;
   std::vector<int> incidenceStart_, incidenceFill_;      // per particle, into incidence_
-  std::vector<std::pair<int, double>> incidence_;        // (term, the particle's weight in it)
+  std::vector<std::pair<int, int>> incidence_;           // (term, the particle's place among its nodes)
+  struct TermParticles {
+    int count = 0;
+    std::array<int, 4> node{};
+  };
+  std::vector<TermParticles> termParticles_;  // what incidence_ was gathered for
+  long incidenceVersion_ = 0;                 // counts the gatherings (the matrix keeps its slots until it changes)
   mutable std::vector<Vec3> termForces_;                 // applyElastic's scratch, one per term
   std::vector<Vec3> residual_, product_, linearisedAt_, previous_;
   double shortestSpring_ = 0.0;  // rest length, or altitude, over the last gathered terms

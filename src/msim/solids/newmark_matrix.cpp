@@ -33,9 +33,26 @@ void NewmarkMatrix::buildPattern(const MassSpringSystem& system) {
 }
 
 void NewmarkMatrix::assemble(const MassSpringSystem& system, const std::vector<SpringTerm>& terms,
-                             std::span<const int> incidenceStart, std::span<const std::pair<int, double>> incidence) {
-  if (particles_ != system.size() || springs_ != system.springs.size() || tetrahedra_ != system.tetrahedra.size())
+                             std::span<const int> incidenceStart, std::span<const std::pair<int, int>> incidence,
+                             long incidenceVersion) {
+  if (particles_ != system.size() || springs_ != system.springs.size() || tetrahedra_ != system.tetrahedra.size()) {
     buildPattern(system);
+    incidenceVersion_ = -1;
+  }
+  if (incidenceVersion != incidenceVersion_) {
+    slots_.resize(incidence.size());
+    parallelFor(0, system.size(), [&](std::size_t p) {
+      for (int j = incidenceStart[p]; j < incidenceStart[p + 1]; ++j) {
+        const SpringTerm& t = terms[static_cast<std::size_t>(incidence[static_cast<std::size_t>(j)].first)];
+        std::array<int, 4>& slot = slots_[static_cast<std::size_t>(j)];
+        for (int i = 0; i < t.count; ++i) {
+          const int q = t.node[static_cast<std::size_t>(i)];
+          slot[static_cast<std::size_t>(i)] = q == static_cast<int>(p) ? -1 : matrix_.find(static_cast<int>(p), q);
+        }
+      }
+    }, 1024);
+    incidenceVersion_ = incidenceVersion;
+  }
   const std::span<const int> rowStart = matrix_.rowStart();
   parallelFor(0, system.size(), [&](std::size_t p) {
     // The row in double (matrix_ rounds it): the diagonal, and each neighbour's block.
@@ -50,8 +67,10 @@ void NewmarkMatrix::assemble(const MassSpringSystem& system, const std::vector<S
       to.xx += w * S.xx, to.yy += w * S.yy, to.zz += w * S.zz, to.xy += w * S.xy, to.xz += w * S.xz, to.yz += w * S.yz;
     };
     for (int j = incidenceStart[p]; j < incidenceStart[p + 1]; ++j) {
-      const auto& [k, ownWeight] = incidence[static_cast<std::size_t>(j)];
+      const auto& [k, place] = incidence[static_cast<std::size_t>(j)];
       const SpringTerm& t = terms[static_cast<std::size_t>(k)];
+      const double ownWeight = t.weight[static_cast<std::size_t>(place)];
+      const std::array<int, 4>& slot = slots_[static_cast<std::size_t>(j)];
       // c d d^T + c' (I - d d^T) = (c - c') d d^T + c' I
       const Vec3& d = t.direction;
       const double a = t.coefficient - t.sideways, b = t.sideways;
@@ -61,8 +80,9 @@ void NewmarkMatrix::assemble(const MassSpringSystem& system, const std::vector<S
         const int q = t.node[static_cast<std::size_t>(i)];
         if (system.pinned[static_cast<std::size_t>(q)]) continue;
         const double w = ownWeight * t.weight[static_cast<std::size_t>(i)];
-        if (q == static_cast<int>(p)) add(diagonal, w, S);
-        else add(exact_[static_cast<std::size_t>(matrix_.find(static_cast<int>(p), q))], w, S);
+        const int entry = slot[static_cast<std::size_t>(i)];
+        if (entry < 0) add(diagonal, w, S);
+        else add(exact_[static_cast<std::size_t>(entry)], w, S);
       }
     }
     matrix_.setRow(p, diagonal, row);

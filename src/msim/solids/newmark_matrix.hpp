@@ -33,9 +33,11 @@ class NewmarkMatrix {
  public:
   // Writes M + the terms into the matrix (the pattern is rebuilt when the mesh changed). The terms
   // each particle takes part in come as CSR by particle: incidence[incidenceStart[p] ..
-  // incidenceStart[p + 1]) = (term, the particle's weight in it).
+  // incidenceStart[p + 1]) = (term, the particle's place among the term's nodes). Where each of
+  // those terms' blocks goes in the particle's row is looked up once per `incidenceVersion` (the
+  // caller changes it whenever the incidence changes) and kept.
   void assemble(const MassSpringSystem& system, const std::vector<SpringTerm>& terms, std::span<const int> incidenceStart,
-                std::span<const std::pair<int, double>> incidence);
+                std::span<const std::pair<int, int>> incidence, long incidenceVersion);
   const numerics::SymmetricBlockMatrix& matrix() const { return matrix_; }
 
  private:
@@ -45,6 +47,10 @@ class NewmarkMatrix {
   numerics::SymmetricBlockMatrix matrix_;
   std::vector<Block> exact_;  // the off-diagonal blocks before rounding, assemble's scratch
   std::size_t particles_ = 0, springs_ = 0, tetrahedra_ = 0;
+  // Per incidence entry (particle p, term), per node q of the term: the off-diagonal entry (p, q)
+  // of the pattern, -1 for p itself; for incidenceVersion_.
+  std::vector<std::array<int, 4>> slots_;
+  long incidenceVersion_ = -1;
 };
 
 }  // namespace msim::solids

@@ -13,6 +13,7 @@ namespace msim::solids {
 
 void SelfRepulsion::findPairs(CollisionPairs& pairs, const std::vector<Vec3>& x, const std::vector<Vec3>& predicted) {
   mesh_ = &pairs;
+  gatheredValid_ = false;  // new pairs: the next gathering examines them all
   pairs.find(x, predicted, settings_.thickness, foundPointTriangle_, foundEdgeEdge_);
   // Each pair's side in the collision-free state (eq. 6.2's history), on all cores.
   pointTriangle_.resize(foundPointTriangle_.size());
@@ -50,88 +51,125 @@ int SelfRepulsion::repelEndVelocity(const std::vector<Vec3>& x, std::vector<Vec3
 // The geometry depends on the positions alone, which a pass leaves alone, so it is found for all
 // pairs at once on all cores, block by block, and the blocks joined in the pairs' order (the
 // Gauss-Seidel passes then see the contacts in the same order whatever the thread count).
+// Consecutive gatherings over the same pairs (the end of one inner step, B.8, and the start of the
+// next, B.2) mostly see the same positions: only strain limiting and the bodies' push-out move
+// particles in between. A pair none of whose particles moved keeps what the last gathering found
+// for it (its face's or edges' frame depends on its particles alone), so only the others are
+// examined again: the result is the same as examining all.
 void SelfRepulsion::gatherContacts(const std::vector<Vec3>& x) {
-  contacts_.clear();
-  if (mesh_ == nullptr) return;
+  if (mesh_ == nullptr) {
+    contacts_.clear();
+    return;
+  }
+  bool incremental = gatheredValid_ && gatheredAt_.size() == x.size();
+  if (incremental) {
+    moved_.resize(x.size());
+    parallelFor(0, x.size(), [&](std::size_t v) { moved_[v] = x[v] != gatheredAt_[v]; });
+    const auto movedCount = static_cast<std::size_t>(std::count(moved_.begin(), moved_.end(), char{1}));
+    if (movedCount == 0) return;
+    incremental = 2 * movedCount < x.size();  // most moved: examining all is cheaper than sorting them out
+  }
+  gatheredAt_ = x;
+  gatheredValid_ = true;
+  const auto moved = [&](int v) { return !incremental || moved_[static_cast<std::size_t>(v)] != 0; };
   const double h = settings_.thickness;
   // Closer than h, and crossed by less than 2h (deeper than repulsion can mend: collisions act).
   const auto within = [h](double gap) { return gap < h && gap > -2.0 * h; };
   const auto& triangles = mesh_->triangles();
   const auto& edges = mesh_->edges();
-  faceNormals_.resize(triangles.size());
-  faceCentroids_.resize(triangles.size());
-  faceRadii2_.resize(triangles.size());
+  faces_.resize(triangles.size());
   parallelFor(0, triangles.size(), [&](std::size_t i) {
     const auto& t = triangles[i];
     const Vec3 &a = x[static_cast<std::size_t>(t[0])], &b = x[static_cast<std::size_t>(t[1])], &c = x[static_cast<std::size_t>(t[2])];
     const Vec3 normal = (b - a).cross(c - a);
     const double length = normal.norm();
-    faceNormals_[i] = length > 0.0 ? Vec3(normal / length) : Vec3::Zero();
     const Vec3 centroid = (a + b + c) / 3.0;
-    faceCentroids_[i] = centroid;
-    faceRadii2_[i] = std::max({(a - centroid).squaredNorm(), (b - centroid).squaredNorm(), (c - centroid).squaredNorm()});
+    faces_[i] = {length > 0.0 ? Vec3(normal / length) : Vec3::Zero(), centroid,
+                 std::max({(a - centroid).squaredNorm(), (b - centroid).squaredNorm(), (c - centroid).squaredNorm()})};
   });
-  edgeMidpoints_.resize(edges.size());
-  edgeHalfLengths_.resize(edges.size());
+  edgeSpheres_.resize(edges.size());
   parallelFor(0, edges.size(), [&](std::size_t i) {
     const Vec3 &p0 = x[static_cast<std::size_t>(edges[i][0])], &p1 = x[static_cast<std::size_t>(edges[i][1])];
-    edgeMidpoints_[i] = 0.5 * (p0 + p1);
-    edgeHalfLengths_[i] = 0.5 * (p1 - p0).norm();
+    edgeSpheres_[i] = {0.5 * (p0 + p1), 0.5 * (p1 - p0).norm()};
   });
+  // The contact of point-triangle pair i, if any, into `found` (pairs are numbered points first,
+  // then edges).
+  const auto examinePointTriangle = [&](std::size_t i, std::vector<Contact>& found) {
+    const PointTriangleHistory& p = pointTriangle_[i];
+    const auto triangle = static_cast<std::size_t>(p.pair.triangle);
+    const auto& t = triangles[triangle];
+    const Vec3& xp = x[static_cast<std::size_t>(p.pair.point)];
+    const Vec3& a = x[static_cast<std::size_t>(t[0])];
+    const FaceFrame& face = faces_[triangle];
+    if (face.normal.squaredNorm() == 0.0) return;  // no area
+    const Vec3 normal = p.flipped ? Vec3(-face.normal) : face.normal;
+    const double gap = (xp - a).dot(normal);  // the distance from the face along the remembered side
+    if (!within(gap)) return;
+    // Only where the point lies over the face: near an edge or a corner the edge pairs act.
+    // The face lies within its farthest corner's distance of its centroid, so a point whose
+    // foot on the face's plane lies farther is not over it (most candidates of a flat cloth:
+    // neighbours beside the face).
+    if ((xp - face.centroid).squaredNorm() - gap * gap > face.radius2) return;
+    const std::optional<Vec3> weights =
+        faceProjectionWeights(xp, a, x[static_cast<std::size_t>(t[1])], x[static_cast<std::size_t>(t[2])]);
+    if (!weights || !(weights->minCoeff() > 0.0)) return;
+    found.push_back({ContactStencil::pointTriangle(p.pair.point, t, *weights), normal, gap, static_cast<int>(i)});
+  };
+  const auto examineEdgeEdge = [&](std::size_t i, std::vector<Contact>& found) {
+    const EdgeEdgeHistory& p = edgeEdge_[i];
+    const auto first = static_cast<std::size_t>(p.pair.first), second = static_cast<std::size_t>(p.pair.second);
+    // Most candidate pairs are far apart: every point of an edge lies within half its length of
+    // its midpoint, so the midpoints' distance less both half lengths bounds the gap from below.
+    const EdgeSphere &one = edgeSpheres_[first], &other = edgeSpheres_[second];
+    const double reach = 2.0 * h + one.halfLength + other.halfLength;
+    if ((one.midpoint - other.midpoint).squaredNorm() >= reach * reach) return;
+    const auto& e = edges[first];
+    const auto& f = edges[second];
+    const std::optional<EdgeEdgeProximity> interior =
+        edgeEdgeInteriorProximity(x[static_cast<std::size_t>(e[0])], x[static_cast<std::size_t>(e[1])],
+                                  x[static_cast<std::size_t>(f[0])], x[static_cast<std::size_t>(f[1])], 2.0 * h);
+    if (!interior) return;  // closest at an end point (the point-face pairs act), or beyond any gap within()
+    const EdgeEdgeProximity& prox = *interior;
+    const bool crossed = p.side.dot(prox.normal) < settings_.edgeFlipEpsilon;
+    const double gap = crossed ? -prox.distance : prox.distance;
+    if (!within(gap)) return;
+    found.push_back({ContactStencil::edgeEdge(e, f, prox.s, prox.t), crossed ? Vec3(-prox.normal) : prox.normal, gap,
+                     static_cast<int>(pointTriangle_.size() + i)});
+  };
+  const auto pairMoved = [&](std::size_t i) {
+    if (i < pointTriangle_.size()) {
+      const PointTrianglePair& p = pointTriangle_[i].pair;
+      const auto& t = triangles[static_cast<std::size_t>(p.triangle)];
+      return moved(p.point) || moved(t[0]) || moved(t[1]) || moved(t[2]);
+    }
+    const EdgeEdgePair& p = edgeEdge_[i - pointTriangle_.size()].pair;
+    const auto &e = edges[static_cast<std::size_t>(p.first)], &f = edges[static_cast<std::size_t>(p.second)];
+    return moved(e[0]) || moved(e[1]) || moved(f[0]) || moved(f[1]);
+  };
   constexpr std::size_t kBlock = 2048;
-  const std::size_t pointBlocks = (pointTriangle_.size() + kBlock - 1) / kBlock;
-  const std::size_t edgeBlocks = (edgeEdge_.size() + kBlock - 1) / kBlock;
-  blockContacts_.resize(std::max(blockContacts_.size(), pointBlocks + edgeBlocks));
-  parallelFor(0, pointBlocks + edgeBlocks, [&](std::size_t block) {
+  const std::size_t pairs = pointTriangle_.size() + edgeEdge_.size();
+  const std::size_t blocks = (pairs + kBlock - 1) / kBlock;
+  blockContacts_.resize(std::max(blockContacts_.size(), blocks));
+  parallelFor(0, blocks, [&](std::size_t block) {
     std::vector<Contact>& found = blockContacts_[block];
     found.clear();
-    if (block < pointBlocks) {
-      const std::size_t end = std::min(pointTriangle_.size(), (block + 1) * kBlock);
-      for (std::size_t i = block * kBlock; i < end; ++i) {
-        const PointTriangleHistory& p = pointTriangle_[i];
-        const auto triangle = static_cast<std::size_t>(p.pair.triangle);
-        const auto& t = triangles[triangle];
-        const Vec3& xp = x[static_cast<std::size_t>(p.pair.point)];
-        const Vec3& a = x[static_cast<std::size_t>(t[0])];
-        if (faceNormals_[triangle].squaredNorm() == 0.0) continue;  // no area
-        const Vec3 normal = p.flipped ? Vec3(-faceNormals_[triangle]) : faceNormals_[triangle];
-        const double gap = (xp - a).dot(normal);  // the distance from the face along the remembered side
-        if (!within(gap)) continue;
-        // Only where the point lies over the face: near an edge or a corner the edge pairs act.
-        // The face lies within its farthest corner's distance of its centroid, so a point whose
-        // foot on the face's plane lies farther is not over it (most candidates of a flat cloth:
-        // neighbours beside the face).
-        if ((xp - faceCentroids_[triangle]).squaredNorm() - gap * gap > faceRadii2_[triangle]) continue;
-        const std::optional<Vec3> weights =
-            faceProjectionWeights(xp, a, x[static_cast<std::size_t>(t[1])], x[static_cast<std::size_t>(t[2])]);
-        if (!weights || !(weights->minCoeff() > 0.0)) continue;
-        found.push_back({ContactStencil::pointTriangle(p.pair.point, t, *weights), normal, gap});
-      }
-    } else {
-      const std::size_t first = (block - pointBlocks) * kBlock;
-      const std::size_t end = std::min(edgeEdge_.size(), first + kBlock);
-      for (std::size_t i = first; i < end; ++i) {
-        const EdgeEdgeHistory& p = edgeEdge_[i];
-        const auto first = static_cast<std::size_t>(p.pair.first), second = static_cast<std::size_t>(p.pair.second);
-        // Most candidate pairs are far apart: every point of an edge lies within half its length of
-        // its midpoint, so the midpoints' distance less both half lengths bounds the gap from below.
-        const double reach = 2.0 * h + edgeHalfLengths_[first] + edgeHalfLengths_[second];
-        if ((edgeMidpoints_[first] - edgeMidpoints_[second]).squaredNorm() >= reach * reach) continue;
-        const auto& e = edges[first];
-        const auto& f = edges[second];
-        const std::optional<EdgeEdgeProximity> interior =
-            edgeEdgeInteriorProximity(x[static_cast<std::size_t>(e[0])], x[static_cast<std::size_t>(e[1])],
-                                      x[static_cast<std::size_t>(f[0])], x[static_cast<std::size_t>(f[1])]);
-        if (!interior) continue;  // closest at an end point: the point-face pairs act
-        const EdgeEdgeProximity& prox = *interior;
-        const bool crossed = p.side.dot(prox.normal) < settings_.edgeFlipEpsilon;
-        const double gap = crossed ? -prox.distance : prox.distance;
-        if (!within(gap)) continue;
-        found.push_back({ContactStencil::edgeEdge(e, f, prox.s, prox.t), crossed ? Vec3(-prox.normal) : prox.normal, gap});
+    const std::size_t first = block * kBlock, end = std::min(pairs, first + kBlock);
+    // The last gathering's contacts in this block (they are in the pairs' order).
+    auto kept = std::lower_bound(contacts_.begin(), contacts_.end(), static_cast<int>(first),
+                                 [](const Contact& c, int pair) { return c.pair < pair; });
+    for (std::size_t i = first; i < end; ++i) {
+      if (incremental && !pairMoved(i)) {
+        while (kept != contacts_.end() && kept->pair < static_cast<int>(i)) ++kept;
+        if (kept != contacts_.end() && kept->pair == static_cast<int>(i)) found.push_back(*kept);
+      } else if (i < pointTriangle_.size()) {
+        examinePointTriangle(i, found);
+      } else {
+        examineEdgeEdge(i - pointTriangle_.size(), found);
       }
     }
   }, 1);
-  for (std::size_t block = 0; block < pointBlocks + edgeBlocks; ++block)
+  contacts_.clear();
+  for (std::size_t block = 0; block < blocks; ++block)
     contacts_.insert(contacts_.end(), blockContacts_[block].begin(), blockContacts_[block].end());
 }
 

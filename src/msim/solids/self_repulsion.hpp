@@ -63,9 +63,11 @@ class SelfRepulsion {
     ContactStencil stencil;
     Vec3 normal;
     double gap = 0.0;
+    int pair = 0;  // its pair: point-triangle pairs first, then edge-edge pairs
   };
   // The pairs closer than h at x (and crossed by less than 2 h), over a face or between the edges'
-  // ends, in the pairs' order (points first).
+  // ends, in the pairs' order (points first); pairs whose particles have not moved since the last
+  // call keep its finding.
   void gatherContacts(const std::vector<Vec3>& x);
   // One Gauss-Seidel pass over the gathered contacts; returns their count.
   int respond(Pass pass, std::vector<Vec3>& v, const std::vector<double>& inverseMass, double dt) const;
@@ -86,12 +88,25 @@ class SelfRepulsion {
   std::vector<PointTrianglePair> foundPointTriangle_;
   std::vector<EdgeEdgePair> foundEdgeEdge_;
   std::vector<std::vector<Contact>> blockContacts_;  // per block of pairs, joined into contacts_
-  // Per pass of positions, shared by the many pairs of each face and edge: every triangle's unit
-  // normal (zero without area), centroid and squared distance from it to its farthest corner,
-  // every edge's midpoint and half length.
-  std::vector<Vec3> faceNormals_, faceCentroids_, edgeMidpoints_;
-  std::vector<double> faceRadii2_, edgeHalfLengths_;
+  // Per pass of positions, shared by the many pairs of each face and edge (each in one record, which
+  // a pair reads at once): every triangle's unit normal (zero without area), centroid and squared
+  // distance from it to its farthest corner, every edge's midpoint and half length.
+  struct FaceFrame {
+    Vec3 normal, centroid;
+    double radius2 = 0.0;
+  };
+  struct EdgeSphere {
+    Vec3 midpoint;
+    double halfLength = 0.0;
+  };
+  std::vector<FaceFrame> faces_;
+  std::vector<EdgeSphere> edgeSpheres_;
   std::vector<Contact> contacts_;
+  // The positions of the last gathering over the current pairs (gatheredValid_), and which particles
+  // have moved since (gatherContacts examines again only the pairs they take part in).
+  std::vector<Vec3> gatheredAt_;
+  std::vector<char> moved_;
+  bool gatheredValid_ = false;
 };
 
 }  // namespace msim::solids

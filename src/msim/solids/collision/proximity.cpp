@@ -42,14 +42,17 @@ double largestCoordinate(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3
 
 std::optional<Vec3> faceProjectionWeights(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
   // The sub-triangle areas measured along n. A nearly degenerate triangle has ill-conditioned
-  // weights; pointTriangleProximity compares them with the edges' candidates.
+  // weights; pointTriangleProximity compares them with the edges' candidates. The signs of wb and
+  // wc are their numerators' (nn > 0), tested before dividing.
   const Vec3 ab = b - a, ac = c - a, ap = p - a;
   const Vec3 n = ab.cross(ac);
   const double nn = n.squaredNorm();
   if (!(nn > 0.0)) return std::nullopt;
-  const double wb = ap.cross(ac).dot(n) / nn, wc = ab.cross(ap).dot(n) / nn;
+  const double bn = ap.cross(ac).dot(n), cn = ab.cross(ap).dot(n);
+  if (!(bn >= 0.0 && cn >= 0.0)) return std::nullopt;
+  const double wb = bn / nn, wc = cn / nn;
   const double wa = 1.0 - wb - wc;
-  if (!(wa >= 0.0 && wb >= 0.0 && wc >= 0.0)) return std::nullopt;
+  if (!(wa >= 0.0)) return std::nullopt;
   return Vec3(wa, wb, wc);
 }
 
@@ -113,17 +116,30 @@ EdgeEdgeProximity edgeEdgeResult(const Vec3& p0, const Vec3& p1, const Vec3& q0,
 }  // namespace
 
 std::optional<EdgeEdgeProximity> edgeEdgeInteriorProximity(const Vec3& p0, const Vec3& p1, const Vec3& q0,
-                                                           const Vec3& q1) {
+                                                           const Vec3& q1, double within) {
   const Vec3 u = p1 - p0, v = q1 - q0, w = p0 - q0;
   // As in edgeEdgeProximity: the squared distance is convex in (s, t), so a critical point
   // strictly inside the unit square is its minimum, and without one the minimum lies on the square's
-  // boundary.
-  const double determinant = u.cross(v).squaredNorm();
-  if (!(determinant > 0.0)) return std::nullopt;
+  // boundary. s = sn / D and t = tn / D with D > 0, so the square is tested on the numerators first:
+  // most pairs a repulsion pass meets (neighbours in a flat sheet) are rejected there without a
+  // division.
+  // At such a point the distance is the lines' along their common normal u x v: |w . (u x v)| / sqrt(D),
+  // so `within` is tested without dividing too (with a margin far above rounding: the exact test
+  // follows). The tests are combined without branching: which of them fails varies from pair to
+  // pair, and a mispredicted branch costs more than the arithmetic. D = 0 (parallel edges) fails
+  // them all.
+  const Vec3 normal = u.cross(v);
+  const double determinant = normal.squaredNorm();
   const double uu = u.dot(u), uv = u.dot(v), vv = v.dot(v), uw = u.dot(w), vw = v.dot(w);
-  const double s = (uv * vw - vv * uw) / determinant, t = (uu * vw - uv * uw) / determinant;
-  if (!(s > 0.0 && s < 1.0 && t > 0.0 && t < 1.0)) return std::nullopt;
-  return edgeEdgeResult(p0, p1, q0, q1, s, t, (w + s * u - t * v).squaredNorm());
+  const double sn = uv * vw - vv * uw, tn = uu * vw - uv * uw, lineGap = w.dot(normal);
+  if (!((sn > 0.0) & (sn < determinant) & (tn > 0.0) & (tn < determinant) &
+        (lineGap * lineGap < (1.0 + 1e-6) * within * within * determinant)))
+    return std::nullopt;
+  const double s = sn / determinant, t = tn / determinant;
+  if (!(s > 0.0 && s < 1.0 && t > 0.0 && t < 1.0)) return std::nullopt;  // a quotient rounded onto an end point
+  const double squared = (w + s * u - t * v).squaredNorm();
+  if (!(squared < within * within)) return std::nullopt;
+  return edgeEdgeResult(p0, p1, q0, q1, s, t, squared);
 }
 
 EdgeEdgeProximity edgeEdgeProximity(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1) {

@@ -7,6 +7,7 @@
 // (face, edges, vertices) and stay well defined for zero-area triangles and zero-length or parallel
 // edges: they compare the interior candidate, when it exists, with the closest points on the
 // boundary, so an ill-conditioned interior solve can never return a point farther than a boundary one.
+#include <cmath>
 #include <optional>
 
 #include "msim/core/vec.hpp"
@@ -36,8 +37,9 @@ EdgeEdgeProximity edgeEdgeProximity(const Vec3& p0, const Vec3& p1, const Vec3& 
 
 // edgeEdgeProximity when its closest points lie strictly inside both edges (the lines' common
 // perpendicular: the only case repulsions act on, the end points being the point-face pairs'),
-// else nullopt; skips the four end-point candidates, which then cannot be the closest.
-std::optional<EdgeEdgeProximity> edgeEdgeInteriorProximity(const Vec3& p0, const Vec3& p1, const Vec3& q0,
-                                                           const Vec3& q1);
+// else nullopt; skips the four end-point candidates, which then cannot be the closest. Also nullopt
+// when they lie `within` or farther apart (the repulsions' reach).
+std::optional<EdgeEdgeProximity> edgeEdgeInteriorProximity(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1,
+                                                           double within = INFINITY);
 
 }  // namespace msim::solids
