@@ -73,61 +73,64 @@ TriangleMesh pleatedCloth(int n) {
   return mesh;
 }
 
-void BM_ClothCollisionPairs(benchmark::State& state) {
-  const TriangleMesh mesh = pleatedCloth(static_cast<int>(state.range(0)));
-  solids::CollisionPairs pairs(mesh.triangles, mesh.vertices.size());
+// The pleated cloth with its pairs and a repulsion of the cloth's thickness.
+struct PleatedCloth {
+  TriangleMesh mesh;
+  solids::CollisionPairs pairs;
   solids::RepulsionSettings settings;
-  settings.thickness = kThickness;
-  solids::SelfRepulsion repulsion(settings);
-  for (auto _ : state) repulsion.findPairs(pairs, mesh.vertices, mesh.vertices);
+  explicit PleatedCloth(int n) : mesh(pleatedCloth(n)), pairs(mesh.triangles, mesh.vertices.size()) {
+    settings.thickness = kThickness;
+  }
+  // The vertices each moved by up to 0.3 thicknesses along each axis.
+  std::vector<Vec3> shaken(std::mt19937& rng) const {
+    std::uniform_real_distribution<double> shake(-0.3 * kThickness, 0.3 * kThickness);
+    std::vector<Vec3> x = mesh.vertices;
+    for (Vec3& p : x) p += Vec3(shake(rng), shake(rng), shake(rng));
+    return x;
+  }
+};
+
+void BM_ClothCollisionPairs(benchmark::State& state) {
+  PleatedCloth cloth(static_cast<int>(state.range(0)));
+  solids::SelfRepulsion repulsion(cloth.settings);
+  for (auto _ : state) repulsion.findPairs(cloth.pairs, cloth.mesh.vertices, cloth.mesh.vertices);
   state.counters["pairs"] = repulsion.stats().pointTrianglePairs + repulsion.stats().edgeEdgePairs;
-  state.counters["triangles"] = static_cast<double>(mesh.triangles.size());
+  state.counters["triangles"] = static_cast<double>(cloth.mesh.triangles.size());
 }
 
 // Step B.2's self-repulsion on the pleated cloth shaken by up to 0.3 thicknesses, every particle
 // elsewhere at each call (two shakes in turn, so every pair is examined again): finding the pairs
 // closer than the thickness among step A's candidates, then the impulses (twice per inner step).
 void BM_ClothRepulsionPass(benchmark::State& state) {
-  const TriangleMesh mesh = pleatedCloth(static_cast<int>(state.range(0)));
-  solids::CollisionPairs pairs(mesh.triangles, mesh.vertices.size());
-  solids::RepulsionSettings settings;
-  settings.thickness = kThickness;
-  solids::SelfRepulsion repulsion(settings);
-  repulsion.findPairs(pairs, mesh.vertices, mesh.vertices);
+  PleatedCloth cloth(static_cast<int>(state.range(0)));
+  solids::SelfRepulsion repulsion(cloth.settings);
+  repulsion.findPairs(cloth.pairs, cloth.mesh.vertices, cloth.mesh.vertices);
   std::mt19937 rng(7);
-  std::uniform_real_distribution<double> shake(-0.3 * kThickness, 0.3 * kThickness);
-  std::array<std::vector<Vec3>, 2> shaken{mesh.vertices, mesh.vertices};
-  for (auto& x : shaken)
-    for (Vec3& p : x) p += Vec3(shake(rng), shake(rng), shake(rng));
-  const std::vector<double> inverseMass(mesh.vertices.size(), 1e4);
-  std::vector<Vec3> v(mesh.vertices.size(), Vec3::Zero());
+  const std::array<std::vector<Vec3>, 2> shaken{cloth.shaken(rng), cloth.shaken(rng)};
+  const std::vector<double> inverseMass(cloth.mesh.vertices.size(), 1e4);
+  std::vector<Vec3> v(cloth.mesh.vertices.size(), Vec3::Zero());
   int contacts = 0;
   std::size_t call = 0;
   for (auto _ : state) contacts = repulsion.repelPositionVelocity(shaken[call++ % 2], v, inverseMass, 1.0 / 384.0);
   state.counters["pairs"] = repulsion.stats().pointTrianglePairs + repulsion.stats().edgeEdgePairs;
   state.counters["contacts"] = contacts;
-  state.counters["triangles"] = static_cast<double>(mesh.triangles.size());
+  state.counters["triangles"] = static_cast<double>(cloth.mesh.triangles.size());
 }
 
 void BM_ClothContinuousCollisions(benchmark::State& state) {
-  const TriangleMesh mesh = pleatedCloth(static_cast<int>(state.range(0)));
-  solids::CollisionPairs pairs(mesh.triangles, mesh.vertices.size());
+  PleatedCloth cloth(static_cast<int>(state.range(0)));
   std::mt19937 rng(7);
-  std::uniform_real_distribution<double> shake(-0.3 * kThickness, 0.3 * kThickness);
-  std::vector<Vec3> end = mesh.vertices;
-  for (Vec3& x : end) x += Vec3(shake(rng), shake(rng), shake(rng));
-  const std::vector<double> mass(mesh.vertices.size(), 1e-4);
-  const std::vector<char> pinned(mesh.vertices.size(), 0);
-  solids::RepulsionSettings repulsion;
-  repulsion.thickness = kThickness;
+  const std::vector<Vec3> end = cloth.shaken(rng);
+  const std::vector<double> mass(cloth.mesh.vertices.size(), 1e-4);
+  const std::vector<char> pinned(cloth.mesh.vertices.size(), 0);
   solids::SelfCollisionResolver resolver;
   solids::SelfCollisionStats stats;
   for (auto _ : state) {
     std::vector<Vec3> x1 = end;
-    stats = resolver.resolve(pairs, mesh.vertices, x1, mass, pinned, 1.0 / 24.0, 1.0 / 192.0, repulsion);
+    stats = resolver.resolve(cloth.pairs, cloth.mesh.vertices, x1, mass, pinned, 1.0 / 24.0, 1.0 / 192.0, cloth.settings);
   }
   state.counters["collisions"] = stats.collisions;
-  state.counters["triangles"] = static_cast<double>(mesh.triangles.size());
+  state.counters["triangles"] = static_cast<double>(cloth.mesh.triangles.size());
 }
 
 void BM_IntersectionReferee(benchmark::State& state) {

@@ -1,10 +1,12 @@
 #include "msim/solids/collision_pairs.hpp"
 
 #include <algorithm>
+#include <numeric>
 #include <set>
 #include <stdexcept>
 #include <string>
 
+#include "msim/core/disjoint_sets.hpp"
 #include "msim/core/parallel.hpp"
 
 namespace msim::solids {
@@ -76,6 +78,65 @@ CollisionPairs::CollisionPairs(std::vector<std::array<int, 3>> triangles, std::s
     }
   edges_.reserve(edges.size());
   for (const auto& [a, b] : edges) edges_.push_back({a, b});
+  DisjointSets pieces(vertexCount);
+  for (const auto& [a, b] : edges_) pieces.join(a, b);
+  std::vector<int> pieceOfRoot(vertexCount, -1);
+  piece_.resize(vertexCount);
+  for (std::size_t v = 0; v < vertexCount; ++v) {
+    int& piece = pieceOfRoot[static_cast<std::size_t>(pieces.root(static_cast<int>(v)))];
+    if (piece < 0) piece = pieceCount_++;
+    piece_[v] = piece;
+  }
+}
+
+void CollisionPairs::groupPieces(const std::vector<Vec3>& start, const std::vector<Vec3>& end, double margin) {
+  // Each piece's box over the whole motion; pieces whose boxes overlap join a group (sweep and
+  // prune along x).
+  pieceBoxes_.assign(static_cast<std::size_t>(pieceCount_), numerics::Aabb{});
+  for (std::size_t v = 0; v < vertexCount_; ++v) {
+    numerics::Aabb& box = pieceBoxes_[static_cast<std::size_t>(piece_[v])];
+    box.grow(start[v]);
+    box.grow(end[v]);
+  }
+  for (numerics::Aabb& box : pieceBoxes_) box.inflate(margin);
+  std::vector<int> order(static_cast<std::size_t>(pieceCount_));
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    return pieceBoxes_[static_cast<std::size_t>(a)].lo.x() < pieceBoxes_[static_cast<std::size_t>(b)].lo.x();
+  });
+  DisjointSets groups(static_cast<std::size_t>(pieceCount_));
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    const numerics::Aabb& box = pieceBoxes_[static_cast<std::size_t>(order[i])];
+    for (std::size_t j = i + 1; j < order.size(); ++j) {
+      const numerics::Aabb& other = pieceBoxes_[static_cast<std::size_t>(order[j])];
+      if (other.lo.x() > box.hi.x()) break;
+      if (box.overlaps(other)) groups.join(order[i], order[j]);
+    }
+  }
+  // Each group's mean displacement, and the vertices' boxes in its frame.
+  groupShift_.assign(static_cast<std::size_t>(pieceCount_), Vec3::Zero());
+  std::vector<int> count(static_cast<std::size_t>(pieceCount_), 0);
+  group_.resize(vertexCount_);
+  for (std::size_t v = 0; v < vertexCount_; ++v) {
+    const int group = groups.root(piece_[v]);
+    group_[v] = group;
+    groupShift_[static_cast<std::size_t>(group)] += end[v] - start[v];
+    ++count[static_cast<std::size_t>(group)];
+  }
+  groups_ = 0;
+  for (std::size_t g = 0; g < groupShift_.size(); ++g)
+    if (count[g] > 0) {
+      groupShift_[g] /= static_cast<double>(count[g]);
+      ++groups_;
+    }
+  vertexBoxes_.resize(vertexCount_);
+  parallelFor(0, vertexCount_, [&](std::size_t v) {
+    numerics::Aabb box;
+    box.grow(start[v]);
+    box.grow(end[v] - groupShift_[static_cast<std::size_t>(group_[v])]);
+    box.inflate(margin);
+    vertexBoxes_[v] = box;
+  });
 }
 
 void CollisionPairs::find(const std::vector<Vec3>& start, const std::vector<Vec3>& end, double margin,
@@ -83,14 +144,7 @@ void CollisionPairs::find(const std::vector<Vec3>& start, const std::vector<Vec3
                           const std::vector<char>* moved) {
   if (start.size() != vertexCount_ || end.size() != vertexCount_)
     throw std::invalid_argument("collision pairs: the positions do not match the mesh's vertex count");
-  vertexBoxes_.resize(vertexCount_);
-  parallelFor(0, vertexCount_, [&](std::size_t v) {
-    numerics::Aabb box;
-    box.grow(start[v]);
-    box.grow(end[v]);
-    box.inflate(margin);
-    vertexBoxes_[v] = box;
-  });
+  groupPieces(start, end, margin);
   triangleBoxes_.resize(triangles_.size());
   parallelFor(0, triangles_.size(), [&](std::size_t t) {
     numerics::Aabb box;
@@ -118,6 +172,7 @@ void CollisionPairs::find(const std::vector<Vec3>& start, const std::vector<Vec3
         triangleTree_.forEachOverlap(vertexBoxes_[v], [&](int t) {
           const auto& tri = triangles_[static_cast<std::size_t>(t)];
           if (tri[0] == point || tri[1] == point || tri[2] == point) return;
+          if (groups_ > 1 && group_[v] != group_[static_cast<std::size_t>(tri[0])]) return;  // boxes in different frames
           if (!isMoved(point) && !isMoved(tri[0]) && !isMoved(tri[1]) && !isMoved(tri[2])) return;
           if (!mayMeetInPairFrame(start, end, {point, tri[0], tri[1], tri[2]}, 1, margin)) return;
           out.push_back({point, t});
@@ -130,6 +185,7 @@ void CollisionPairs::find(const std::vector<Vec3>& start, const std::vector<Vec3
           if (f <= static_cast<int>(e)) return;  // each pair once
           const auto& other = edges_[static_cast<std::size_t>(f)];
           if (sharesVertex(edge, other)) return;
+          if (groups_ > 1 && group_[static_cast<std::size_t>(edge[0])] != group_[static_cast<std::size_t>(other[0])]) return;
           if (!isMoved(edge[0]) && !isMoved(edge[1]) && !isMoved(other[0]) && !isMoved(other[1])) return;
           if (!mayMeetInPairFrame(start, end, {edge[0], edge[1], other[0], other[1]}, 2, margin)) return;
           out.push_back({static_cast<int>(e), f});

@@ -4,10 +4,15 @@
 // bounding-volume trees over the triangles' and the edges' boxes. A primitive's box spans its
 // vertices at the start and at the end of a motion, grown by a margin: for a mesh at rest
 // (start = end) the pairs within the margin (repulsions, step A), for a moving one the pairs
-// that may meet during the motion (continuous collision detection, step C). The trees find the
-// overlaps in the frame of the positions given; each leaf pair is then tested again in the frame
-// that moves with its own mean displacement (ch. 6.3, step C.2). The pruning is loose on purpose
-// (ch. 6.2): the narrow phase decides. Pairs that share a vertex are never reported
+// that may meet during the motion (continuous collision detection, step C). Distances are the
+// same in every frame that moves uniformly, so the boxes may be judged in any such frame, and the
+// tighter the frame follows the primitives, the fewer boxes overlap: the mesh's pieces (its
+// connected parts: leaves, garments) whose boxes over the whole motion overlap form groups, the
+// trees find the overlaps within each group in the frame that moves with the group's mean
+// displacement (a leaf tumbling through the air is judged in its own frame, not swept along its
+// path), and primitives of different groups cannot meet. Each leaf pair is then tested again in
+// the frame that moves with its own mean displacement (ch. 6.3, step C.2). The pruning is loose on
+// purpose (ch. 6.2): the narrow phase decides. Pairs that share a vertex are never reported
 // (a triangle's own vertices, edges meeting at a vertex).
 #include <array>
 #include <vector>
@@ -46,9 +51,18 @@ class CollisionPairs {
             const std::vector<char>* moved = nullptr);
 
  private:
+  // The vertices' boxes in the frame of their group's mean displacement, and the groups.
+  void groupPieces(const std::vector<Vec3>& start, const std::vector<Vec3>& end, double margin);
+
   std::vector<std::array<int, 3>> triangles_;
   std::vector<std::array<int, 2>> edges_;
   std::size_t vertexCount_;
+  std::vector<int> piece_;  // per vertex, its piece (connected part of the mesh), 0 .. pieceCount_ - 1
+  int pieceCount_ = 0;
+  std::vector<int> group_;  // per vertex, its group in the last find
+  int groups_ = 0;
+  std::vector<numerics::Aabb> pieceBoxes_;
+  std::vector<Vec3> groupShift_;
   std::vector<numerics::Aabb> vertexBoxes_, triangleBoxes_, edgeBoxes_;
   numerics::Bvh triangleTree_, edgeTree_;
   long queries_ = 0;

@@ -71,36 +71,21 @@ void applyRigidImpactZone(std::span<const int> zone, const std::vector<double>& 
 }
 
 ImpactZones::ImpactZones(int particleCount)
-    : parent_(static_cast<std::size_t>(particleCount)),
-      size_(static_cast<std::size_t>(particleCount), 1),
-      collided_(static_cast<std::size_t>(particleCount), 0) {
-  for (int i = 0; i < particleCount; ++i) parent_[i] = i;
-}
-
-int ImpactZones::root(int particle) const {
-  while (parent_[particle] != particle) particle = parent_[particle];
-  return particle;
-}
+    : sets_(static_cast<std::size_t>(particleCount)), collided_(static_cast<std::size_t>(particleCount), 0) {}
 
 void ImpactZones::addCollision(std::span<const int> particles) {
   if (particles.empty()) return;
   for (const int p : particles) collided_[p] = 1;
-  for (const int p : particles.subspan(1)) {
-    int a = root(particles[0]), b = root(p);
-    if (a == b) continue;
-    if (size_[a] < size_[b]) std::swap(a, b);
-    parent_[b] = a;
-    size_[a] += size_[b];
-  }
+  for (const int p : particles.subspan(1)) sets_.join(particles[0], p);
 }
 
 std::vector<std::vector<int>> ImpactZones::zones() const {
   std::vector<std::vector<int>> result;
-  std::vector<int> zoneOfRoot(parent_.size(), -1);
+  std::vector<int> zoneOfRoot(sets_.size(), -1);
   // Visiting the particles in increasing order sorts each zone and orders the zones.
-  for (int p = 0; p < static_cast<int>(parent_.size()); ++p) {
+  for (int p = 0; p < static_cast<int>(sets_.size()); ++p) {
     if (!collided_[p]) continue;
-    int& zone = zoneOfRoot[root(p)];
+    int& zone = zoneOfRoot[static_cast<std::size_t>(sets_.root(p))];
     if (zone < 0) {
       zone = static_cast<int>(result.size());
       result.emplace_back();

@@ -28,6 +28,7 @@
 #include <span>
 #include <vector>
 
+#include "msim/core/disjoint_sets.hpp"
 #include "msim/core/vec.hpp"
 
 namespace msim::solids {
@@ -60,10 +61,7 @@ class ImpactZones {
   std::vector<std::vector<int>> zones() const;
 
  private:
-  int root(int particle) const;
-
-  std::vector<int> parent_;
-  std::vector<int> size_;  // of the tree under each root (union by size keeps the trees shallow)
+  DisjointSets sets_;
   std::vector<char> collided_;
 };
 
