@@ -45,9 +45,9 @@ class QpOperator {
 // the largest real diagonal (1 if there is none): MPRGP's expansion steps have the fixed length
 // 1.9 / ||A||, so a stand-in far above the real diagonals shortens them as many times (a
 // stand-in of 1, over a hundred times the granular friction diagonals, made flowing sand's
-// friction solves take a thousand steps instead of about ten). Parallel.
+// friction solves take a thousand steps instead of about ten). Returns that value. Parallel.
 template <typename Decoupled>
-void setDecoupledDiagonals(std::span<double> diagonal, const Decoupled& decoupled);
+double setDecoupledDiagonals(std::span<double> diagonal, const Decoupled& decoupled);
 
 // Adapter for an assembled symmetric matrix. Keeps a reference: the matrix must outlive it.
 class SparseQpOperator final : public QpOperator {
@@ -153,7 +153,7 @@ class BoundQpSolver {
 };
 
 template <typename Decoupled>
-void setDecoupledDiagonals(std::span<double> diagonal, const Decoupled& decoupled) {
+double setDecoupledDiagonals(std::span<double> diagonal, const Decoupled& decoupled) {
   const double largest = tbb::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, diagonal.size(), 4096), 0.0,
       [&](const tbb::blocked_range<std::size_t>& r, double m) {
@@ -162,10 +162,12 @@ void setDecoupledDiagonals(std::span<double> diagonal, const Decoupled& decouple
         return m;
       },
       [](double a, double b) { return std::max(a, b); });
+  const double fill = largest > 0.0 ? largest : 1.0;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, diagonal.size(), 4096), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t i = r.begin(); i != r.end(); ++i)
-      if (decoupled(i)) diagonal[i] = largest > 0.0 ? largest : 1.0;
+      if (decoupled(i)) diagonal[i] = fill;
   });
+  return fill;
 }
 
 }  // namespace msim::numerics

@@ -103,7 +103,7 @@ DistributedProjection::FaceTerm DistributedProjection::faceTerm(const IVec<3>& l
   const bool inDomain = side ? g + 1 < block_.global.res[axis] : g > 0;
   const IVec<3> across = side ? (l + IVec<3>::Unit(axis)).eval() : (l - IVec<3>::Unit(axis)).eval();
   const bool coupled = inDomain && (!liquidPhi_ || (*liquidPhi_)(across) < 0.0f);
-  return {weights_.component(axis)(face), coupled, inverseTheta_.component(axis)(face)};
+  return {weights_.component(axis)(face), coupled, inverseTheta_.component(axis)(face), across};
 }
 
 void DistributedProjection::assemble() {
@@ -194,8 +194,7 @@ double DistributedProjection::maxResidual() {
     for (int a = 0; a < 3; ++a)
       for (int side = 0; side < 2; ++side) {
         const FaceTerm t = faceTerm(l, a, side);
-        const IVec<3> across = side ? (l + IVec<3>::Unit(a)).eval() : (l - IVec<3>::Unit(a)).eval();
-        ax += t.coupled ? t.weight * (x - scaled_(across)) : t.weight * t.scale * x;
+        ax += t.coupled ? t.weight * (x - scaled_(t.across)) : t.weight * t.scale * x;
       }
     worst = std::max(worst, std::abs(rhs_[k] - ax));
   });

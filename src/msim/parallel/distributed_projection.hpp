@@ -60,6 +60,7 @@ class DistributedProjection {
     double weight;  // w_f
     bool coupled;   // the neighbour across has an unknown
     double scale;   // 1 / theta across a liquid-air face, else 1
+    IVec<3> across;  // the local cell on the face's other side
   };
   FaceTerm faceTerm(const IVec<3>& l, int axis, int side) const;
   void assemble();

@@ -228,9 +228,9 @@ FrictionResult StressGrid::friction(const Eigen::VectorXd& momentum, double dt, 
   const double scale = dt * dt / laws.yield;
   // Unknowns no open face sees (inside walls) take the largest real diagonal.
   diagonal_ = scale * columnNorms_;
-  numerics::setDecoupledDiagonals(std::span<double>(diagonal_.data(), static_cast<std::size_t>(diagonal_.size())),
-                                  [&](std::size_t k) { return !(columnNorms_[static_cast<Eigen::Index>(k)] > 0.0); });
-  const double largest = diagonal_.size() > 0 ? diagonal_.maxCoeff() : 1.0;
+  const double largest = numerics::setDecoupledDiagonals(
+      std::span<double>(diagonal_.data(), static_cast<std::size_t>(diagonal_.size())),
+      [&](std::size_t k) { return !(columnNorms_[static_cast<Eigen::Index>(k)] > 0.0); });
   const double h = grid_.dx;
   const FrictionOperator op(divergence_, divergenceT_, scale, diagonal_, std::max(16.0 * scale / (h * h), largest), faces_);
   rhs_ = -(dt / laws.yield) * (divergenceT_ * momentum);

@@ -212,8 +212,6 @@ class SmokeSolver {
   const std::string& scalarName(std::size_t i) const { return scalars_[i].name; }
   std::size_t scalarCount() const { return scalars_.size(); }
   const Grid<float, D>& solid() const { return solid_; }
-  // The projection's face weights: open fractions after thresholding, 0 on domain walls.
-  const MacGrid<D>& faceWeights() const { return projection_.faceWeights(); }
   const numerics::PressureProjection<D>& projection() const { return projection_; }
   // The last pressure [Pa]; it warm-starts the next projection, so a resumed run restores it.
   Grid<float, D>& pressure() { return projection_.pressure(); }

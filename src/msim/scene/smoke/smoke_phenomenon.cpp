@@ -245,7 +245,7 @@ class SmokePhenomenon final : public Phenomenon {
     for (std::size_t i = 0; i < solver_.scalarCount(); ++i) split_->gather(solver_.scalar(i), g.scalars[i]);
     if (!obstacles_.empty() && !g.solidsGathered) {  // static: once (decided alike on every rank)
       split_->gather(solver_.solid(), g.solid);
-      split_->gather(solver_.faceWeights(), g.faceWeights);
+      split_->gather(solver_.projection().faceWeights(), g.faceWeights);
       g.solidsGathered = true;
     }
   }
