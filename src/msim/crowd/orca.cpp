@@ -195,23 +195,35 @@ void OrcaSolver::computeVelocities(const Agents& agents, const StaticObstacles& 
             }
             const std::size_t hard = s.planes.size();
 
-            // The maxNeighbours closest agents within neighbourDist, ties by index (deterministic).
+            // The maxNeighbours closest agents within neighbourDist, ties by index (deterministic). Each
+            // row of the stencil's distances is computed in one vectorisable pass; the list is only touched
+            // by candidates closer than its current last entry (or within range while it is short).
             s.nearest.clear();
             if (maxNeighbours > 0) {
+              float threshold = range2;  // candidates beyond it cannot enter the list
               for (int q = 0; q < st.count; ++q) {
-                for (std::uint32_t j = st.lo[q]; j < st.hi[q]; ++j) {
-                  const float ex = pos[j].x() - xi.x(), ey = pos[j].y() - xi.y();
-                  const float d2 = ex * ex + ey * ey;
-                  if (d2 >= range2 || j == k) continue;
-                  const Neighbour entry{d2, order[j], j};
+                const std::uint32_t lo = st.lo[q], count = st.hi[q] - lo;
+                s.distances.resize(std::max<std::size_t>(s.distances.size(), count));
+                float* d2 = s.distances.data();
+                const Vec2f* p = pos.data() + lo;
+                for (std::uint32_t m = 0; m < count; ++m) {
+                  const float ex = p[m].x() - xi.x(), ey = p[m].y() - xi.y();
+                  d2[m] = ex * ex + ey * ey;
+                }
+                for (std::uint32_t m = 0; m < count; ++m) {
+                  if (d2[m] > threshold) continue;
+                  const std::uint32_t j = lo + m;
+                  if (d2[m] >= range2 || j == k) continue;
+                  const Neighbour entry{d2[m], order[j], j};
                   if (s.nearest.size() == maxNeighbours) {
                     if (!closer(entry, s.nearest.back())) continue;
                     s.nearest.back() = entry;
                   } else {
                     s.nearest.push_back(entry);
                   }
-                  for (std::size_t m = s.nearest.size() - 1; m > 0 && closer(s.nearest[m], s.nearest[m - 1]); --m)
-                    std::swap(s.nearest[m], s.nearest[m - 1]);
+                  for (std::size_t i2 = s.nearest.size() - 1; i2 > 0 && closer(s.nearest[i2], s.nearest[i2 - 1]); --i2)
+                    std::swap(s.nearest[i2], s.nearest[i2 - 1]);
+                  if (s.nearest.size() == maxNeighbours) threshold = s.nearest.back().d2;
                 }
               }
             }

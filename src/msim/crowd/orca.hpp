@@ -69,6 +69,7 @@ class OrcaSolver {
   };
   struct Scratch {
     std::vector<Neighbour> nearest;  // closest first
+    std::vector<float> distances;    // squared distances to one row of stencil candidates
     std::vector<HalfPlane> planes;
     std::vector<HalfPlane> projected;
   };
