@@ -1,6 +1,6 @@
 // The crowd stress model end to end (Golas ch. 4) on scenes/crowd_stress_merge.json: the merge
 // packs past the critical density, every friction solve converges, the crowd pressure is measured
-// per frame; bad settings exit 2 naming their key.
+// per frame over space and time, with the strain rate and the run's peak pressure map; bad settings exit 2 naming their key.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -32,9 +32,18 @@ TEST(CrowdStressCli, MergePacksPastTheCriticalDensityAndEverySolveConverges) {
   for (const json& f : run.at("frames")) {
     densest = std::max(densest, f.at("max_density_per_m2").get<double>());
     EXPECT_GE(f.at("pressure_max_per_s2").get<double>(), 0.0);
+    EXPECT_LE(f.at("pressure_temporal_mean_per_s2").get<double>(), f.at("pressure_temporal_max_per_s2").get<double>());
+    EXPECT_LE(f.at("strain_rate_mean_per_s").get<double>(), f.at("strain_rate_max_per_s").get<double>());
   }
   EXPECT_GT(densest, 3.5);  // the stress model's regime
   EXPECT_GT(run.at("frames").back().at("agents").get<int>(), 500);
+  // A packed crowd that moves: people's velocities vary in time and space.
+  EXPECT_GT(run.at("frames").back().at("pressure_temporal_mean_per_s2").get<double>(), 0.0);
+  EXPECT_GT(run.at("frames").back().at("strain_rate_mean_per_s").get<double>(), 0.0);
+  const json& turbulence = run.at("results").at("turbulence");
+  EXPECT_GE(turbulence.at("pressure_temporal_peak_per_s2").get<double>(),
+            run.at("frames").back().at("pressure_temporal_max_per_s2").get<double>() - 1e-6);
+  EXPECT_TRUE(fs::exists(dir / "out" / "pressure_map.png"));
 }
 
 TEST(CrowdStressCli, BadSettingsNameTheirKey) {

@@ -56,6 +56,27 @@ TEST(FloorPlan, ValuesMapToTheColourMapAndObstaclesAreFilled) {
   EXPECT_LT(colourMap(0.5).sum(), colourMap(1.0).sum());
 }
 
+TEST(FloorPlan, CellFieldColoursTheFloorWhereItIsPositive) {
+  FloorPlan plan;
+  plan.hi = Vec2(4, 2);
+  plan.width = 400;  // 0.01 m pixels, 400 x 200; row 150 is y = 0.495
+  plan.valueMin = 1.0;
+  plan.valueMax = 3.0;
+  const std::vector<float> values{2.0f, 0.0f};  // two 1 m cells over [0, 2] x [0, 1]
+  const CellField field{GridSpec<2>(Vec2(0, 0), 1.0, IVec<2>(2, 1)), values};
+  const io::Image image = renderFloorPlan(plan, Discs{}, {}, &field);
+  const Vec3 mid = colourMap(0.5);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(linear(image.pixel(50, 150)[c]), mid[c], 0.01);          // the cell holding 2
+    EXPECT_NEAR(linear(image.pixel(150, 150)[c]), plan.floor[c], 0.01);  // the cell holding 0
+    EXPECT_NEAR(linear(image.pixel(300, 150)[c]), plan.floor[c], 0.01);  // beyond the field
+    EXPECT_NEAR(linear(image.pixel(50, 50)[c]), plan.floor[c], 0.01);    // above it
+  }
+  const std::vector<float> short_{1.0f};
+  const CellField wrong{field.spec, short_};
+  expectInvalidArgument([&] { renderFloorPlan(plan, Discs{}, {}, &wrong); }, "field values");
+}
+
 TEST(FloorPlan, BadInputIsRefused) {
   FloorPlan plan;
   expectInvalidArgument([&] { renderFloorPlan(plan, Discs{{Vec2(0.5, 0.5), Vec2(0.2, 0.2)}, {0.1, 0.1, 0.1}, {}}); },

@@ -59,8 +59,12 @@ void FloorPlan::validate() const {
   if (!(valueMax > valueMin)) throw std::invalid_argument("floor plan: valueMax must exceed valueMin");
 }
 
-io::Image renderFloorPlan(const FloorPlan& plan, const Discs& discs, const std::vector<std::vector<Vec2>>& obstacles) {
+io::Image renderFloorPlan(const FloorPlan& plan, const Discs& discs, const std::vector<std::vector<Vec2>>& obstacles,
+                          const CellField* floorField) {
   plan.validate();
+  if (floorField != nullptr && floorField->values.size() != floorField->spec.cellCount())
+    throw std::invalid_argument("floor plan: " + std::to_string(floorField->values.size()) + " field values for " +
+                                std::to_string(floorField->spec.cellCount()) + " cells");
   const std::size_t n = discs.centres.size();
   if (discs.radii.size() != n && discs.radii.size() != 1 && !(n == 0 && discs.radii.empty()))
     throw std::invalid_argument("floor plan: " + std::to_string(discs.radii.size()) + " radii for " +
@@ -100,6 +104,13 @@ io::Image renderFloorPlan(const FloorPlan& plan, const Discs& discs, const std::
   parallelFor(0, static_cast<std::size_t>(height), [&](std::size_t row) {
     const double y = plan.hi.y() - (static_cast<double>(row) + 0.5) * pixel;
     std::vector<Vec3> colours(static_cast<std::size_t>(plan.width), plan.floor);
+    if (floorField != nullptr && floorField->spec.contains(Vec2(floorField->spec.origin.x(), y)))
+      for (int col = 0; col < plan.width; ++col) {
+        const Vec2 p(plan.lo.x() + (col + 0.5) * pixel, y);
+        if (!floorField->spec.contains(p)) continue;
+        const float v = floorField->values[floorField->spec.clampedCellIndex(p)];
+        if (v > 0.0f) colours[static_cast<std::size_t>(col)] = colourMap((v - plan.valueMin) / (plan.valueMax - plan.valueMin));
+      }
     std::vector<double> crossings;
     for (std::size_t k = 0; k < obstacles.size(); ++k)
       if (obstacles[k].size() >= 3 && y >= polygonLo[k].y() && y <= polygonHi[k].y())

@@ -3,8 +3,10 @@
 // (speed, density, ...) through a colour map, over a floor with polygonal obstacles. This is the
 // picture crowd simulations are judged by (issue #4: "agents in 2D crowds as discs on a floor
 // plan, coloured by a chosen field").
+#include <span>
 #include <vector>
 
+#include "msim/core/grid_spec.hpp"
 #include "msim/core/vec.hpp"
 #include "msim/io/png.hpp"
 
@@ -24,6 +26,13 @@ struct FloorPlan {
   void validate() const;
 };
 
+// A field on the cells of a grid shown on the floor through the colour map (over [valueMin,
+// valueMax] of the plan), cells holding 0 or less left as floor; obstacles and discs go on top.
+struct CellField {
+  GridSpec<2> spec;
+  std::span<const float> values;  // spec.cellCount() values, x fastest
+};
+
 struct Discs {
   std::vector<Vec2> centres;  // [m]
   std::vector<double> radii;  // one per disc, or a single radius for all [m]
@@ -34,6 +43,6 @@ struct Discs {
 // coverage of the disc edge across the pixel). std::invalid_argument for mismatched sizes,
 // non-positive radii or non-finite data.
 io::Image renderFloorPlan(const FloorPlan& plan, const Discs& discs,
-                          const std::vector<std::vector<Vec2>>& obstacles = {});
+                          const std::vector<std::vector<Vec2>>& obstacles = {}, const CellField* floorField = nullptr);
 
 }  // namespace msim::render

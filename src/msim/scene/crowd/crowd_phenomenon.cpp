@@ -13,7 +13,7 @@
 #include "msim/crowd/metric_plots.hpp"
 #include "msim/crowd/metrics_json.hpp"
 #include "msim/crowd/metrics.hpp"
-#include "msim/crowd/stress/crowd_pressure.hpp"
+#include "msim/crowd/stress/turbulence_metrics.hpp"
 #include "msim/crowd/voronoi_density.hpp"
 #include "msim/io/atomic_file.hpp"
 #include "msim/io/csv.hpp"
@@ -77,10 +77,11 @@ class CrowdPhenomenon final : public Phenomenon {
     lookaheadSolves_ += la.solves;
     lookaheadIterations_ += la.iterations;
     blendWeightSum_ += la.meanWeight;
+    ScopedStage stage(timers_, "crowd: metrics");
+    const crowd::Agents& a = sim_->agents();
+    turbulence_.sample(a, dt);
     // Flow through the measurement lines, step by step (crossings between frames would be missed).
     if (!lines_.empty()) {
-      ScopedStage stage(timers_, "crowd: metrics");
-      const crowd::Agents& a = sim_->agents();
       for (std::size_t k = 0; k < lines_.size(); ++k)
         lineCrossings_[k] += crowd::countCrossings(lines_[k], lastIds_, lastPositions_, a.id, a.position).net();
       lastIds_ = a.id;
@@ -212,9 +213,9 @@ class CrowdPhenomenon final : public Phenomenon {
       discs.values.resize(a.size(), 0.0);
     } else if (setup_.colourBy == "pressure") {
       // Helbing's crowd pressure at each agent's cell, yellow from twice the turbulent 0.02 /s^2.
-      plan.valueMax = 2.0 * kTurbulentPressure;
-      for (std::size_t i = 0; i < a.size(); ++i)
-        discs.values.push_back(pressure_.count() > 0 ? pressure_[pressure_.spec().clampedCellIndex(a.position[i])] : 0.0);
+      plan.valueMax = 2.0 * crowd::stress::TurbulenceMetrics::kTurbulentPressure;
+      const Grid<float, 2>& pressure = turbulence_.spatialPressure();
+      for (std::size_t i = 0; i < a.size(); ++i) discs.values.push_back(pressure[pressure.spec().clampedCellIndex(a.position[i])]);
     } else {
       plan.valueMax = std::max(1.0, static_cast<double>(groupCount() - 1));
       for (std::size_t i = 0; i < a.size(); ++i) discs.values.push_back(a.group[i]);
@@ -255,9 +256,19 @@ class CrowdPhenomenon final : public Phenomenon {
               // average) and the hybrid's mean blend weight w (eq. 3.11; 0 all discrete, 1 all continuum).
               {"lookahead_iterations_per_solve", iterationsPerSolve_},
               {"lookahead_blend_weight", meanBlendWeight_},
-              // Helbing's crowd pressure rho Var(v) over 3 x 3 cells (Golas eq. 4.13): turbulent above 0.02 /s^2.
-              {"pressure_max_per_s2", pressureMax_},
-              {"pressure_cells_over_turbulent", pressureCellsOver_}};
+              // Helbing's crowd pressure rho Var(v) (Golas eq. 4.13), the variance over 3 x 3 cells and
+              // over the last 3 s: turbulent above 0.02 /s^2; the strain-rate magnitude (Fig. 4.11).
+              {"pressure_max_per_s2", turbulenceFrame_.pressureMax},
+              {"pressure_cells_over_turbulent", turbulenceFrame_.pressureCellsOver},
+              {"pressure_temporal_max_per_s2", turbulenceFrame_.temporalPressureMax},
+              {"pressure_temporal_mean_per_s2", turbulenceFrame_.temporalPressureMean},
+              {"pressure_temporal_cells_over_turbulent", turbulenceFrame_.temporalCellsOver},
+              {"strain_rate_max_per_s", turbulenceFrame_.strainRate.max},
+              {"strain_rate_mean_per_s", turbulenceFrame_.strainRate.mean},
+              {"strain_rate_variation", turbulenceFrame_.strainRate.variation},
+              // Stop-and-go: agents standing for 1 s or more while those ahead walk.
+              {"standstill_agents", turbulenceFrame_.standing},
+              {"standstill_episodes_total", turbulenceFrame_.standstillEpisodes}};
     for (std::size_t k = 0; k < setup_.lines.size(); ++k)
       s["line_" + setup_.lines[k].name + "_crossings"] = lineCrossings_[k];
     return s;
@@ -335,6 +346,7 @@ class CrowdPhenomenon final : public Phenomenon {
     }
     results["measurement_lines"] = flows;
     writeFundamentalDiagram(runDir / "fundamental_diagram.png");
+    results["turbulence"] = writePressureMap(runDir / "pressure_map.png");
     writeTimeSeries(runDir / "time_series.png", frames);
     results["inconsistency"] = writeInconsistency(runDir / "inconsistency.png", frames);
     results["fundamental_diagram"] = crowd::toJson(std::span<const crowd::FdBin>(fdBins_));
@@ -390,14 +402,7 @@ class CrowdPhenomenon final : public Phenomenon {
     ScopedStage stage(timers_, "crowd: metrics");
     const crowd::Agents& a = sim_->agents();
     speed_ = crowd::speedStats(a.velocity);
-    if (!(pressure_.spec() == setup_.settings.grid)) pressure_ = Grid<float, 2>(setup_.settings.grid);
-    crowd::stress::spatialPressure(a.position, a.velocity, 1, pressure_);
-    pressureMax_ = 0.0;
-    pressureCellsOver_ = 0;
-    for (std::size_t c = 0; c < pressure_.count(); ++c) {
-      pressureMax_ = std::max(pressureMax_, double(pressure_[c]));
-      pressureCellsOver_ += pressure_[c] > kTurbulentPressure;
-    }
+    turbulenceFrame_ = turbulence_.measure(a.position, a.velocity);
     checkStall();
     agentDensity_.clear();
     nn_ = crowd::NearestNeighbourFrame{};
@@ -465,6 +470,31 @@ class CrowdPhenomenon final : public Phenomenon {
     });
   }
 
+  // Each cell's largest crowd pressure over time during the run on the floor plan, yellow from
+  // twice the turbulent 0.02 /s^2 (cells nobody stood in left as floor); its figures for run.json.
+  json writePressureMap(const fs::path& file) const {
+    using crowd::stress::TurbulenceMetrics;
+    const Grid<float, 2>& peak = turbulence_.peakTemporalPressure();
+    render::FloorPlan plan;
+    plan.lo = setup_.settings.lo;
+    plan.hi = setup_.settings.hi;
+    plan.width = preview_;
+    plan.valueMax = 2.0 * TurbulenceMetrics::kTurbulentPressure;
+    const render::CellField field{peak.spec(), std::span<const float>(peak.data())};
+    std::vector<std::vector<Vec2>> outlines;
+    for (const crowd::Polygon& p : setup_.obstacles) outlines.push_back(p.vertices);
+    io::writePng(file, render::renderFloorPlan(plan, render::Discs{}, outlines, &field));
+    double largest = 0.0;
+    long over = 0;
+    for (std::size_t c = 0; c < peak.count(); ++c) {
+      largest = std::max(largest, double(peak[c]));
+      over += peak[c] > TurbulenceMetrics::kTurbulentPressure;
+    }
+    return {{"pressure_temporal_peak_per_s2", largest},
+            {"cells_ever_turbulent", over},
+            {"window_s", TurbulenceMetrics::kWindowSeconds}};
+  }
+
   void writeFundamentalDiagram(const fs::path& file) const {
     io::writePng(file, render::renderPlot(crowd::speedDensityPlot(fdScatter_, fdBins_)));
   }
@@ -520,10 +550,8 @@ class CrowdPhenomenon final : public Phenomenon {
   double uicSolveSeconds_ = 0.0;  // QP solve time of those steps (Fig. 4.10)
   double iterationsPerStep_ = 0.0;  // of the last complete frame
   double solveMsPerStep_ = 0.0;     // of the last complete frame
-  static constexpr double kTurbulentPressure = 0.02;  // [1/s^2] (Helbing et al. 2007)
-  Grid<float, 2> pressure_;
-  double pressureMax_ = 0.0;
-  long pressureCellsOver_ = 0;
+  crowd::stress::TurbulenceMetrics turbulence_{setup_.settings.grid};
+  crowd::stress::TurbulenceFrame turbulenceFrame_;
   long steps_ = 0, stressSolves_ = 0, stressIterations_ = 0, stressUnconverged_ = 0;
   std::size_t lookaheadSolves_ = 0, lookaheadIterations_ = 0;  // of the frame being simulated
   double blendWeightSum_ = 0.0;                                 // the steps' mean weights summed

@@ -1,0 +1,51 @@
+#pragma once
+// What a crowd-safety engineer reads off a crowd for turbulence (Golas ch. 4.4): Helbing's crowd
+// pressure with the variance over space (3 x 3 cells) and over time (a 3 s window, the seed's
+// pressure maps of Fig. 4.6), the scene-mean temporal pressure of Fig. 4.10 and the strain-rate
+// magnitude of Fig. 4.11, on the crowd's grid, and the standstill episodes of stop-and-go waves
+// (standstill.hpp). The crowd is sampled every step (the temporal variance and the standstills
+// need every step's velocities) and measured once per frame.
+#include <span>
+
+#include "msim/core/grid.hpp"
+#include "msim/crowd/stress/crowd_pressure.hpp"
+#include "msim/crowd/stress/standstill.hpp"
+
+namespace msim::crowd::stress {
+
+struct TurbulenceFrame {
+  double pressureMax = 0.0;           // spatial variance [1/s^2]
+  long pressureCellsOver = 0;         // cells above the turbulent 0.02 /s^2
+  double temporalPressureMax = 0.0;   // temporal variance [1/s^2]
+  double temporalPressureMean = 0.0;  // over the crowd's cells (Fig. 4.10)
+  long temporalCellsOver = 0;
+  StrainRateSummary strainRate;       // [1/s]
+  long standing = 0;                  // agents in a standstill episode now
+  long standstillEpisodes = 0;        // since the start
+};
+
+class TurbulenceMetrics {
+ public:
+  static constexpr double kTurbulentPressure = 0.02;  // [1/s^2] (Helbing et al. 2007)
+  static constexpr int kWindowCells = 1;              // the spatial windows: 3 x 3 cells
+  static constexpr double kWindowSeconds = 3.0;       // the temporal window (Fig. 4.6)
+
+  explicit TurbulenceMetrics(const GridSpec<2>& grid);
+  void sample(const Agents& agents, double dt);
+  TurbulenceFrame measure(std::span<const Vec2f> positions, std::span<const Vec2f> velocities);
+
+  // The last measure()'s fields.
+  const Grid<float, 2>& spatialPressure() const { return spatial_; }
+  const Grid<float, 2>& temporalPressure() const { return temporal_; }
+  const Grid<float, 2>& strainRate() const { return strain_; }
+  // Each cell's largest temporal pressure over the measured frames: where the crowd turned
+  // turbulent during the run.
+  const Grid<float, 2>& peakTemporalPressure() const { return peak_; }
+
+ private:
+  TemporalPressure sampler_;
+  StandstillDetector standstills_;
+  Grid<float, 2> spatial_, temporal_, strain_, peak_;
+};
+
+}  // namespace msim::crowd::stress

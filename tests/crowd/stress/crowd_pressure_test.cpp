@@ -1,0 +1,156 @@
+// Helbing's crowd pressure over time and the strain-rate magnitude (Golas eq. 4.13, Figs. 4.6,
+// 4.10, 4.11): the strain rate of linear flows against its closed form (simple shear sqrt(2)
+// gamma, rigid rotation and uniform flow 0), and the temporal pressure's lazily decayed sums
+// against a brute-force weighted variance over every stored sample.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "msim/crowd/stress/crowd_pressure.hpp"
+
+using namespace msim;
+using namespace msim::crowd;
+using namespace msim::crowd::stress;
+
+namespace {
+
+// Four agents per cell at its quarter points (the window means are then the flow at the cell
+// centres for a linear flow), velocities from `flow`.
+template <typename Flow>
+void quarterPoints(const GridSpec<2>& spec, Flow&& flow, std::vector<Vec2f>& x, std::vector<Vec2f>& v) {
+  for (int j = 0; j < spec.res.y(); ++j)
+    for (int i = 0; i < spec.res.x(); ++i)
+      for (const Vec2& q : {Vec2(0.25, 0.25), Vec2(0.75, 0.25), Vec2(0.25, 0.75), Vec2(0.75, 0.75)}) {
+        const Vec2 p = spec.origin + (Vec2(i, j) + q) * spec.dx;
+        x.push_back(p.cast<float>());
+        v.push_back(flow(p).template cast<float>());
+      }
+}
+
+}  // namespace
+
+TEST(CrowdPressure, StrainRateOfLinearFlowsMatchesTheirClosedForm) {
+  const GridSpec<2> spec(Vec2(0.0, 0.0), 0.5, IVec<2>(12, 10));
+  Grid<float, 2> strain(spec);
+  const double gamma = 0.4, omega = 0.3;
+  struct Case {
+    const char* name;
+    double expected;
+    Vec2 (*flow)(const Vec2&, double);
+    double parameter;
+  };
+  const Case cases[] = {
+      {"simple shear v = (gamma y, 0)", std::sqrt(2.0) * gamma, [](const Vec2& p, double g) { return Vec2(g * p.y(), 0.0); }, gamma},
+      {"rigid rotation", 0.0, [](const Vec2& p, double w) { return Vec2(-w * p.y(), w * p.x()); }, omega},
+      {"uniform flow", 0.0, [](const Vec2&, double) { return Vec2(1.2, -0.3); }, 0.0},
+      {"stretching v = (g x, -g y)", 2.0 * std::sqrt(2.0) * gamma, [](const Vec2& p, double g) { return Vec2(g * p.x(), -g * p.y()); }, gamma},
+  };
+  for (const Case& k : cases) {
+    std::vector<Vec2f> x, v;
+    quarterPoints(spec, [&](const Vec2& p) { return k.flow(p, k.parameter); }, x, v);
+    const StrainRateSummary summary = strainRate(x, v, 1, strain);
+    EXPECT_EQ(summary.cells, spec.cellCount()) << k.name;
+    EXPECT_GE(summary.max, k.expected - 1e-5) << k.name;
+    if (k.parameter == 0.0) EXPECT_NEAR(summary.mean + summary.max + summary.variation, 0.0, 1e-6) << k.name;
+    // Where the 3 x 3 windows and their neighbours' are whole (clipped windows at the boundary are
+    // not centred on their cell).
+    for (int j = 2; j < spec.res.y() - 2; ++j)
+      for (int i = 2; i < spec.res.x() - 2; ++i) EXPECT_NEAR(strain(IVec<2>(i, j)), k.expected, 1e-5) << k.name << " at " << i << "," << j;
+  }
+}
+
+TEST(CrowdPressure, StrainRateIsZeroWhereNobodyIs) {
+  const GridSpec<2> spec(Vec2(0.0, 0.0), 1.0, IVec<2>(9, 9));
+  Grid<float, 2> strain(spec);
+  const std::vector<Vec2f> x{Vec2f(4.5f, 4.5f), Vec2f(4.6f, 4.4f)}, v{Vec2f(1.0f, 0.0f), Vec2f(-1.0f, 0.0f)};
+  strainRate(x, v, 1, strain);
+  EXPECT_EQ(strain(IVec<2>(0, 0)), 0.0f);
+  EXPECT_EQ(strain(IVec<2>(8, 8)), 0.0f);
+}
+
+TEST(CrowdPressure, TemporalPressureEqualsTheWeightedVarianceOverStoredSamples) {
+  // Cells 1 m wide, window 1 (3 x 3 cells), half-life 1.5 s; 60 samples 0.05-0.15 s apart of 30
+  // agents wandering at random (cells empty in some samples). The reference keeps every sample and
+  // weighs the one taken at t_k by dt_k 2^(-(T - t_k) / 1.5).
+  const GridSpec<2> spec(Vec2(0.0, 0.0), 1.0, IVec<2>(6, 5));
+  const double seconds = 3.0;
+  TemporalPressure temporal(spec, 1, seconds);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  struct Sample {
+    double t, dt;
+    std::vector<double> count, vx, vy;  // per cell: the window's count and mean velocity
+  };
+  std::vector<Sample> samples;
+  std::vector<Vec2f> x(30), v(30);
+  for (Vec2f& p : x) p = Vec2f(float(6.0 * u(rng)), float(5.0 * u(rng)));
+  double t = 0.0;
+  for (int s = 0; s < 60; ++s) {
+    const double dt = 0.05 + 0.1 * u(rng);
+    t += dt;
+    for (std::size_t k = 0; k < x.size(); ++k) {
+      v[k] = Vec2f(float(2.0 * u(rng) - 1.0), float(2.0 * u(rng) - 1.0));
+      x[k] = (x[k] + 0.8f * v[k]).cwiseMax(Vec2f(0.01f, 0.01f)).cwiseMin(Vec2f(5.99f, 4.99f));
+    }
+    temporal.add(x, v, dt);
+    Sample sample{t, dt, std::vector<double>(spec.cellCount(), 0.0), std::vector<double>(spec.cellCount(), 0.0),
+                  std::vector<double>(spec.cellCount(), 0.0)};
+    for (std::size_t k = 0; k < x.size(); ++k) {
+      const int i = int(x[k].x()), j = int(x[k].y());
+      for (int b = j - 1; b <= j + 1; ++b)
+        for (int a = i - 1; a <= i + 1; ++a) {
+          if (a < 0 || b < 0 || a >= 6 || b >= 5) continue;
+          const std::size_t c = std::size_t(a + 6 * b);
+          sample.count[c] += 1.0;
+          sample.vx[c] += v[k].x();
+          sample.vy[c] += v[k].y();
+        }
+    }
+    samples.push_back(std::move(sample));
+  }
+  Grid<float, 2> p(spec);
+  temporal.pressure(p);
+  int checked = 0;
+  for (int j = 0; j < 5; ++j)
+    for (int i = 0; i < 6; ++i) {
+      const std::size_t c = std::size_t(i + 6 * j);
+      const int cells = (std::min(5, i + 1) - std::max(0, i - 1) + 1) * (std::min(4, j + 1) - std::max(0, j - 1) + 1);
+      double all = 0.0, occupied = 0.0, density = 0.0, mx = 0.0, my = 0.0, m2 = 0.0;
+      int hits = 0;
+      for (const Sample& s : samples) {
+        const double w = s.dt * std::pow(2.0, -(t - s.t) / (0.5 * seconds));
+        all += w;
+        if (s.count[c] == 0.0) continue;
+        ++hits;
+        const double vx = s.vx[c] / s.count[c], vy = s.vy[c] / s.count[c];
+        occupied += w;
+        density += w * s.count[c] / cells;
+        mx += w * vx;
+        my += w * vy;
+        m2 += w * (vx * vx + vy * vy);
+      }
+      if (hits < 2) {
+        EXPECT_EQ(p[c], 0.0f);
+        continue;
+      }
+      mx /= occupied;
+      my /= occupied;
+      const double expected = density / all * (m2 / occupied - mx * mx - my * my);
+      EXPECT_NEAR(p[c], expected, 1e-5 * std::max(1.0, expected)) << i << "," << j;
+      ++checked;
+    }
+  EXPECT_GT(checked, 20);
+}
+
+TEST(CrowdPressure, TemporalPressureOfASteadyCrowdIsZero) {
+  const GridSpec<2> spec(Vec2(0.0, 0.0), 0.5, IVec<2>(8, 8));
+  TemporalPressure temporal(spec, 1, 3.0);
+  std::vector<Vec2f> x, v;
+  quarterPoints(spec, [](const Vec2&) { return Vec2(0.9, 0.2); }, x, v);
+  for (int s = 0; s < 20; ++s) temporal.add(x, v, 0.05);
+  Grid<float, 2> p(spec);
+  temporal.pressure(p);
+  for (std::size_t c = 0; c < p.count(); ++c) EXPECT_NEAR(p[c], 0.0f, 1e-9f);
+}
