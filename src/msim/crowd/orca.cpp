@@ -221,8 +221,8 @@ void OrcaSolver::computeVelocities(const Agents& agents, const StaticObstacles& 
                   } else {
                     s.nearest.push_back(entry);
                   }
-                  for (std::size_t i2 = s.nearest.size() - 1; i2 > 0 && closer(s.nearest[i2], s.nearest[i2 - 1]); --i2)
-                    std::swap(s.nearest[i2], s.nearest[i2 - 1]);
+                  for (std::size_t at = s.nearest.size() - 1; at > 0 && closer(s.nearest[at], s.nearest[at - 1]); --at)
+                    std::swap(s.nearest[at], s.nearest[at - 1]);
                   if (s.nearest.size() == maxNeighbours) threshold = s.nearest.back().d2;
                 }
               }
