@@ -104,7 +104,7 @@ io::Image renderFloorPlan(const FloorPlan& plan, const Discs& discs, const std::
   parallelFor(0, static_cast<std::size_t>(height), [&](std::size_t row) {
     const double y = plan.hi.y() - (static_cast<double>(row) + 0.5) * pixel;
     std::vector<Vec3> colours(static_cast<std::size_t>(plan.width), plan.floor);
-    if (floorField != nullptr && floorField->spec.contains(Vec2(floorField->spec.origin.x(), y)))
+    if (floorField != nullptr && y >= floorField->spec.origin.y() && y <= floorField->spec.upper().y())
       for (int col = 0; col < plan.width; ++col) {
         const Vec2 p(plan.lo.x() + (col + 0.5) * pixel, y);
         if (!floorField->spec.contains(p)) continue;

@@ -50,7 +50,9 @@ TEST(CrowdPressure, StrainRateOfLinearFlowsMatchesTheirClosedForm) {
   for (const Case& k : cases) {
     std::vector<Vec2f> x, v;
     quarterPoints(spec, [&](const Vec2& p) { return k.flow(p, k.parameter); }, x, v);
-    const StrainRateSummary summary = strainRate(x, v, 1, strain);
+    CrowdWindows windows(spec, 1);
+    windows.gather(x, v);
+    const StrainRateSummary summary = strainRate(windows, strain);
     EXPECT_EQ(summary.cells, spec.cellCount()) << k.name;
     EXPECT_GE(summary.max, k.expected - 1e-5) << k.name;
     if (k.parameter == 0.0) EXPECT_NEAR(summary.mean + summary.max + summary.variation, 0.0, 1e-6) << k.name;
@@ -65,7 +67,9 @@ TEST(CrowdPressure, StrainRateIsZeroWhereNobodyIs) {
   const GridSpec<2> spec(Vec2(0.0, 0.0), 1.0, IVec<2>(9, 9));
   Grid<float, 2> strain(spec);
   const std::vector<Vec2f> x{Vec2f(4.5f, 4.5f), Vec2f(4.6f, 4.4f)}, v{Vec2f(1.0f, 0.0f), Vec2f(-1.0f, 0.0f)};
-  strainRate(x, v, 1, strain);
+  CrowdWindows windows(spec, 1);
+  windows.gather(x, v);
+  strainRate(windows, strain);
   EXPECT_EQ(strain(IVec<2>(0, 0)), 0.0f);
   EXPECT_EQ(strain(IVec<2>(8, 8)), 0.0f);
 }
@@ -76,7 +80,8 @@ TEST(CrowdPressure, TemporalPressureEqualsTheWeightedVarianceOverStoredSamples) 
   // weighs the one taken at t_k by dt_k 2^(-(T - t_k) / 1.5).
   const GridSpec<2> spec(Vec2(0.0, 0.0), 1.0, IVec<2>(6, 5));
   const double seconds = 3.0;
-  TemporalPressure temporal(spec, 1, seconds);
+  TemporalPressure temporal(spec, seconds);
+  CrowdWindows windows(spec, 1);
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   struct Sample {
@@ -94,7 +99,8 @@ TEST(CrowdPressure, TemporalPressureEqualsTheWeightedVarianceOverStoredSamples) 
       v[k] = Vec2f(float(2.0 * u(rng) - 1.0), float(2.0 * u(rng) - 1.0));
       x[k] = (x[k] + 0.8f * v[k]).cwiseMax(Vec2f(0.01f, 0.01f)).cwiseMin(Vec2f(5.99f, 4.99f));
     }
-    temporal.add(x, v, dt);
+    windows.gather(x, v);
+    temporal.add(windows, dt);
     Sample sample{t, dt, std::vector<double>(spec.cellCount(), 0.0), std::vector<double>(spec.cellCount(), 0.0),
                   std::vector<double>(spec.cellCount(), 0.0)};
     for (std::size_t k = 0; k < x.size(); ++k) {
@@ -146,10 +152,12 @@ TEST(CrowdPressure, TemporalPressureEqualsTheWeightedVarianceOverStoredSamples) 
 
 TEST(CrowdPressure, TemporalPressureOfASteadyCrowdIsZero) {
   const GridSpec<2> spec(Vec2(0.0, 0.0), 0.5, IVec<2>(8, 8));
-  TemporalPressure temporal(spec, 1, 3.0);
+  TemporalPressure temporal(spec, 3.0);
+  CrowdWindows windows(spec, 1);
   std::vector<Vec2f> x, v;
   quarterPoints(spec, [](const Vec2&) { return Vec2(0.9, 0.2); }, x, v);
-  for (int s = 0; s < 20; ++s) temporal.add(x, v, 0.05);
+  windows.gather(x, v);
+  for (int s = 0; s < 20; ++s) temporal.add(windows, 0.05);
   Grid<float, 2> p(spec);
   temporal.pressure(p);
   for (std::size_t c = 0; c < p.count(); ++c) EXPECT_NEAR(p[c], 0.0f, 1e-9f);

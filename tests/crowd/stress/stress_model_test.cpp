@@ -250,8 +250,11 @@ TEST(CrowdStress, PressureIsDensityTimesVelocityVariance) {
         same.emplace_back(0.7f, 0.1f);
       }
   Grid<float, 2> p(spec);
-  spatialPressure(x, v, 1, p);
+  CrowdWindows windows(spec, 1);
+  windows.gather(x, v);
+  spatialPressure(windows, p);
   for (std::size_t c = 0; c < p.count(); ++c) EXPECT_NEAR(p[c], 1.0f, 1e-5f);
-  spatialPressure(x, same, 1, p);
+  windows.gather(x, same);
+  spatialPressure(windows, p);
   for (std::size_t c = 0; c < p.count(); ++c) EXPECT_NEAR(p[c], 0.0f, 1e-5f);
 }

@@ -22,11 +22,9 @@ bool StandstillDetector::othersAheadMove(const Vec2f& x, const Vec2f& direction)
 }
 
 void StandstillDetector::sample(const Agents& a, double dt) {
-  std::uint64_t top = 0;
-  for (const std::uint64_t id : a.id) top = std::max(top, id + 1);
-  if (still_.size() < top) {
-    still_.resize(top, 0.0);
-    inEpisode_.resize(top, 0);
+  if (still_.size() < a.nextId) {  // ids are below nextId
+    still_.resize(a.nextId, 0.0);
+    inEpisode_.resize(a.nextId, 0);
   }
   bool binned = false;
   standing_ = 0;

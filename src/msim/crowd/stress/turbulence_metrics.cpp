@@ -5,16 +5,18 @@
 namespace msim::crowd::stress {
 
 TurbulenceMetrics::TurbulenceMetrics(const GridSpec<2>& grid)
-    : sampler_(grid, kWindowCells, kWindowSeconds), standstills_(grid), spatial_(grid), temporal_(grid), strain_(grid), peak_(grid) {}
+    : windows_(grid, kWindowCells), sampler_(grid, kWindowSeconds), standstills_(grid), spatial_(grid), temporal_(grid), strain_(grid), peak_(grid) {}
 
 void TurbulenceMetrics::sample(const Agents& agents, double dt) {
-  sampler_.add(agents.position, agents.velocity, dt);
+  windows_.gather(agents.position, agents.velocity);
+  sampler_.add(windows_, dt);
   standstills_.sample(agents, dt);
 }
 
-TurbulenceFrame TurbulenceMetrics::measure(std::span<const Vec2f> positions, std::span<const Vec2f> velocities) {
+TurbulenceFrame TurbulenceMetrics::measure(const Agents& agents) {
   TurbulenceFrame f;
-  stress::spatialPressure(positions, velocities, kWindowCells, spatial_);
+  windows_.gather(agents.position, agents.velocity);
+  stress::spatialPressure(windows_, spatial_);
   sampler_.pressure(temporal_);
   for (std::size_t c = 0; c < spatial_.count(); ++c) {
     f.pressureMax = std::max(f.pressureMax, double(spatial_[c]));
@@ -24,7 +26,7 @@ TurbulenceFrame TurbulenceMetrics::measure(std::span<const Vec2f> positions, std
     peak_[c] = std::max(peak_[c], temporal_[c]);
   }
   f.temporalPressureMean = sampler_.meanWhereOccupied(temporal_);
-  f.strainRate = stress::strainRate(positions, velocities, kWindowCells, strain_);
+  f.strainRate = stress::strainRate(windows_, strain_);
   f.standing = standstills_.standing();
   f.standstillEpisodes = standstills_.episodes();
   return f;

@@ -5,8 +5,6 @@
 // magnitude of Fig. 4.11, on the crowd's grid, and the standstill episodes of stop-and-go waves
 // (standstill.hpp). The crowd is sampled every step (the temporal variance and the standstills
 // need every step's velocities) and measured once per frame.
-#include <span>
-
 #include "msim/core/grid.hpp"
 #include "msim/crowd/stress/crowd_pressure.hpp"
 #include "msim/crowd/stress/standstill.hpp"
@@ -32,7 +30,7 @@ class TurbulenceMetrics {
 
   explicit TurbulenceMetrics(const GridSpec<2>& grid);
   void sample(const Agents& agents, double dt);
-  TurbulenceFrame measure(std::span<const Vec2f> positions, std::span<const Vec2f> velocities);
+  TurbulenceFrame measure(const Agents& agents);
 
   // The last measure()'s fields.
   const Grid<float, 2>& spatialPressure() const { return spatial_; }
@@ -43,6 +41,7 @@ class TurbulenceMetrics {
   const Grid<float, 2>& peakTemporalPressure() const { return peak_; }
 
  private:
+  CrowdWindows windows_;
   TemporalPressure sampler_;
   StandstillDetector standstills_;
   Grid<float, 2> spatial_, temporal_, strain_, peak_;

@@ -191,10 +191,7 @@ class CrowdPhenomenon final : public Phenomenon {
   }
 
   io::Image preview() const override {
-    render::FloorPlan plan;
-    plan.lo = setup_.settings.lo;
-    plan.hi = setup_.settings.hi;
-    plan.width = preview_;
+    render::FloorPlan plan = floorPlan();
     const crowd::Agents& a = sim_->agents();
     render::Discs discs;
     discs.centres.reserve(a.size());
@@ -220,8 +217,7 @@ class CrowdPhenomenon final : public Phenomenon {
       plan.valueMax = std::max(1.0, static_cast<double>(groupCount() - 1));
       for (std::size_t i = 0; i < a.size(); ++i) discs.values.push_back(a.group[i]);
     }
-    std::vector<std::vector<Vec2>> outlines;
-    for (const crowd::Polygon& p : setup_.obstacles) outlines.push_back(p.vertices);
+    std::vector<std::vector<Vec2>> outlines = staticOutlines();
     for (const crowd::Polygon& p : sim_->movingObstaclesNow()) outlines.push_back(p.vertices);
     return render::renderFloorPlan(plan, discs, outlines);
   }
@@ -358,6 +354,19 @@ class CrowdPhenomenon final : public Phenomenon {
     return std::max(800, scene.resolved.at("outputs").at("preview").at("width").get<int>());
   }
   double rhoMax() const { return setup_.settings.uicSettings.rhoMax; }
+  // The top view of the scene's floor at the preview's width, and its fixed obstacles.
+  render::FloorPlan floorPlan() const {
+    render::FloorPlan plan;
+    plan.lo = setup_.settings.lo;
+    plan.hi = setup_.settings.hi;
+    plan.width = preview_;
+    return plan;
+  }
+  std::vector<std::vector<Vec2>> staticOutlines() const {
+    std::vector<std::vector<Vec2>> outlines;
+    for (const crowd::Polygon& p : setup_.obstacles) outlines.push_back(p.vertices);
+    return outlines;
+  }
   std::size_t groupCount() const { return std::max<std::size_t>(1, setup_.groupCount); }
   double evacuatedFraction() const {
     if (initialIds_.empty()) return 0.0;
@@ -402,7 +411,7 @@ class CrowdPhenomenon final : public Phenomenon {
     ScopedStage stage(timers_, "crowd: metrics");
     const crowd::Agents& a = sim_->agents();
     speed_ = crowd::speedStats(a.velocity);
-    turbulenceFrame_ = turbulence_.measure(a.position, a.velocity);
+    turbulenceFrame_ = turbulence_.measure(a);
     checkStall();
     agentDensity_.clear();
     nn_ = crowd::NearestNeighbourFrame{};
@@ -475,15 +484,10 @@ class CrowdPhenomenon final : public Phenomenon {
   json writePressureMap(const fs::path& file) const {
     using crowd::stress::TurbulenceMetrics;
     const Grid<float, 2>& peak = turbulence_.peakTemporalPressure();
-    render::FloorPlan plan;
-    plan.lo = setup_.settings.lo;
-    plan.hi = setup_.settings.hi;
-    plan.width = preview_;
+    render::FloorPlan plan = floorPlan();
     plan.valueMax = 2.0 * TurbulenceMetrics::kTurbulentPressure;
     const render::CellField field{peak.spec(), std::span<const float>(peak.data())};
-    std::vector<std::vector<Vec2>> outlines;
-    for (const crowd::Polygon& p : setup_.obstacles) outlines.push_back(p.vertices);
-    io::writePng(file, render::renderFloorPlan(plan, render::Discs{}, outlines, &field));
+    io::writePng(file, render::renderFloorPlan(plan, render::Discs{}, staticOutlines(), &field));
     double largest = 0.0;
     long over = 0;
     for (std::size_t c = 0; c < peak.count(); ++c) {
