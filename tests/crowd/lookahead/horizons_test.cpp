@@ -54,7 +54,9 @@ TEST(LookaheadHorizons, EveryDistanceInRangeFallsInExactlyOneBand) {
     // The traversal's tabulated squares agree away from float rounding at the band edges.
     bool nearEdge = false;
     for (int i = 1; i <= s.levels + 1; ++i) nearEdge = nearEdge || std::abs(d - s.bandStart(i)) < 1e-3;
-    if (!nearEdge) EXPECT_EQ(tabulated.levelOfSquaredDistance(static_cast<float>(d * d)), holder) << d;
+    if (!nearEdge) {
+      EXPECT_EQ(tabulated.levelOfSquaredDistance(static_cast<float>(d * d)), holder) << d;
+    }
     for (int i = 0; i < holder; ++i)
       EXPECT_GE(d - 2.0 * s.maxSpeed * s.horizon(i), s.neighbourDist - 1e-12) << d << " level " << i;
   }

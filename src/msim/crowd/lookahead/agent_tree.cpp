@@ -1,6 +1,7 @@
 #include "msim/crowd/lookahead/agent_tree.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <numeric>
 #include <stdexcept>
 
@@ -40,7 +41,7 @@ std::int32_t AgentTree::buildNode(std::uint32_t first, std::uint32_t count, std:
     n.lo = n.lo.cwiseMin(positions[*it]);
     n.hi = n.hi.cwiseMax(positions[*it]);
   }
-  if (count > 1) {
+  if (count > kLeafSize) {
     const int axis = (n.hi.x() - n.lo.x()) >= (n.hi.y() - n.lo.y()) ? 0 : 1;
     const std::uint32_t half = count / 2;
     std::nth_element(begin, begin + half, end, [&](std::uint32_t a, std::uint32_t b) {
@@ -56,9 +57,17 @@ std::int32_t AgentTree::buildNode(std::uint32_t first, std::uint32_t count, std:
     n.separation = std::max({l.separation, r.separation, boxGap(l.lo, l.hi, r.lo, r.hi)});
     n.radius = std::max(l.radius, r.radius);
   } else {
-    n.mean = positions[*begin];
-    n.velocity = velocities[*begin];
-    n.radius = radii[*begin];
+    // A leaf: its members' means, and as its separation the largest gap between one member and
+    // the nearest other (exact at this size).
+    for (auto it = begin; it != end; ++it) {
+      n.mean += positions[*it] / static_cast<float>(count);
+      n.velocity += velocities[*it] / static_cast<float>(count);
+      n.radius = std::max(n.radius, radii[*it]);
+      float nearest = count > 1 ? std::numeric_limits<float>::infinity() : 0.0f;
+      for (auto other = begin; other != end; ++other)
+        if (other != it) nearest = std::min(nearest, (positions[*it] - positions[*other]).norm());
+      n.separation = std::max(n.separation, nearest);
+    }
   }
   for (auto it = begin; it != end; ++it) {
     n.spread = std::max(n.spread, (positions[*it] - n.mean).norm());

@@ -5,8 +5,10 @@
 // from the mean velocity, and the maximal
 // separation, the largest gap between a member and its nearest fellow member, approximated as the
 // seed does while building: the larger of the children's values and the gap between the children's
-// bounding boxes. Leaves are single agents. Built in O(n log n) by median splits along the longer
-// side of each node's box; nothing is allocated once the buffers have grown.
+// bounding boxes (a leaf's exact). Leaves hold up to kLeafSize agents: where a leaf cannot stand for
+// its members as one cluster the traversal takes them one by one, cheaper than two more levels of
+// nodes. Built in O(n log n) by median splits along the longer side of each node's box; nothing is
+// allocated once the buffers have grown.
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -27,8 +29,10 @@ class AgentTree {
     float separation = 0.0f;         // the approximate maximal separation
     std::uint32_t count = 0;
     std::uint32_t first = 0;         // members: agents()[first, first + count)
-    std::int32_t left = -1, right = -1;  // children, -1 for a leaf
+    std::int32_t left = -1, right = -1;  // children, -1 for a leaf (at most kLeafSize members)
   };
+
+  static constexpr std::uint32_t kLeafSize = 4;
 
   // Builds over the agents at `positions` with `velocities` and `radii` (equal lengths).
   void build(std::span<const Vec2f> positions, std::span<const Vec2f> velocities, std::span<const float> radii);

@@ -53,25 +53,26 @@ void appendLookaheadPlanes(const DiscreteLookahead& l, std::uint32_t self, const
     const AgentTree::Node& n = l.tree.node(stack[--top]);
     const float nearest2 = nearestInBox2(x, n.lo, n.hi);
     if (nearest2 >= reach2 || farthestInBox2(x, n.lo, n.hi) < near2) continue;  // beyond every band, or all at level 0
-    if (n.left < 0) {
-      const std::uint32_t j = l.tree.agents()[n.first];
-      if (j == self) continue;
-      const int level = l.levelOfSquaredDistance((l.positions[j] - x).squaredNorm());
-      if (level >= 1 && level <= depth) avoid(l.positions[j], l.velocities[j], l.radii[j] * l.shrink[static_cast<std::size_t>(level)], level);
-      continue;
-    }
     const int level = l.levelOfSquaredDistance(nearest2);
     const bool containsSelf = x.x() >= n.lo.x() && x.x() <= n.hi.x() && x.y() >= n.lo.y() && x.y() <= n.hi.y();
     if (level >= 1 && level <= depth && !containsSelf && n.count <= (1u << (level - 1))) {
       const float horizon = l.horizon[static_cast<std::size_t>(level)];
       const float walked = static_cast<float>(s.maxSpeed) * horizon, drift = n.velocitySpread * horizon;
-      if (n.separation <= std::max(walked, 2.0f * n.radius) && drift <= 2.0f * n.radius) {
+      if (n.separation <= std::max(walked, 4.0f * n.radius) && drift <= 2.0f * n.radius) {
         avoid(n.mean, n.velocity, clusterRadius(n, n.radius * l.shrink[static_cast<std::size_t>(level)], horizon), level);
         continue;
       }
     }
-    stack[top++] = n.right;
-    stack[top++] = n.left;
+    if (n.left >= 0) {
+      stack[top++] = n.right;
+      stack[top++] = n.left;
+      continue;
+    }
+    for (const std::uint32_t j : l.tree.agents().subspan(n.first, n.count)) {
+      if (j == self) continue;
+      const int own = l.levelOfSquaredDistance((l.positions[j] - x).squaredNorm());
+      if (own >= 1 && own <= depth) avoid(l.positions[j], l.velocities[j], l.radii[j] * l.shrink[static_cast<std::size_t>(own)], own);
+    }
   }
 }
 

@@ -5,12 +5,15 @@
 // agent's own position extrapolated likewise, all in the one linear program of the agent's ORCA
 // step. Far agents are grouped (Fig. 3.5): a node of the agent tree whose nearest possible member
 // lies in band i stands for its members as one cluster (eqs. 3.3-3.5) when it holds at most
-// 2^(i-1) agents (the seed's target size dt_i / dt), no gap inside it is wider than the
-// distance an agent walks within dt_i (nor 2 r) and its members, extrapolated, drift apart by at
-// most a diameter by then [assumptions: the seed leaves the quality threshold open; a gap nobody
-// can reach within the horizon is of no use to plan through, and a cluster of agents walking
-// different ways, two crossing streams, would stand for neither]. Its radius covers the members'
-// extrapolated discs: r_f + max |x_j - x_C| + max |v_j - v_C| dt_i. A node that fails is opened. Deeper levels are cut per agent (curtailing.hpp): `depth` holds each agent's L_j.
+// 2^(i-1) agents (the seed's target size dt_i / dt), no gap inside it lets an agent through that
+// it could reach within dt_i (members' centres at most 4 r apart - two radii and a diameter - or
+// at most the distance an agent walks within dt_i) and its members, extrapolated, drift apart by
+// at most a diameter by then [assumptions: the seed leaves the quality threshold open (its notes
+// suggest 2-4 diameters); a gap nobody can reach within the horizon is of no use to plan through,
+// and a cluster of agents walking different ways, two crossing streams, would stand for neither].
+// Its radius covers the members' extrapolated discs: r_f + max |x_j - x_C| + max |v_j - v_C| dt_i.
+// A node that fails is opened. Deeper levels are cut per agent (curtailing.hpp): `depth` holds
+// each agent's L_j.
 #include <array>
 #include <cstdint>
 #include <span>
