@@ -385,4 +385,10 @@ TEST(CrowdCli, BadInputNamesTheKey) {
                             R"("shape": {"type": "point", "position": [18, 10]}, "exit": true,
                                "more_shapes": [{"type": "box", "min": [17, 1], "max": [20, 3]}]})"),
                    {"goals[0].more_shapes", "not a point"});
+  // An inflow without a rate re-admits the leavers or nothing: 0 only with 'recycle'.
+  expectInputError("crowd_inflow_no_rate",
+                   replaced(doorway(), R"("obstacles": [)",
+                            R"("inflows": [{"region": {"type": "box", "min": [1, 1], "max": [3, 19]}, "rate": 0, "goal": "out"}],
+                               "obstacles": [)"),
+                   {"inflows[0].rate", "recycle"});
 }

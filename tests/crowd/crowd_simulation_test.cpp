@@ -133,6 +133,40 @@ TEST(CrowdSimulation, InflowsSpawnAtTheirRateAndExitsRemoveAgents) {
   EXPECT_GT(sim.exits().front().time, 1.0 + 26.0 / 1.4 - 2.0);
 }
 
+TEST(CrowdSimulation, RecyclingInflowsHoldTheCrowdsCount) {
+  // Two recycling inflows (rate 0) at the west end re-admit the agents that leave through the east
+  // exit, shared between them: the count stays at the start's after every step while agents
+  // leave, and every leaver comes back.
+  const Vec2 hi(30, 10);
+  Goal east;
+  east.kind = Goal::Kind::Region;
+  east.regions = {rectangle(Vec2(28, 0), Vec2(30, 10))};
+  east.exit = true;
+  std::vector<Inflow> inflows(2);
+  for (std::size_t k = 0; k < 2; ++k) {
+    inflows[k].region = rectangle(Vec2(0.5, 0.5 + 5.0 * k), Vec2(2, 4.5 + 5.0 * k));
+    inflows[k].rate = 0.0;
+    inflows[k].recycle = true;
+    inflows[k].agent.goal = 0;
+    inflows[k].agent.radius = kRadius;
+  }
+  auto planner = std::make_shared<DirectPlanner>(std::vector<Goal>{east});
+  const std::size_t start = 120;
+  CrowdSimulation sim(settings(hi, 30), {}, {east}, planner, randomAgents(start, Vec2(3, 1), Vec2(27, 9), 0, AgentModel::Uic, 5),
+                      inflows);
+  std::size_t spawned = 0;
+  for (int step = 0; step < 600; ++step) {
+    sim.step(0.05);
+    spawned += sim.lastStep().spawned;
+    ASSERT_EQ(sim.agents().size(), start) << "t = " << sim.time();
+  }
+  EXPECT_GT(sim.exits().size(), start);  // more than the whole crowd has passed the exit
+  EXPECT_EQ(spawned, sim.exits().size());
+  // The other inflow's agents and an inflow that neither recycles nor has a rate: refused.
+  inflows[0].recycle = false;
+  EXPECT_THROW(CrowdSimulation(settings(hi, 30), {}, {east}, planner, Agents{}, inflows), InputError);
+}
+
 TEST(CrowdSimulation, ScriptedAgentsWalkTheirScriptAndOthersGiveWay) {
   // A scripted agent crosses a crowd walking the other way (ch. 4.4.3): it keeps its path and
   // speed exactly, and nobody overlaps it.

@@ -108,8 +108,9 @@ CrowdSimulation::CrowdSimulation(const CrowdSettings& settings, std::vector<Poly
     if ((lo.array() < settings_.lo.array()).any() || (hi.array() > settings_.hi.array()).any())
       throw InputError(fmt::format("inflows[{}].region: it reaches outside the domain [{}, {}] x [{}, {}]", k,
                                    settings_.lo.x(), settings_.hi.x(), settings_.lo.y(), settings_.hi.y()));
-    if (!(f.rate > 0.0) || !std::isfinite(f.rate))
-      throw InputError(fmt::format("inflows[{}].rate: expected a positive number of agents per second", k));
+    if (!(f.rate > 0.0 || (f.recycle && f.rate == 0.0)) || !std::isfinite(f.rate))
+      throw InputError(fmt::format(
+          "inflows[{}].rate: expected a positive number of agents per second (0 only with 'recycle': true)", k));
     if (f.agent.goal >= goals_.size())
       throw InputError(fmt::format("inflows[{}].goal: there is no goal {}", k, f.agent.goal));
     Rng probe = rng_.split(~std::uint64_t(k));
@@ -490,6 +491,15 @@ void CrowdSimulation::arriveAndSpawn(double dt) {
     compactFlagged(farDirection_, remove_);
   }
   stats_.exited = exited;
+
+  // Each leaver is re-admitted whole by one of the recycling inflows open now, chosen by its id
+  // (the same on a resumed run).
+  recycling_.clear();
+  for (std::size_t k = 0; k < inflows_.size(); ++k)
+    if (inflows_[k].recycle && time_ >= inflows_[k].start && time_ <= inflows_[k].stop) recycling_.push_back(k);
+  if (!recycling_.empty())
+    for (std::size_t e = exits_.size() - exited; e < exits_.size(); ++e)
+      inflowCredit_[recycling_[exits_[e].agentId % recycling_.size()]] += 1.0;
 
   stats_.spawned = 0;
   for (std::size_t k = 0; k < inflows_.size(); ++k) {

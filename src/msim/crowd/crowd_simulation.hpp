@@ -35,7 +35,11 @@ namespace msim::crowd {
 // Agents entering through a region at a steady rate (the four-way crossing of Fig. 4.6).
 struct Inflow {
   Polygon region;
-  double rate = 1.0;  // [agents/s]
+  double rate = 1.0;  // [agents/s]; 0 only for a recycling inflow
+  // Besides its rate, the inflow re-admits agents that leave through exits (each leaver by one of
+  // the recycling inflows open at the time, chosen by its id), so a crowd keeps its count: the
+  // fixed-density runs of Golas ch. 4's Hajj sweep.
+  bool recycle = false;
   double start = 0.0, stop = std::numeric_limits<double>::infinity();  // [s]
   AgentSpec agent;    // goal, radius, speed, model, group of the new agents (position ignored)
   SpeedDistribution speeds;  // each new agent's speed, unless Fixed (then agent.maxSpeed)
@@ -194,6 +198,7 @@ class CrowdSimulation {
   Agents agents_;
   std::vector<Inflow> inflows_;
   std::vector<double> inflowCredit_;
+  std::vector<std::size_t> recycling_;  // scratch: the recycling inflows open now
   std::vector<Script> scripts_;
   std::vector<std::size_t> scriptProgress_;  // next waypoint per script
   double time_ = 0.0;

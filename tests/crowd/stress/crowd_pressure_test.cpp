@@ -1,7 +1,7 @@
 // Helbing's crowd pressure over time and the strain-rate magnitude (Golas eq. 4.13, Figs. 4.6,
 // 4.10, 4.11): the strain rate of linear flows against its closed form (simple shear sqrt(2)
 // gamma, rigid rotation and uniform flow 0), and the temporal pressure's lazily decayed sums
-// against a brute-force weighted variance over every stored sample.
+// against a brute-force weighted variance over every stored sample, and Helbing's local speed.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -61,6 +61,29 @@ TEST(CrowdPressure, StrainRateOfLinearFlowsMatchesTheirClosedForm) {
     for (int j = 2; j < spec.res.y() - 2; ++j)
       for (int i = 2; i < spec.res.x() - 2; ++i) EXPECT_NEAR(strain(IVec<2>(i, j)), k.expected, 1e-5) << k.name << " at " << i << "," << j;
   }
+}
+
+TEST(CrowdPressure, LocalSpeedIsTheMeanFlowNotTheAgentsSpeed) {
+  // Helbing's local speed: a uniform flow's is its speed; agents of every cell pushed to and fro
+  // (pairs walking opposite ways at 1 m/s) have a local speed of 0 whatever their own speeds; a
+  // uniform flow in one half of the grid and a jostling crowd in the other average to half, weighted
+  // by the agents (the windows straddling the two halves see part of the flow: between).
+  const GridSpec<2> spec(Vec2(0.0, 0.0), 1.0, IVec<2>(10, 6));
+  std::vector<Vec2f> x, v;
+  quarterPoints(spec, [](const Vec2&) { return Vec2(0.9, -1.2); }, x, v);
+  CrowdWindows windows(spec, 1);
+  windows.gather(x, v);
+  EXPECT_NEAR(meanLocalSpeed(windows), 1.5, 1e-6);
+  for (std::size_t k = 0; k < v.size(); ++k) v[k] = (k % 2 == 0 ? 1.0f : -1.0f) * Vec2f(0.6f, 0.8f);
+  windows.gather(x, v);
+  EXPECT_NEAR(meanLocalSpeed(windows), 0.0, 1e-6);
+  for (std::size_t k = 0; k < v.size(); ++k)
+    if (x[k].x() < 5.0f) v[k] = Vec2f(1.0f, 0.0f);
+  windows.gather(x, v);
+  EXPECT_GT(meanLocalSpeed(windows), 0.4);
+  EXPECT_LT(meanLocalSpeed(windows), 0.6);
+  windows.gather({}, {});
+  EXPECT_EQ(meanLocalSpeed(windows), 0.0);
 }
 
 TEST(CrowdPressure, StrainRateIsZeroWhereNobodyIs) {

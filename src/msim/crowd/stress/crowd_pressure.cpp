@@ -70,6 +70,16 @@ void spatialPressure(const CrowdWindows& windows, Grid<float, 2>& pressure) {
   }
 }
 
+double meanLocalSpeed(const CrowdWindows& windows) {
+  double weighted = 0.0, weight = 0.0;
+  for (const std::uint32_t c : windows.cells()) {
+    const CrowdWindows::Sums& w = windows.sums(c);
+    weighted += std::hypot(w.vx, w.vy);  // count x |mean velocity|
+    weight += w.count;
+  }
+  return weight > 0.0 ? weighted / weight : 0.0;
+}
+
 StrainRateSummary strainRate(const CrowdWindows& windows, Grid<float, 2>& strain) {
   requireSameGrid(windows, strain);
   const GridSpec<2>& spec = windows.spec();

@@ -47,6 +47,11 @@ class CrowdWindows {
 // velocity (0 where the window holds fewer than 2 agents).
 void spatialPressure(const CrowdWindows& windows, Grid<float, 2>& pressure);
 
+// Helbing et al.'s (2007) local speed, the magnitude of the window's mean velocity (a crowd whose
+// people are pushed to and fro has fast individuals but a slow local flow), averaged over the
+// windows with their agent counts as weights: the crowd's mean local speed [m/s] (0 for nobody).
+double meanLocalSpeed(const CrowdWindows& windows);
+
 // |grad v + grad v^T|_F per cell [1/s] of the window-mean velocity field, by central differences
 // across the cell (one-sided next to a cell whose window holds nobody; 0 where neither side has
 // anyone along an axis or the cell's own window is empty). The summary is over the cells whose

@@ -27,6 +27,7 @@ TurbulenceFrame TurbulenceMetrics::measure(const Agents& agents) {
   }
   f.temporalPressureMean = sampler_.meanWhereOccupied(temporal_);
   f.strainRate = stress::strainRate(windows_, strain_);
+  f.localSpeed = stress::meanLocalSpeed(windows_);
   f.standing = standstills_.standing();
   f.standstillEpisodes = standstills_.episodes();
   return f;

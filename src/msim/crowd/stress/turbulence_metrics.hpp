@@ -18,6 +18,7 @@ struct TurbulenceFrame {
   double temporalPressureMean = 0.0;  // over the crowd's cells (Fig. 4.10)
   long temporalCellsOver = 0;
   StrainRateSummary strainRate;       // [1/s]
+  double localSpeed = 0.0;            // the crowd's mean local speed (Helbing's) [m/s]
   long standing = 0;                  // agents in a standstill episode now
   long standstillEpisodes = 0;        // since the start
 };

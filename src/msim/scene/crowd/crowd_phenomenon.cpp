@@ -262,6 +262,8 @@ class CrowdPhenomenon final : public Phenomenon {
               {"strain_rate_max_per_s", turbulenceFrame_.strainRate.max},
               {"strain_rate_mean_per_s", turbulenceFrame_.strainRate.mean},
               {"strain_rate_variation", turbulenceFrame_.strainRate.variation},
+              // Helbing's local speed: the magnitude of the 3 x 3 cells' mean velocity, crowd-averaged.
+              {"local_speed_mps", turbulenceFrame_.localSpeed},
               // Stop-and-go: agents standing for 1 s or more while those ahead walk.
               {"standstill_agents", turbulenceFrame_.standing},
               {"standstill_episodes_total", turbulenceFrame_.standstillEpisodes}};

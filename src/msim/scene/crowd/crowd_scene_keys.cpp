@@ -205,7 +205,10 @@ Schema groupSchema() {
 Schema inflowSchema() {
   Schema f = Schema::object("agents entering at a steady rate");
   f.field("region", regionSchema("where they appear", false).required());
-  f.number("rate", "1/s", "agents per second").min(0.0, Bound::Exclusive).required();
+  f.number("rate", "1/s", "agents per second (0 with 'recycle')").min(0.0).required();
+  f.boolean("recycle", false,
+            "re-admits agents that leave through exits besides its rate: the crowd keeps its count "
+            "(fixed-density runs)");
   f.number("start", "s", 0.0, "first agent").min(0.0);
   f.number("stop", "s", 1e30, "no agents after this").min(0.0);
   agentKeys(f, false);
@@ -628,6 +631,8 @@ struct Builder {
       crowd::validateSimple(in.region, fmt::format("{}: '{}.region'", source, key));
       requireInside(in.region, key + ".region");
       in.rate = f.at("rate").get<double>();
+      in.recycle = f.at("recycle").get<bool>();
+      if (in.rate == 0.0 && !in.recycle) fail(key + ".rate", "expected a positive number of agents per second (0 only with 'recycle': true)");
       in.start = f.at("start").get<double>();
       in.stop = f.at("stop").get<double>();
       if (in.stop <= in.start) fail(key + ".stop", "must come after 'start'");
