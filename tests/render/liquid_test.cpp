@@ -212,7 +212,9 @@ TEST(LiquidTracer, SlabAttenuatesByBeerLambertAndTwoFresnelTransmissions) {
                   twoTransmissions);
       // Up to 30 degrees the internal reflections add less than 1e-3 (R ~ 0.02 at each face); at 60
       // degrees they add 0.3% of the light (R = 0.06 at the inner face) and only the series holds.
-      if (deg <= 30.0) EXPECT_NEAR(L[ch], twoTransmissions, 1e-3);
+      if (deg <= 30.0) {
+        EXPECT_NEAR(L[ch], twoTransmissions, 1e-3);
+      }
       // New rays start 1e-4 cell off the surface, so each pass through the liquid is 2e-4 cell short:
       // a relative error of sigma_a * 2e-4 dx / cos theta_t (2.5e-5 in the red at 60 degrees).
       EXPECT_NEAR(L[ch], series, 2e-5);

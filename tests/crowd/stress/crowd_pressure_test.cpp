@@ -55,7 +55,9 @@ TEST(CrowdPressure, StrainRateOfLinearFlowsMatchesTheirClosedForm) {
     const StrainRateSummary summary = strainRate(windows, strain);
     EXPECT_EQ(summary.cells, spec.cellCount()) << k.name;
     EXPECT_GE(summary.max, k.expected - 1e-5) << k.name;
-    if (k.parameter == 0.0) EXPECT_NEAR(summary.mean + summary.max + summary.variation, 0.0, 1e-6) << k.name;
+    if (k.parameter == 0.0) {
+      EXPECT_NEAR(summary.mean + summary.max + summary.variation, 0.0, 1e-6) << k.name;
+    }
     // Where the 3 x 3 windows and their neighbours' are whole (clipped windows at the boundary are
     // not centred on their cell).
     for (int j = 2; j < spec.res.y() - 2; ++j)

@@ -121,8 +121,11 @@ TEST(CrowdStress, T4SplattingKeepsEveryAgent) {
   double mass = 0.0;
   for (std::size_t c = 0; c < g.density().count(); ++c) mass += g.density()[c] * 0.25;
   EXPECT_NEAR(mass, 2500.0, 2500.0 * 1e-6);
-  for (std::size_t c = 0; c < g.density().count(); ++c)
-    if (g.density()[c] > 0.0f) EXPECT_NEAR(g.velocityX()[c], 1.0f, 1e-6f);
+  for (std::size_t c = 0; c < g.density().count(); ++c) {
+    if (g.density()[c] > 0.0f) {
+      EXPECT_NEAR(g.velocityX()[c], 1.0f, 1e-6f);
+    }
+  }
 }
 
 TEST(CrowdStress, T5DiscomfortPushesAlongWallsNotIntoThem) {
@@ -157,7 +160,9 @@ TEST(CrowdStress, T6AccelerationIsClampedKeepingItsDirection) {
     const Vec2 a(n(rng), n(rng));
     const Vec2 c = clampAcceleration(a, 3.0);
     EXPECT_LE(c.norm(), 3.0 * (1.0 + 1e-9));
-    if (a.norm() <= 3.0) EXPECT_EQ(c, a);
+    if (a.norm() <= 3.0) {
+      EXPECT_EQ(c, a);
+    }
     else EXPECT_NEAR(c.normalized().dot(a.normalized()), 1.0, 1e-12);
   }
 }

@@ -94,7 +94,7 @@ StrainRateSummary strainRate(const CrowdWindows& windows, Grid<float, 2>& strain
   };
   // d v / d(axis) at cell (i, j): central where both neighbours have a velocity, one-sided where one does.
   const auto derivative = [&](int i, int j, int di, int dj, const Vec2& here) -> Vec2 {
-    Vec2 lo, hi;
+    Vec2 lo = Vec2::Zero(), hi = Vec2::Zero();
     const bool hasLo = mean(i - di, j - dj, lo), hasHi = mean(i + di, j + dj, hi);
     if (hasLo && hasHi) return (hi - lo) / (2.0 * spec.dx);
     if (hasHi) return (hi - here) / spec.dx;
@@ -106,7 +106,7 @@ StrainRateSummary strainRate(const CrowdWindows& windows, Grid<float, 2>& strain
   double sum = 0.0, sum2 = 0.0;
   for (const std::uint32_t c : windows.cells()) {
     const int i = static_cast<int>(c % static_cast<std::uint32_t>(nx)), j = static_cast<int>(c / static_cast<std::uint32_t>(nx));
-    Vec2 here;
+    Vec2 here = Vec2::Zero();  // every listed cell's window holds someone
     mean(i, j, here);
     const Vec2 dx = derivative(i, j, 1, 0, here), dy = derivative(i, j, 0, 1, here);  // dv/dx, dv/dy
     const double exx = 2.0 * dx.x(), eyy = 2.0 * dy.y(), exy = dy.x() + dx.y();
