@@ -40,7 +40,10 @@ class DomainSplit {
   virtual double maxOverRanks(double value) = 0;
   // Static solids for the pressure solve: the open fraction of every local face. Collective.
   virtual void setOpenFractions(const MacGrid<D>& openFraction) = 0;
-  // The pressure projection of the global grid on the local velocity (walls and solids at rest):
+  // Moving solids for the pressure solve: their velocity on every local face (the closed parts
+  // of faces move with it). Collective.
+  virtual void setSolidVelocity(const MacGrid<D>& solidVelocity) = 0;
+  // The pressure projection of the global grid on the local velocity (walls at rest):
   // u = u* - (dt / rho) grad p with div u = 0 on the owned cells; `pressure` [Pa] warm-starts
   // the solve and receives p on the owned cells. Collective.
   virtual SplitSolveStats project(MacGrid<D>& velocity, Grid<float, D>& pressure, double dt, double density) = 0;

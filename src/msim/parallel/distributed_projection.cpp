@@ -34,6 +34,7 @@ DistributedProjection::DistributedProjection(const GridBlock<3>& block, const nu
       settings_(settings),
       comm_(comm),
       minOpenFraction_(minOpenFraction),
+      solidVelocity_(block.localSpec(), 0.0f),
       velocityGhosts_(block, comm),
       weightGhosts_(block, comm),
       cellGhosts_(block, IVec<3>::Zero(), comm),
@@ -58,6 +59,21 @@ void DistributedProjection::destroyHypre() {
   matrix_ = nullptr;
   stencil_ = nullptr;
   grid_ = nullptr;
+}
+
+void DistributedProjection::setSolidVelocity(const MacGrid<3>& solidVelocity) {
+  solidVelocity_ = solidVelocity;
+  const IVec<3> res = block_.global.res;
+  for (int a = 0; a < 3; ++a) {
+    Grid<float, 3>& us = solidVelocity_.component(a);
+    for (std::size_t i = 0; i < us.count(); ++i) {
+      const IVec<3> g = us.coord(i) + origin_;
+      if ((g[a] == 0 && sides_.side[a][0] == numerics::DomainSide::Wall) ||
+          (g[a] == res[a] && sides_.side[a][1] == numerics::DomainSide::Wall))
+        us[i] = 0.0f;
+    }
+  }
+  velocityGhosts_.exchange(solidVelocity_);
 }
 
 void DistributedProjection::setOpenFractions(const MacGrid<3>& openFraction) {
@@ -208,15 +224,16 @@ SplitSolveStats DistributedProjection::project(MacGrid<3>& velocity, Grid<float,
     throw std::invalid_argument("pressure projection: the step and the density must be positive");
   const double toScaled = dt / (density * block_.global.dx);
   velocityGhosts_.exchange(velocity);
-  // b = -dx div u*: the net face-weighted outflow of each fluid cell, negated.
+  // b = -dx div u*: the net outflow of each fluid cell through its faces' open parts (u*) and
+  // closed parts (the solid's velocity), negated.
   double sum = 0.0, count = 0.0;
+  const auto flux = [&](int a, const IVec<3>& f) {
+    const double w = weights_.component(a)(f);
+    return w * velocity.component(a)(f) + (1.0 - w) * solidVelocity_.component(a)(f);
+  };
   forOwnedCells(block_, [&](const IVec<3>& l, std::size_t k) {
     double outflow = 0.0;
-    for (int a = 0; a < 3; ++a) {
-      const IVec<3> up = l + IVec<3>::Unit(a);
-      outflow += double(weights_.component(a)(up)) * velocity.component(a)(up) -
-                 double(weights_.component(a)(l)) * velocity.component(a)(l);
-    }
+    for (int a = 0; a < 3; ++a) outflow += flux(a, l + IVec<3>::Unit(a)) - flux(a, l);
     rhs_[k] = fluid_[k] ? -outflow : 0.0;
     sum += rhs_[k];
     count += fluid_[k];
@@ -278,7 +295,7 @@ SplitSolveStats DistributedProjection::project(MacGrid<3>& velocity, Grid<float,
     cellGhosts_.exchange(scaled_);
   }
 
-  // u = u* - grad p^ on the owned open faces; closed faces take the (static) solid's velocity 0.
+  // u = u* - grad p^ on the owned open faces; closed faces take the solid's velocity.
   const IVec<3> origin = block_.cellOrigin(), res = block_.global.res;
   for (int a = 0; a < 3; ++a) {
     Grid<float, 3>& u = velocity.component(a);
@@ -289,7 +306,7 @@ SplitSolveStats DistributedProjection::project(MacGrid<3>& velocity, Grid<float,
         for (int x = faces.lo[0]; x < faces.hi[0]; ++x) {
           const IVec<3> g(x, y, z), l = g - origin, low = l - IVec<3>::Unit(a);
           if (w(l) <= 0.0f) {
-            u(l) = 0.0f;
+            u(l) = solidVelocity_.component(a)(l);
             continue;
           }
           // Air cells and the ghosts beyond open sides hold p^ = 0; across a liquid-air face the

@@ -10,7 +10,8 @@
 // The system is the serial one: A p^ = -dx div u* with p^ = p dt / (rho dx), A_ii = sum of the
 // cell's face weights, A_ij = -w_f, domain walls w = 0, open sides Dirichlet (p = 0 beyond).
 // Convergence is declared, as in the serial PcgSolver, when |b - A p^|_inf <= tolerance |b|_inf.
-// Supported: static solids (open fractions per face) and walls at rest. A domain without open
+// Supported: solids (open fractions per face), at rest or moving (their face velocities), and
+// walls at rest. A domain without open
 // sides has the constants as null space; the right-hand side's mean over fluid cells is removed
 // and one fluid cell is pinned, which changes p^ by a constant only (one connected fluid region
 // is assumed, as in a box of smoke).
@@ -46,6 +47,11 @@ class DistributedProjection {
   // method) and the update across it is divided by theta. liquidPhi is the local cell-centred
   // field; its ghosts are exchanged here. Rebuilds the matrix. Collective.
   void setFreeSurface(const Grid<float, 3>& liquidPhi, float minTheta = 1e-3f);
+  // The velocity of moving solids on every local face (block.localSpec()'s MAC layout), as
+  // numerics::PressureProjection::setSolidVelocity: a face's closed part moves with it (its flux
+  // counts in the divergence the solve removes) and a closed face takes it; the domain's walls
+  // stay at rest. Its ghosts are exchanged here. Collective.
+  void setSolidVelocity(const MacGrid<3>& solidVelocity);
   // Makes the owned faces of `velocity` (a local MAC grid) divergence free; its ghosts are
   // exchanged first and are stale afterwards. `pressure` [Pa] (local, cell-centred) warm-starts
   // the solve and receives its result on the owned cells, as the serial projection keeps its
@@ -75,6 +81,7 @@ class DistributedProjection {
   MPI_Comm comm_;
   float minOpenFraction_;
   MacGrid<3> weights_;
+  MacGrid<3> solidVelocity_;                 // with ghosts; 0 on the domain's walls
   std::optional<Grid<float, 3>> liquidPhi_;  // with ghosts; empty without a free surface
   MacGrid<3> inverseTheta_;                  // 1 / theta on liquid-air faces, 1 elsewhere
   MacGhostExchange<3> velocityGhosts_, weightGhosts_;

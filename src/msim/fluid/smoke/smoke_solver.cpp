@@ -121,7 +121,7 @@ void SmokeSolver<D>::updateSealed() {
 template <int D>
 void SmokeSolver<D>::setObstacleVelocity(const MacGrid<D>& solidVelocity) {
   projection_.setSolidVelocity(solidVelocity);
-  movingObstacles_ = true;
+  if (split_) split_->setSolidVelocity(solidVelocity);
 }
 
 template <int D>
@@ -153,7 +153,10 @@ void SmokeSolver<D>::setDomainSplit(DomainSplit<D>* split) {
   split_ = split;
   advector_.setPlacement(split ? split->placement() : BlockPlacement<D>{});
   // Obstacles placed before: the split's solve takes them too (its own walls by global index).
-  if (split_ && hasObstacles_) split_->setOpenFractions(projection_.faceWeights());
+  if (split_ && hasObstacles_) {
+    split_->setOpenFractions(projection_.faceWeights());
+    split_->setSolidVelocity(projection_.solidVelocity());
+  }
 }
 
 template <int D>
@@ -161,7 +164,6 @@ void SmokeSolver<D>::checkDistributable() const {
   auto refuse = [](const std::string& what) {
     throw InputError("smoke split among MPI processes: " + what + " is not distributed; run it on one process");
   };
-  if (movingObstacles_) refuse("a moving obstacle");
   if (vortex_) refuse("vortex particles");
   if (params_.viscosity > 0.0) refuse("viscosity");
   if (params_.scalarTransport == ScalarTransport::Conservative) refuse("conservative scalar transport");

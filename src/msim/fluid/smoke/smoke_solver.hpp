@@ -281,7 +281,6 @@ class SmokeSolver {
   ViscousDiffusion<D> viscosity_;
   StageTimers timers_;
   DomainSplit<D>* split_ = nullptr;
-  bool movingObstacles_ = false;  // setObstacleVelocity was called
   double maxDivergence_ = 0.0;
   int pressureIterations_ = 0, viscosityIterations_ = 0;
   long steps_ = 0;

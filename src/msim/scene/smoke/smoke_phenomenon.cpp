@@ -142,7 +142,6 @@ class SmokePhenomenon final : public Phenomenon {
     for (int a = 0; a < D; ++a) solver_.velocity().component(a).fill(static_cast<float>(u0[a]));
     // Vortex particles before the obstacles, which the solver hands them.
     solver_.setVortexLayer(vortexLayer<D>(scene, "smoke"));
-    if (split_ && obstacles_.moving()) refuseSplit(source_, "obstacles", "a moving obstacle");
     if (!obstacles_.empty()) placeObstacles(0.0);
     // Rank 0 writes the obstacles of the whole grid with each frame of a split run.
     if (split_ && split_->root() && !obstacles_.empty()) wholeObstacles_.emplace(scene, scene.gridSpec<D>());
@@ -243,7 +242,8 @@ class SmokePhenomenon final : public Phenomenon {
     split_->gather(solver_.velocity(), g.velocity);
     g.scalars.resize(solver_.scalarCount());
     for (std::size_t i = 0; i < solver_.scalarCount(); ++i) split_->gather(solver_.scalar(i), g.scalars[i]);
-    if (!obstacles_.empty() && !g.solidsGathered) {  // static: once (decided alike on every rank)
+    // Static solids once, moving ones every frame (decided alike on every rank).
+    if (!obstacles_.empty() && (!g.solidsGathered || obstacles_.moving())) {
       split_->gather(solver_.solid(), g.solid);
       split_->gather(solver_.projection().faceWeights(), g.faceWeights);
       g.solidsGathered = true;
