@@ -43,7 +43,9 @@ class DomainSplit {
   // Moving solids for the pressure solve: their velocity on every local face (the closed parts
   // of faces move with it). Collective.
   virtual void setSolidVelocity(const MacGrid<D>& solidVelocity) = 0;
-  // The pressure projection of the global grid on the local velocity (walls at rest):
+  // A domain wall moving along its normal (an inlet) [m/s along +axis]; others stay at rest.
+  virtual void setWallNormalVelocity(int axis, int side, double velocity) = 0;
+  // The pressure projection of the global grid on the local velocity:
   // u = u* - (dt / rho) grad p with div u = 0 on the owned cells; `pressure` [Pa] warm-starts
   // the solve and receives p on the owned cells. Collective.
   virtual SplitSolveStats project(MacGrid<D>& velocity, Grid<float, D>& pressure, double dt, double density) = 0;

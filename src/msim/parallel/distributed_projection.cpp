@@ -63,17 +63,26 @@ void DistributedProjection::destroyHypre() {
 
 void DistributedProjection::setSolidVelocity(const MacGrid<3>& solidVelocity) {
   solidVelocity_ = solidVelocity;
+  velocityGhosts_.exchange(solidVelocity_);
+  applyWallVelocities();
+}
+
+void DistributedProjection::setWallNormalVelocity(int axis, int side, double velocity) {
+  wallNormalVelocity_[static_cast<std::size_t>(axis)][static_cast<std::size_t>(side)] = static_cast<float>(velocity);
+  applyWallVelocities();
+}
+
+void DistributedProjection::applyWallVelocities() {
   const IVec<3> res = block_.global.res;
   for (int a = 0; a < 3; ++a) {
     Grid<float, 3>& us = solidVelocity_.component(a);
     for (std::size_t i = 0; i < us.count(); ++i) {
       const IVec<3> g = us.coord(i) + origin_;
-      if ((g[a] == 0 && sides_.side[a][0] == numerics::DomainSide::Wall) ||
-          (g[a] == res[a] && sides_.side[a][1] == numerics::DomainSide::Wall))
-        us[i] = 0.0f;
+      for (int side = 0; side < 2; ++side)
+        if (g[a] == (side == 0 ? 0 : res[a]) && sides_.side[a][side] == numerics::DomainSide::Wall)
+          us[i] = wallNormalVelocity_[static_cast<std::size_t>(a)][static_cast<std::size_t>(side)];
     }
   }
-  velocityGhosts_.exchange(solidVelocity_);
 }
 
 void DistributedProjection::setOpenFractions(const MacGrid<3>& openFraction) {

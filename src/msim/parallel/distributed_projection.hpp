@@ -11,13 +11,14 @@
 // cell's face weights, A_ij = -w_f, domain walls w = 0, open sides Dirichlet (p = 0 beyond).
 // Convergence is declared, as in the serial PcgSolver, when |b - A p^|_inf <= tolerance |b|_inf.
 // Supported: solids (open fractions per face), at rest or moving (their face velocities), and
-// walls at rest. A domain without open
+// walls at rest or moving along their normals. A domain without open
 // sides has the constants as null space; the right-hand side's mean over fluid cells is removed
 // and one fluid cell is pinned, which changes p^ by a constant only (one connected fluid region
 // is assumed, as in a box of smoke).
 #include <HYPRE_struct_ls.h>
 #include <mpi.h>
 
+#include <array>
 #include <optional>
 #include <vector>
 
@@ -49,9 +50,13 @@ class DistributedProjection {
   void setFreeSurface(const Grid<float, 3>& liquidPhi, float minTheta = 1e-3f);
   // The velocity of moving solids on every local face (block.localSpec()'s MAC layout), as
   // numerics::PressureProjection::setSolidVelocity: a face's closed part moves with it (its flux
-  // counts in the divergence the solve removes) and a closed face takes it; the domain's walls
-  // stay at rest. Its ghosts are exchanged here. Collective.
+  // counts in the divergence the solve removes) and a closed face takes it. The domain's walls
+  // move with their own normal velocity whatever it says. Its ghosts are exchanged here.
+  // Collective.
   void setSolidVelocity(const MacGrid<3>& solidVelocity);
+  // A domain wall that moves along its normal (fluid enters or leaves through it: a wind
+  // tunnel's inlet), as numerics::PressureProjection::setWallNormalVelocity [m/s along +axis].
+  void setWallNormalVelocity(int axis, int side, double velocity);
   // Makes the owned faces of `velocity` (a local MAC grid) divergence free; its ghosts are
   // exchanged first and are stale afterwards. `pressure` [Pa] (local, cell-centred) warm-starts
   // the solve and receives its result on the owned cells, as the serial projection keeps its
@@ -81,7 +86,9 @@ class DistributedProjection {
   MPI_Comm comm_;
   float minOpenFraction_;
   MacGrid<3> weights_;
-  MacGrid<3> solidVelocity_;                 // with ghosts; 0 on the domain's walls
+  MacGrid<3> solidVelocity_;                 // with ghosts; the walls' own on the domain's walls
+  std::array<std::array<float, 2>, 3> wallNormalVelocity_{};
+  void applyWallVelocities();  // the walls' normal velocities into solidVelocity_
   std::optional<Grid<float, 3>> liquidPhi_;  // with ghosts; empty without a free surface
   MacGrid<3> inverseTheta_;                  // 1 / theta on liquid-air faces, 1 elsewhere
   MacGhostExchange<3> velocityGhosts_, weightGhosts_;

@@ -29,6 +29,9 @@ class MpiDomainSplit final : public DomainSplit<3> {
   double maxOverRanks(double value) override;
   void setOpenFractions(const MacGrid<3>& openFraction) override { projection_.setOpenFractions(openFraction); }
   void setSolidVelocity(const MacGrid<3>& solidVelocity) override { projection_.setSolidVelocity(solidVelocity); }
+  void setWallNormalVelocity(int axis, int side, double velocity) override {
+    projection_.setWallNormalVelocity(axis, side, velocity);
+  }
   SplitSolveStats project(MacGrid<3>& velocity, Grid<float, 3>& pressure, double dt, double density) override;
 
   const GridBlock<3>& block() const { return block_; }

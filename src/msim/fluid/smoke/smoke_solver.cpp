@@ -152,6 +152,9 @@ template <int D>
 void SmokeSolver<D>::setDomainSplit(DomainSplit<D>* split) {
   split_ = split;
   advector_.setPlacement(split ? split->placement() : BlockPlacement<D>{});
+  if (split_)
+    for (int a = 0; a < D; ++a)
+      for (int side = 0; side < 2; ++side) split_->setWallNormalVelocity(a, side, params_.wallVelocity[a][side][a]);
   // Obstacles placed before: the split's solve takes them too (its own walls by global index).
   if (split_ && hasObstacles_) {
     split_->setOpenFractions(projection_.faceWeights());
@@ -168,9 +171,6 @@ void SmokeSolver<D>::checkDistributable() const {
   if (params_.viscosity > 0.0) refuse("viscosity");
   if (params_.scalarTransport == ScalarTransport::Conservative) refuse("conservative scalar transport");
   if (advectionOffset_ || scalarsElsewhere_) refuse("procedural turbulence");
-  for (int a = 0; a < D; ++a)
-    for (int side = 0; side < 2; ++side)
-      if (!params_.wallVelocity[a][side].isZero()) refuse("a moving wall");
   for (const auto& src : sources_)
     if (src.active && src.expansion != 0.0) refuse("an expanding source");
 }

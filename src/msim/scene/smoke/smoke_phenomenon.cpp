@@ -78,9 +78,6 @@ std::unique_ptr<DomainSplit<D>> smokeSplit(const Scene& scene) {
       if (sources[i].at("expansion").get<double>() != 0.0)
         refuse(fmt::format("sources[{}].expansion", i), "an expanding source");
     const fluid::SmokeParams<3> p = smokeParams<3>(scene);
-    for (const auto& axis : p.wallVelocity)
-      for (const auto& wall : axis)
-        if (!wall.isZero()) refuse("smoke.wall_velocity", "a moving wall");
     // Enough ghost layers for the scheme at the solver's CFL number (and blocks at least that thick).
     const int needed = parallel::smokeGhostLayers(p.advection, std::max(1.0, p.cfl));
     const json& mpi = r.at("mpi");
