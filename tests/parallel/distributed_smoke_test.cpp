@@ -1,5 +1,6 @@
 // A 3D smoke plume (sources with inflow, buoyancy, vorticity confinement, MacCormack, open top),
-// alone, split by a ball at rest and swept by a moving ball, run for 50 steps split among the ranks gives the density of the same run on one rank within
+// alone, split by a ball at rest, swept by a moving ball, in a wind tunnel and from an expanding
+// source, run for 50 steps split among the ranks gives the density of the same run on one rank within
 // 1e-4 relative (the check), and stays close to the serial solver with its own MG-PCG.
 #include <gtest/gtest.h>
 
@@ -38,8 +39,9 @@ fluid::SmokeParams<3> plumeParams() {
 }
 
 // A ball of hot smoke blowing upwards near the floor, voxelised on `spec` (the whole grid or a block).
-fluid::SmokeSource<3> plumeSource(const GridSpec<3>& spec) {
+fluid::SmokeSource<3> plumeSource(const GridSpec<3>& spec, double expansion = 0.0) {
   fluid::SmokeSource<3> src;
+  src.expansion = expansion;
   src.density = 1.0;
   src.temperature = 420.0;
   src.velocity = Vec<3>(0.2, 1.2, 0.0);
@@ -55,56 +57,57 @@ fluid::SmokeSource<3> plumeSource(const GridSpec<3>& spec) {
 }
 
 // The plume alone, split by a ball at rest, or by a ball that swings across it once in the 50
-// steps (a moving obstacle: its faces push the smoke through the pressure solve).
-enum class Ball { None, AtRest, Moving, Tunnel };
+// steps (a moving obstacle: its faces push the smoke through the pressure solve); the plume and
+// the ball in a wind tunnel; the plume from a source whose gas expands (a target divergence).
+enum class Variant { Plume, Ball, MovingBall, Tunnel, Expanding };
 const Vec<3> kSwing(0.1, 0.0, 0.04);                   // amplitude [m]
 const double kOmega = 2.0 * 3.14159265358979 / 0.4;   // [1/s]
 
 // The ball at time t (negative inside), and its velocity.
-double ballDistance(const Vec<3>& x, Ball ball, double t) {
-  const Vec<3> centre = Vec<3>(0.5, 0.55, 0.45) + (ball == Ball::Moving ? std::sin(kOmega * t) : 0.0) * kSwing;
+double ballDistance(const Vec<3>& x, Variant variant, double t) {
+  const Vec<3> centre = Vec<3>(0.5, 0.55, 0.45) + (variant == Variant::MovingBall ? std::sin(kOmega * t) : 0.0) * kSwing;
   return (x - centre).norm() - 0.13;
 }
 Vec<3> ballVelocity(double t) { return kOmega * std::cos(kOmega * t) * kSwing; }
 
 // The tunnel variant: the plume in a wind, blown in through the x_min wall (moving along its
 // normal) and out through an open x_max side, around the ball at rest.
-fluid::SmokeParams<3> variantParams(Ball ball) {
+fluid::SmokeParams<3> variantParams(Variant variant) {
   fluid::SmokeParams<3> p = plumeParams();
-  if (ball == Ball::Tunnel) {
+  if (variant == Variant::Tunnel) {
     p.wallVelocity[0][0] = Vec<3>(0.5, 0.0, 0.0);
     p.sides.side[0][1] = numerics::DomainSide::Open;
   }
   return p;
 }
 
-Grid<float, 3> runPlume(const GridSpec<3>& spec, DomainSplit<3>* split, Ball ball) {
-  fluid::SmokeSolver<3> solver(spec, variantParams(ball));
+Grid<float, 3> runPlume(const GridSpec<3>& spec, DomainSplit<3>* split, Variant variant) {
+  fluid::SmokeSolver<3> solver(spec, variantParams(variant));
   const auto place = [&](double t) {
-    solver.setObstacles(numerics::sampleNodes<3>(spec, [&](const Vec<3>& x) { return ballDistance(x, ball, t); }));
-    if (ball == Ball::Moving) {
+    solver.setObstacles(numerics::sampleNodes<3>(spec, [&](const Vec<3>& x) { return ballDistance(x, variant, t); }));
+    if (variant == Variant::MovingBall) {
       MacGrid<3> velocity(spec);
       for (int a = 0; a < 3; ++a) velocity.component(a).fill(static_cast<float>(ballVelocity(t)[a]));
       solver.setObstacleVelocity(velocity);
     }
   };
-  if (ball != Ball::None) place(0.0);
-  solver.addSource(plumeSource(spec));
+  if (variant != Variant::Plume && variant != Variant::Expanding) place(0.0);
+  solver.addSource(plumeSource(spec, variant == Variant::Expanding ? 4.0 : 0.0));
   solver.setDomainSplit(split);
   for (int s = 0; s < kSteps; ++s) {
     EXPECT_LE(kDt, solver.cflTimestep()) << "step " << s;
-    if (ball == Ball::Moving) place((s + 0.5) * kDt);
+    if (variant == Variant::MovingBall) place((s + 0.5) * kDt);
     solver.step(kDt);
   }
   return solver.density();
 }
 
-Grid<float, 3> runSplit(MPI_Comm comm, Ball ball) {
-  const fluid::SmokeParams<3> params = variantParams(ball);
+Grid<float, 3> runSplit(MPI_Comm comm, Variant variant) {
+  const fluid::SmokeParams<3> params = variantParams(variant);
   const GridBlock<3> block(kGlobal, BlockDecomposition<3>(kGlobal.res, sizeOf(comm), 4, "test"), rankOf(comm),
                            smokeGhostLayers(params.advection, 1.0));
   MpiDomainSplit split(block, params.sides, params.projection.pcg, comm);
-  return gatherToRoot(runPlume(block.localSpec(), &split, ball), block, comm);
+  return gatherToRoot(runPlume(block.localSpec(), &split, variant), block, comm);
 }
 
 double maxAbs(const Grid<float, 3>& g) {
@@ -119,30 +122,31 @@ double maxDifference(const Grid<float, 3>& a, const Grid<float, 3>& b) {
   return m;
 }
 
-class DistributedSmoke : public ::testing::TestWithParam<Ball> {};
+class DistributedSmoke : public ::testing::TestWithParam<Variant> {};
 
 TEST_P(DistributedSmoke, FiftyStepsMatchOneRankWithin1e4Relative) {
-  const Ball ball = GetParam();
+  const Variant variant = GetParam();
   // The one-rank run on rank 0 alone, the split run on every rank, the serial solver on rank 0.
   MPI_Comm alone;
   MPI_Comm_split(MPI_COMM_WORLD, worldRank() == 0 ? 0 : MPI_UNDEFINED, 0, &alone);
   std::optional<Grid<float, 3>> one, serial;
   if (worldRank() == 0) {
-    one = runSplit(alone, ball);
-    serial = runPlume(kGlobal, nullptr, ball);
+    one = runSplit(alone, variant);
+    serial = runPlume(kGlobal, nullptr, variant);
     MPI_Comm_free(&alone);
   }
-  const Grid<float, 3> split = runSplit(MPI_COMM_WORLD, ball);
+  const Grid<float, 3> split = runSplit(MPI_COMM_WORLD, variant);
   bool ok = true;
   if (worldRank() == 0) {
     const double scale = maxAbs(*one);
     const double toOne = maxDifference(split, *one) / scale, toSerial = maxDifference(split, *serial) / scale;
-    const char* variant = ball == Ball::None     ? ""
-                          : ball == Ball::AtRest ? " around a ball"
-                          : ball == Ball::Moving ? " swept by a moving ball"
-                                                 : " in a wind tunnel around a ball";
+    const char* name = variant == Variant::Plume        ? ""
+                       : variant == Variant::Ball       ? " around a ball"
+                       : variant == Variant::MovingBall ? " swept by a moving ball"
+                       : variant == Variant::Tunnel     ? " in a wind tunnel around a ball"
+                                                        : " from an expanding source";
     std::printf("smoke plume%s, %d steps on %d ranks: max density %.3f; relative difference to 1 rank %.1e, to the "
-                "serial MG-PCG solver %.1e\n", variant, kSteps, worldSize(), scale, toOne, toSerial);
+                "serial MG-PCG solver %.1e\n", name, kSteps, worldSize(), scale, toOne, toSerial);
     EXPECT_GT(scale, 0.5);
     EXPECT_LT(toOne, 1e-4);
     EXPECT_LT(toSerial, 1e-2);
@@ -151,7 +155,9 @@ TEST_P(DistributedSmoke, FiftyStepsMatchOneRankWithin1e4Relative) {
   EXPECT_TRUE(fromRoot(ok));
 }
 
-INSTANTIATE_TEST_SUITE_P(Obstacle, DistributedSmoke, ::testing::Values(Ball::None, Ball::AtRest, Ball::Moving, Ball::Tunnel));
+INSTANTIATE_TEST_SUITE_P(Variants, DistributedSmoke,
+                         ::testing::Values(Variant::Plume, Variant::Ball, Variant::MovingBall, Variant::Tunnel,
+                                           Variant::Expanding));
 
 }  // namespace
 }  // namespace msim::parallel

@@ -27,8 +27,8 @@ for key in ("smoke_mass_kg", "kinetic_energy_J", "max_speed_m_s", "enstrophy"):
     assert rel < 1e-4, key
 PY
 [[ $(ls "$tmp/two/vdb" | wc -l) -eq 6 && $(ls "$tmp/two/png" | wc -l) -eq 6 ]] || { echo "expected 6 frames"; exit 1; }
-# Around a static obstacle, around one that moves, in a wind blown in through a wall, and fire
-# under a mesh obstacle that one rank's block does not touch.
+# Around a static obstacle, around one that moves, in a wind blown in through a wall, from an
+# expanding source, and fire under a mesh obstacle that one rank's block does not touch.
 compare_scene() {  # compare_scene SCENE NAME KEYS...: one and two processes agree within 1e-4
   local scene=$1 name=$2
   shift 2
@@ -49,6 +49,8 @@ extra=(--set 'obstacles[0].velocity=[0.3,0,0]')
 compare_scene smoke_sphere moving_sphere smoke_mass_kg kinetic_energy_J enstrophy
 extra=(--set 'smoke.wall_velocity.x_min=[0.4,0,0]' --set domain.boundaries.x_max=open)  # a wind tunnel
 compare_scene smoke_sphere tunnel smoke_mass_kg kinetic_energy_J enstrophy
+extra=(--set 'sources[0].expansion=5')  # gas that expands as it is released
+compare_scene plume_3d expanding smoke_mass_kg kinetic_energy_J enstrophy
 extra=(--set smoke.viscosity=0)  # the log's scene is viscous; viscosity does not split yet
 compare_scene burning_log log fuel_kg flame_kg kinetic_energy_J
 

@@ -45,6 +45,9 @@ class DomainSplit {
   virtual void setSolidVelocity(const MacGrid<D>& solidVelocity) = 0;
   // A domain wall moving along its normal (an inlet) [m/s along +axis]; others stay at rest.
   virtual void setWallNormalVelocity(int axis, int side, double velocity) = 0;
+  // The divergence [1/s] project() leaves in each local cell (expanding gas; null: none). The
+  // field must outlive the calls to project().
+  virtual void setCellTargetDivergence(const Grid<float, D>* perCell) = 0;
   // The pressure projection of the global grid on the local velocity:
   // u = u* - (dt / rho) grad p with div u = 0 on the owned cells; `pressure` [Pa] warm-starts
   // the solve and receives p on the owned cells. Collective.

@@ -233,8 +233,8 @@ SplitSolveStats DistributedProjection::project(MacGrid<3>& velocity, Grid<float,
     throw std::invalid_argument("pressure projection: the step and the density must be positive");
   const double toScaled = dt / (density * block_.global.dx);
   velocityGhosts_.exchange(velocity);
-  // b = -dx div u*: the net outflow of each fluid cell through its faces' open parts (u*) and
-  // closed parts (the solid's velocity), negated.
+  // b = dx c - dx div u*: the target divergence c (expanding gas) less the net outflow of each
+  // fluid cell through its faces' open parts (u*) and closed parts (the solid's velocity).
   double sum = 0.0, count = 0.0;
   const auto flux = [&](int a, const IVec<3>& f) {
     const double w = weights_.component(a)(f);
@@ -243,7 +243,8 @@ SplitSolveStats DistributedProjection::project(MacGrid<3>& velocity, Grid<float,
   forOwnedCells(block_, [&](const IVec<3>& l, std::size_t k) {
     double outflow = 0.0;
     for (int a = 0; a < 3; ++a) outflow += flux(a, l + IVec<3>::Unit(a)) - flux(a, l);
-    rhs_[k] = fluid_[k] ? -outflow : 0.0;
+    const double target = cellTargetDivergence_ ? block_.global.dx * (*cellTargetDivergence_)(l) : 0.0;
+    rhs_[k] = fluid_[k] ? target - outflow : 0.0;
     sum += rhs_[k];
     count += fluid_[k];
   });

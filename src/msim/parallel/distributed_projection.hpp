@@ -57,6 +57,10 @@ class DistributedProjection {
   // A domain wall that moves along its normal (fluid enters or leaves through it: a wind
   // tunnel's inlet), as numerics::PressureProjection::setWallNormalVelocity [m/s along +axis].
   void setWallNormalVelocity(int axis, int side, double velocity);
+  // The divergence [1/s] the projection leaves in each local cell (expanding gas), as
+  // numerics::PressureProjection::setCellTargetDivergence; null: none. Kept by pointer: the field
+  // must outlive the calls to project().
+  void setCellTargetDivergence(const Grid<float, 3>* perCell) { cellTargetDivergence_ = perCell; }
   // Makes the owned faces of `velocity` (a local MAC grid) divergence free; its ghosts are
   // exchanged first and are stale afterwards. `pressure` [Pa] (local, cell-centred) warm-starts
   // the solve and receives its result on the owned cells, as the serial projection keeps its
@@ -88,6 +92,7 @@ class DistributedProjection {
   MacGrid<3> weights_;
   MacGrid<3> solidVelocity_;                 // with ghosts; the walls' own on the domain's walls
   std::array<std::array<float, 2>, 3> wallNormalVelocity_{};
+  const Grid<float, 3>* cellTargetDivergence_ = nullptr;
   void applyWallVelocities();  // the walls' normal velocities into solidVelocity_
   std::optional<Grid<float, 3>> liquidPhi_;  // with ghosts; empty without a free surface
   MacGrid<3> inverseTheta_;                  // 1 / theta on liquid-air faces, 1 elsewhere

@@ -171,8 +171,6 @@ void SmokeSolver<D>::checkDistributable() const {
   if (params_.viscosity > 0.0) refuse("viscosity");
   if (params_.scalarTransport == ScalarTransport::Conservative) refuse("conservative scalar transport");
   if (advectionOffset_ || scalarsElsewhere_) refuse("procedural turbulence");
-  for (const auto& src : sources_)
-    if (src.active && src.expansion != 0.0) refuse("an expanding source");
 }
 
 template <int D>
@@ -413,6 +411,7 @@ void SmokeSolver<D>::updateExpansion() {
     if (expansion_.count() != 0) {
       expansion_ = Grid<float, D>();
       projection_.setCellTargetDivergence(nullptr);
+      if (split_) split_->setCellTargetDivergence(nullptr);
     }
     return;
   }
@@ -422,6 +421,7 @@ void SmokeSolver<D>::updateExpansion() {
     if (src.active)
       for (const auto& [cell, w] : src.cells) expansion_[cell] += static_cast<float>(w * src.expansion);
   projection_.setCellTargetDivergence(&expansion_);
+  if (split_) split_->setCellTargetDivergence(&expansion_);
 }
 
 template <int D>
@@ -452,16 +452,16 @@ template <int D>
 double SmokeSolver<D>::measureDivergence() {
   projection_.divergence(velocity_, divergence_);
   // Expanding sources keep their divergence on purpose; what is measured is the error.
-  if (expansion_.count() != 0)
-    return parallelMax(divergence_.count(), [&](std::size_t i) { return std::abs(divergence_[i] - expansion_[i]); });
-  if (!split_) return parallelMax(divergence_.count(), [&](std::size_t i) { return std::abs(divergence_[i]); });
+  const bool expanding = expansion_.count() != 0;
+  const auto error = [&](std::size_t i) { return std::abs(double(divergence_[i]) - (expanding ? expansion_[i] : 0.0)); };
+  if (!split_) return parallelMax(divergence_.count(), error);
   // A split run: the owned cells (the local face weights are right on all their faces, a block's
   // edge lying a ghost layer away), over every rank.
   const IVec<D> lo = split_->ownedLo(), hi = split_->ownedHi();
   const double worst = parallelMax(divergence_.count(), [&](std::size_t i) {
     const IVec<D> c = divergence_.coord(i);
     const bool owned = (c.array() >= lo.array()).all() && (c.array() < hi.array()).all();
-    return owned ? std::abs(double(divergence_[i])) : 0.0;
+    return owned ? error(i) : 0.0;
   });
   return split_->maxOverRanks(worst);
 }

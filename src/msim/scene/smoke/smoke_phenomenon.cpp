@@ -73,10 +73,6 @@ std::unique_ptr<DomainSplit<D>> smokeSplit(const Scene& scene) {
       refuse("smoke.vortex_particles.enabled", "the vortex particles");
     if (smoke.at("viscosity").get<double>() > 0.0) refuse("smoke.viscosity", "viscosity");
     if (smoke.at("advection").at("scalars") == "conservative") refuse("smoke.advection.scalars", "conservative transport");
-    const json& sources = r.at("sources");
-    for (std::size_t i = 0; i < sources.size(); ++i)
-      if (sources[i].at("expansion").get<double>() != 0.0)
-        refuse(fmt::format("sources[{}].expansion", i), "an expanding source");
     const fluid::SmokeParams<3> p = smokeParams<3>(scene);
     // Enough ghost layers for the scheme at the solver's CFL number (and blocks at least that thick).
     const int needed = parallel::smokeGhostLayers(p.advection, std::max(1.0, p.cfl));
