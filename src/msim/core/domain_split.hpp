@@ -30,14 +30,27 @@ class DomainSplit {
   // grid, from their owners. Collective.
   virtual void exchange(Grid<float, D>& cells) = 0;
   virtual void exchange(MacGrid<D>& faces) = 0;
+  // The same for one face component of a MAC grid (a local grid of that layout). Collective.
+  virtual void exchange(Grid<float, D>& faces, int axis) = 0;
   // The owned samples of every rank's local field put together into `global` on rank 0 (left
   // as it is elsewhere). Collective.
   virtual void gather(const Grid<float, D>& local, Grid<float, D>& global) = 0;
   virtual void gather(const MacGrid<D>& local, MacGrid<D>& global) = 0;
   // Whether this rank writes the run's files (rank 0).
   virtual bool root() const = 0;
-  // The largest of `value` over every rank. Collective.
+  // The largest of `value` over every rank, and the sum. Collective.
   virtual double maxOverRanks(double value) = 0;
+  virtual double sumOverRanks(double value) = 0;
+  // The local samples [lo, hi) of a field with the given layout (cell-centred: zero; face
+  // component a: unit vector a) that are this rank's own: its owned cells, and along a face axis
+  // the faces below them, the domain's last face belonging to the last block.
+  void ownedSamples(const IVec<D>& extra, IVec<D>& lo, IVec<D>& hi) const {
+    lo = ownedLo();
+    hi = ownedHi();
+    const BlockPlacement<D> where = placement();
+    for (int a = 0; a < D; ++a)
+      if (extra[a] > 0 && hi[a] + where.cellOrigin[a] == where.globalRes[a]) hi[a] += 1;
+  }
   // Static solids for the pressure solve: the open fraction of every local face. Collective.
   virtual void setOpenFractions(const MacGrid<D>& openFraction) = 0;
   // Moving solids for the pressure solve: their velocity on every local face (the closed parts

@@ -51,6 +51,8 @@ class MacGhostExchange {
  public:
   MacGhostExchange(const GridBlock<D>& block, MPI_Comm comm);
   void exchange(MacGrid<D>& local);
+  // One component alone (a local grid of that face layout).
+  void exchange(Grid<float, D>& component, int axis) { components_[static_cast<std::size_t>(axis)].exchange(component); }
   std::size_t receivedSamples() const;
 
  private:

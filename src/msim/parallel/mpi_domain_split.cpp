@@ -25,6 +25,11 @@ double MpiDomainSplit::maxOverRanks(double value) {
   return value;
 }
 
+double MpiDomainSplit::sumOverRanks(double value) {
+  MPI_Allreduce(MPI_IN_PLACE, &value, 1, MPI_DOUBLE, MPI_SUM, comm_);
+  return value;
+}
+
 SplitSolveStats MpiDomainSplit::project(MacGrid<3>& velocity, Grid<float, 3>& pressure, double dt, double density) {
   return projection_.project(velocity, pressure, dt, density);
 }

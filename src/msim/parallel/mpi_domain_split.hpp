@@ -23,10 +23,12 @@ class MpiDomainSplit final : public DomainSplit<3> {
   IVec<3> ownedHi() const override { return block_.ownedLocal().hi; }
   void exchange(Grid<float, 3>& cells) override { cells_.exchange(cells); }
   void exchange(MacGrid<3>& faces) override { faces_.exchange(faces); }
+  void exchange(Grid<float, 3>& faces, int axis) override { faces_.exchange(faces, axis); }
   void gather(const Grid<float, 3>& local, Grid<float, 3>& global) override;
   void gather(const MacGrid<3>& local, MacGrid<3>& global) override;
   bool root() const override { return block_.rank == 0; }
   double maxOverRanks(double value) override;
+  double sumOverRanks(double value) override;
   void setOpenFractions(const MacGrid<3>& openFraction) override { projection_.setOpenFractions(openFraction); }
   void setSolidVelocity(const MacGrid<3>& solidVelocity) override { projection_.setSolidVelocity(solidVelocity); }
   void setWallNormalVelocity(int axis, int side, double velocity) override {

@@ -168,7 +168,6 @@ void SmokeSolver<D>::checkDistributable() const {
     throw InputError("smoke split among MPI processes: " + what + " is not distributed; run it on one process");
   };
   if (vortex_) refuse("vortex particles");
-  if (params_.viscosity > 0.0) refuse("viscosity");
   if (params_.scalarTransport == ScalarTransport::Conservative) refuse("conservative scalar transport");
   if (advectionOffset_ || scalarsElsewhere_) refuse("procedural turbulence");
 }
@@ -224,7 +223,7 @@ void SmokeSolver<D>::step(double dt) {
     ScopedStage s(timers_, "viscosity");
     const ViscosityBoundaries<D> walls{params_.sides, params_.wallSlip, params_.wallVelocity};
     viscosityIterations_ = viscosity_.apply(velocity_, projection_.faceWeights(), walls, params_.viscosity, dt,
-                                            params_.viscosityMode, params_.viscositySolve);
+                                            params_.viscosityMode, params_.viscositySolve, split_);
   }
   {
     // Eq. 3.2 through the pressure: inflow faces are set first so the projection balances them.

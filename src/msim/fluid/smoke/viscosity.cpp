@@ -51,9 +51,33 @@ struct FaceStencil {
   }
 };
 
-double maxAbs(const std::vector<float>& v, std::size_t n) {
-  return parallelMax(n, [&](std::size_t i) { return std::abs(v[i]); });
-}
+// The sums and norms of the solve over the samples this rank updates (all of them without a
+// split), reduced over the ranks.
+template <int D>
+class OwnedReductions {
+ public:
+  OwnedReductions(const Grid<float, D>& layout, int axis, DomainSplit<D>* split) : layout_(layout), split_(split) {
+    if (split) split->ownedSamples(IVec<D>::Unit(axis), lo_, hi_);
+  }
+  double maxAbs(const float* v) const {
+    const double local = parallelMax(layout_.count(), [&](std::size_t i) { return own(i) ? std::abs(double(v[i])) : 0.0; });
+    return split_ ? split_->maxOverRanks(local) : local;
+  }
+  double dot(const float* a, const float* b) const {
+    const double local = parallelSum(layout_.count(), [&](std::size_t i) { return own(i) ? double(a[i]) * b[i] : 0.0; });
+    return split_ ? split_->sumOverRanks(local) : local;
+  }
+
+ private:
+  bool own(std::size_t i) const {
+    if (!split_) return true;
+    const IVec<D> s = layout_.coord(i);
+    return (s.array() >= lo_.array()).all() && (s.array() < hi_.array()).all();
+  }
+  const Grid<float, D>& layout_;
+  DomainSplit<D>* split_;
+  IVec<D> lo_ = IVec<D>::Zero(), hi_ = IVec<D>::Zero();
+};
 
 }  // namespace
 
@@ -73,19 +97,21 @@ ViscousDiffusion<D>::ViscousDiffusion(const GridSpec<D>& spec) : spec_(spec) {
 template <int D>
 int ViscousDiffusion<D>::apply(MacGrid<D>& velocity, const MacGrid<D>& faceWeights,
                                const ViscosityBoundaries<D>& boundaries, double nu, double dt, ViscosityMode mode,
-                               const ViscositySolveSettings& settings) {
+                               const ViscositySolveSettings& settings, DomainSplit<D>* split) {
   const double c = nu * dt / (spec_.dx * spec_.dx);
+  if (split) split->exchange(velocity);  // the stencils read the neighbours' faces
   int iterations = 0;
   for (int a = 0; a < D; ++a)
     iterations = std::max(iterations, solveComponent(a, velocity.component(a), faceWeights.component(a), boundaries,
-                                                     c, mode, settings));
+                                                     c, mode, settings, split));
+  if (split) split->exchange(velocity);
   return iterations;
 }
 
 template <int D>
 int ViscousDiffusion<D>::solveComponent(int axis, Grid<float, D>& u, const Grid<float, D>& weight,
                                         const ViscosityBoundaries<D>& b, double c, ViscosityMode mode,
-                                        const ViscositySolveSettings& settings) {
+                                        const ViscositySolveSettings& settings, DomainSplit<D>* split) {
   const FaceStencil<D> st{u, b, axis};
   const std::size_t n = u.count();
   float* x = u.data().data();
@@ -101,31 +127,38 @@ int ViscousDiffusion<D>::solveComponent(int axis, Grid<float, D>& u, const Grid<
 
   // Backward Euler: x - c L(x) = u*. Starting from x = u* the residual is c L(u*) (the explicit
   // increment); fixed faces carry no residual and no search direction, so they stay Dirichlet data.
+  // Split: every product reads the direction's ghosts (filled first); the samples a rank does not
+  // own are computed too, from whatever they hold, but no sum reads them.
+  const OwnedReductions<D> owned(u, axis, split);
+  Grid<float, D>& direction = directions_[static_cast<std::size_t>(axis)];
+  if (split && !direction.sameLayout(u)) direction = Grid<float, D>(u.spec(), u.size(), u.offset());
+  float* p = split ? direction.data().data() : p_.data();
   parallelForCells(u, [&](const IVec<D>& f, std::size_t lin) {
     r_[lin] = isFree(lin) ? static_cast<float>(c * st.laplace(x, f, lin, true)) : 0.0f;
     z_[lin] = isFree(lin) ? static_cast<float>(r_[lin] / (1.0 + c * st.diagonal(f))) : 0.0f;
-    p_[lin] = z_[lin];
+    p[lin] = z_[lin];
   });
-  const double scale = std::max(maxAbs(u.data(), n), 1e-30);
-  double rz = parallelSum(n, [&](std::size_t i) { return double(r_[i]) * z_[i]; });
+  const double scale = std::max(owned.maxAbs(x), 1e-30);
+  double rz = owned.dot(r_.data(), z_.data());
   int it = 0;
-  while (it < settings.maxIterations && maxAbs(r_, n) > settings.tolerance * scale) {
+  while (it < settings.maxIterations && owned.maxAbs(r_.data()) > settings.tolerance * scale) {
     ++it;
+    if (split) split->exchange(direction, axis);
     parallelForCells(u, [&](const IVec<D>& f, std::size_t lin) {
-      q_[lin] = isFree(lin) ? static_cast<float>(p_[lin] - c * st.laplace(p_.data(), f, lin, false)) : 0.0f;
+      q_[lin] = isFree(lin) ? static_cast<float>(p[lin] - c * st.laplace(p, f, lin, false)) : 0.0f;
     });
-    const double pq = parallelSum(n, [&](std::size_t i) { return double(p_[i]) * q_[i]; });
+    const double pq = owned.dot(p, q_.data());
     if (pq <= 0.0) break;
     const double alpha = rz / pq;
     parallelForCells(u, [&](const IVec<D>& f, std::size_t lin) {
-      x[lin] += static_cast<float>(alpha * p_[lin]);
+      x[lin] += static_cast<float>(alpha * p[lin]);
       r_[lin] -= static_cast<float>(alpha * q_[lin]);
       z_[lin] = isFree(lin) ? static_cast<float>(r_[lin] / (1.0 + c * st.diagonal(f))) : 0.0f;
     });
-    const double rzNew = parallelSum(n, [&](std::size_t i) { return double(r_[i]) * z_[i]; });
+    const double rzNew = owned.dot(r_.data(), z_.data());
     const double beta = rzNew / rz;
     rz = rzNew;
-    parallelFor(0, n, [&](std::size_t i) { p_[i] = static_cast<float>(z_[i] + beta * p_[i]); });
+    parallelFor(0, n, [&](std::size_t i) { p[i] = static_cast<float>(z_[i] + beta * p[i]); });
   }
   return it;
 }

@@ -11,6 +11,7 @@
 #include <array>
 #include <vector>
 
+#include "msim/core/domain_split.hpp"
 #include "msim/core/mac_grid.hpp"
 #include "msim/numerics/pressure/projection.hpp"
 
@@ -51,15 +52,21 @@ class ViscousDiffusion {
   // Diffuses `velocity` by kinematic viscosity nu [m^2/s] over dt. `faceWeights` marks fixed faces
   // (weight 0), as PressureProjection::faceWeights() does. Returns the largest number of PCG
   // iterations over the components (0 for explicit).
+  // Split among processes (`split`, Selle ch. 8.1's CG with exchanged rows and reduced dot
+  // products): the velocity is a block with ghost layers; each rank updates its own faces, fills
+  // the search direction's ghosts before every product and reduces the sums and norms, so the
+  // iteration is the serial one up to the order of the sums. The ghosts are filled on return.
   int apply(MacGrid<D>& velocity, const MacGrid<D>& faceWeights, const ViscosityBoundaries<D>& boundaries,
-            double nu, double dt, ViscosityMode mode, const ViscositySolveSettings& settings = {});
+            double nu, double dt, ViscosityMode mode, const ViscositySolveSettings& settings = {},
+            DomainSplit<D>* split = nullptr);
 
  private:
   int solveComponent(int axis, Grid<float, D>& u, const Grid<float, D>& weight, const ViscosityBoundaries<D>& b,
-                     double c, ViscosityMode mode, const ViscositySolveSettings& settings);
+                     double c, ViscosityMode mode, const ViscositySolveSettings& settings, DomainSplit<D>* split);
 
   GridSpec<D> spec_;
   std::vector<float> old_, r_, z_, p_, q_;  // sized to the largest face component
+  std::array<Grid<float, D>, D> directions_;  // split runs: p per component, with ghosts
 };
 
 }  // namespace msim::fluid

@@ -71,7 +71,6 @@ std::unique_ptr<DomainSplit<D>> smokeSplit(const Scene& scene) {
     if (smoke.at("turbulence").at("enabled").get<bool>()) refuse("smoke.turbulence.enabled", "sub-grid turbulence");
     if (smoke.at("vortex_particles").at("enabled").get<bool>())
       refuse("smoke.vortex_particles.enabled", "the vortex particles");
-    if (smoke.at("viscosity").get<double>() > 0.0) refuse("smoke.viscosity", "viscosity");
     if (smoke.at("advection").at("scalars") == "conservative") refuse("smoke.advection.scalars", "conservative transport");
     const fluid::SmokeParams<3> p = smokeParams<3>(scene);
     // Enough ghost layers for the scheme at the solver's CFL number (and blocks at least that thick).
