@@ -1,6 +1,6 @@
 // A 3D smoke plume (sources with inflow, buoyancy, vorticity confinement, MacCormack, open top),
 // alone, split by a ball at rest, swept by a moving ball, in a wind tunnel, from an expanding
-// source and viscous, run for 50 steps split among the ranks gives the density of the same run on one rank within
+// source, viscous and with the scalars moved in flux form, run for 50 steps split among the ranks gives the density of the same run on one rank within
 // 1e-4 relative (the check), and stays close to the serial solver with its own MG-PCG.
 #include <gtest/gtest.h>
 
@@ -59,8 +59,8 @@ fluid::SmokeSource<3> plumeSource(const GridSpec<3>& spec, double expansion = 0.
 // The plume alone, split by a ball at rest, or by a ball that swings across it once in the 50
 // steps (a moving obstacle: its faces push the smoke through the pressure solve); the plume and
 // the ball in a wind tunnel; the plume from a source whose gas expands (a target divergence); the
-// plume around the ball with viscosity.
-enum class Variant { Plume, Ball, MovingBall, Tunnel, Expanding, Viscous };
+// plume around the ball with viscosity, and with the conservative (flux-form MUSCL) scalar transport.
+enum class Variant { Plume, Ball, MovingBall, Tunnel, Expanding, Viscous, Conservative };
 const Vec<3> kSwing(0.1, 0.0, 0.04);                   // amplitude [m]
 const double kOmega = 2.0 * 3.14159265358979 / 0.4;   // [1/s]
 
@@ -75,6 +75,7 @@ Vec<3> ballVelocity(double t) { return kOmega * std::cos(kOmega * t) * kSwing; }
 // normal) and out through an open x_max side, around the ball at rest.
 fluid::SmokeParams<3> variantParams(Variant variant) {
   fluid::SmokeParams<3> p = plumeParams();
+  if (variant == Variant::Conservative) p.scalarTransport = fluid::ScalarTransport::Conservative;
   if (variant == Variant::Viscous) p.viscosity = 0.05;  // implicit (nu dt / dx^2 = 0.64): a CG over the blocks
   if (variant == Variant::Tunnel) {
     p.wallVelocity[0][0] = Vec<3>(0.5, 0.0, 0.0);
@@ -93,8 +94,7 @@ Grid<float, 3> runPlume(const GridSpec<3>& spec, DomainSplit<3>* split, Variant 
       solver.setObstacleVelocity(velocity);
     }
   };
-  if (variant == Variant::Ball || variant == Variant::MovingBall || variant == Variant::Tunnel || variant == Variant::Viscous)
-    place(0.0);
+  if (variant != Variant::Plume && variant != Variant::Expanding) place(0.0);
   solver.addSource(plumeSource(spec, variant == Variant::Expanding ? 4.0 : 0.0));
   solver.setDomainSplit(split);
   for (int s = 0; s < kSteps; ++s) {
@@ -108,7 +108,8 @@ Grid<float, 3> runPlume(const GridSpec<3>& spec, DomainSplit<3>* split, Variant 
 Grid<float, 3> runSplit(MPI_Comm comm, Variant variant) {
   const fluid::SmokeParams<3> params = variantParams(variant);
   const GridBlock<3> block(kGlobal, BlockDecomposition<3>(kGlobal.res, sizeOf(comm), 4, "test"), rankOf(comm),
-                           smokeGhostLayers(params.advection, 1.0));
+                           smokeGhostLayers(params.advection, 1.0,
+                                            params.scalarTransport == fluid::ScalarTransport::Conservative));
   MpiDomainSplit split(block, params.sides, params.projection.pcg, comm);
   return gatherToRoot(runPlume(block.localSpec(), &split, variant), block, comm);
 }
@@ -148,7 +149,8 @@ TEST_P(DistributedSmoke, FiftyStepsMatchOneRankWithin1e4Relative) {
                        : variant == Variant::MovingBall ? " swept by a moving ball"
                        : variant == Variant::Tunnel     ? " in a wind tunnel around a ball"
                        : variant == Variant::Expanding  ? " from an expanding source"
-                                                        : " around a ball, viscous";
+                       : variant == Variant::Viscous    ? " around a ball, viscous"
+                                                        : " around a ball, scalars in flux form";
     std::printf("smoke plume%s, %d steps on %d ranks: max density %.3f; relative difference to 1 rank %.1e, to the "
                 "serial MG-PCG solver %.1e\n", name, kSteps, worldSize(), scale, toOne, toSerial);
     EXPECT_GT(scale, 0.5);
@@ -161,7 +163,7 @@ TEST_P(DistributedSmoke, FiftyStepsMatchOneRankWithin1e4Relative) {
 
 INSTANTIATE_TEST_SUITE_P(Variants, DistributedSmoke,
                          ::testing::Values(Variant::Plume, Variant::Ball, Variant::MovingBall, Variant::Tunnel,
-                                           Variant::Expanding, Variant::Viscous));
+                                           Variant::Expanding, Variant::Viscous, Variant::Conservative));
 
 }  // namespace
 }  // namespace msim::parallel

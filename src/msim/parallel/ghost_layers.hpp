@@ -24,9 +24,15 @@ inline int advectionGhostLayers(const numerics::AdvectionSettings& s, double cfl
 // onto faces. An owned face reads samples up to three cells away.
 constexpr int kConfinementGhostLayers = 3;
 
-// The ghost layers a smoke step reads: its advection scheme's or confinement's, whichever is wider.
-inline int smokeGhostLayers(const numerics::AdvectionSettings& s, double cfl) {
-  return std::max(advectionGhostLayers(s, cfl), kConfinementGhostLayers);
+// The conservative scalar transport (numerics/flux_transport.hpp): a face's MUSCL value reads the
+// two cells on either side of it, so each SSP-RK2 stage moves a cell by what lies up to two cells
+// away, and the two stages of a substep four; the fields' ghosts are refreshed before every substep.
+constexpr int kFluxTransportGhostLayers = 4;
+
+// The ghost layers a smoke step reads: its advection scheme's, confinement's or (with the
+// conservative scalar transport) the flux transport's, whichever is widest.
+inline int smokeGhostLayers(const numerics::AdvectionSettings& s, double cfl, bool conservativeScalars = false) {
+  return std::max({advectionGhostLayers(s, cfl), kConfinementGhostLayers, conservativeScalars ? kFluxTransportGhostLayers : 0});
 }
 
 }  // namespace msim::parallel

@@ -168,7 +168,6 @@ void SmokeSolver<D>::checkDistributable() const {
     throw InputError("smoke split among MPI processes: " + what + " is not distributed; run it on one process");
   };
   if (vortex_) refuse("vortex particles");
-  if (params_.scalarTransport == ScalarTransport::Conservative) refuse("conservative scalar transport");
   if (advectionOffset_ || scalarsElsewhere_) refuse("procedural turbulence");
 }
 
@@ -321,12 +320,18 @@ void SmokeSolver<D>::transportScalarsConservatively(double dt) {
   c.transport.setVelocity(c.faceVelocity);
   // FluxTransport is positivity preserving for sum_a |u_a| dt / dx <= 1/2 (MUSCL + SSP-RK2), up
   // to 2 D times stricter than the step's CFL limit: sub-cycle in equal steps.
-  const double limit = c.transport.maxStableDt(0.0);
+  // Split runs: every rank takes the same substeps, and each substep starts from filled ghosts
+  // (two stages of MUSCL read four cells: parallel/ghost_layers.hpp).
+  const double local = c.transport.maxStableDt(0.0);
+  const double limit = split_ ? -split_->maxOverRanks(-local) : local;
   const int n = std::max(1, static_cast<int>(std::ceil(dt / limit)));
   const double h = dt / n;
   const numerics::TransportSettings zeroBackground{numerics::TransportForm::Conservative, 0.0, 0.0};
   auto transport = [&](Grid<float, D>& field) {
-    for (int k = 0; k < n; ++k) c.transport.step(field, zeroBackground, h);
+    for (int k = 0; k < n; ++k) {
+      if (split_) split_->exchange(field);
+      c.transport.step(field, zeroBackground, h);
+    }
   };
   // Every field is moved as its excess over a background that is 0 at open-side inflow: density
   // and the extra scalars (which dissipate towards 0) as they are, temperature as T - T_ambient.

@@ -71,16 +71,17 @@ std::unique_ptr<DomainSplit<D>> smokeSplit(const Scene& scene) {
     if (smoke.at("turbulence").at("enabled").get<bool>()) refuse("smoke.turbulence.enabled", "sub-grid turbulence");
     if (smoke.at("vortex_particles").at("enabled").get<bool>())
       refuse("smoke.vortex_particles.enabled", "the vortex particles");
-    if (smoke.at("advection").at("scalars") == "conservative") refuse("smoke.advection.scalars", "conservative transport");
     const fluid::SmokeParams<3> p = smokeParams<3>(scene);
     // Enough ghost layers for the scheme at the solver's CFL number (and blocks at least that thick).
-    const int needed = parallel::smokeGhostLayers(p.advection, std::max(1.0, p.cfl));
+    const bool conservative = p.scalarTransport == fluid::ScalarTransport::Conservative;
+    const int needed = parallel::smokeGhostLayers(p.advection, std::max(1.0, p.cfl), conservative);
     const json& mpi = r.at("mpi");
     const int asked = mpi.at("ghost_layers").get<int>();
     if (asked > 0 && asked < needed)
       throw InputError(fmt::format("{}: 'mpi.ghost_layers' is {} but this smoke reads {} layers of its neighbours "
-                                   "(its advection at CFL {:g} and vorticity confinement); use {} or more, or 0",
-                                   file, asked, needed, p.cfl, needed));
+                                   "(its advection at CFL {:g}, vorticity confinement{}); use {} or more, or 0",
+                                   file, asked, needed, p.cfl, conservative ? " and the conservative scalar transport" : "",
+                                   needed));
     const int ghost = asked > 0 ? asked : needed;
     const GridSpec<3> global = scene.gridSpec<3>();
     const Vec<3> blocks = sceneVector<3>(mpi.at("blocks"));
