@@ -34,6 +34,15 @@ CrowdSettings settings(const Vec2& hi, int resolutionX) {
   return s;
 }
 
+// The exit at the east end of a 30 x 10 m hall.
+Goal eastExit() {
+  Goal east;
+  east.kind = Goal::Kind::Region;
+  east.regions = {rectangle(Vec2(28, 0), Vec2(30, 10))};
+  east.exit = true;
+  return east;
+}
+
 // Agents uniformly at random in [lo, hi] (relaxed apart by the simulation's constructor).
 Agents randomAgents(std::size_t n, const Vec2& lo, const Vec2& hi, std::uint32_t goal, AgentModel model,
                     std::uint64_t seed) {
@@ -103,10 +112,7 @@ TEST(CrowdSimulation, DensityStaysCappedAtTheFreeAreaLimitEveryStep) {
 
 TEST(CrowdSimulation, InflowsSpawnAtTheirRateAndExitsRemoveAgents) {
   const Vec2 hi(30, 10);
-  Goal east;
-  east.kind = Goal::Kind::Region;
-  east.regions = {rectangle(Vec2(28, 0), Vec2(30, 10))};
-  east.exit = true;
+  const Goal east = eastExit();
   Inflow in;
   in.region = rectangle(Vec2(0.5, 0.5), Vec2(2, 9.5));
   in.rate = 7.0;
@@ -138,10 +144,7 @@ TEST(CrowdSimulation, RecyclingInflowsHoldTheCrowdsCount) {
   // exit, shared between them: the count stays at the start's after every step while agents
   // leave, and every leaver comes back.
   const Vec2 hi(30, 10);
-  Goal east;
-  east.kind = Goal::Kind::Region;
-  east.regions = {rectangle(Vec2(28, 0), Vec2(30, 10))};
-  east.exit = true;
+  const Goal east = eastExit();
   std::vector<Inflow> inflows(2);
   for (std::size_t k = 0; k < 2; ++k) {
     inflows[k].region = rectangle(Vec2(0.5, 0.5 + 5.0 * k), Vec2(2, 4.5 + 5.0 * k));
