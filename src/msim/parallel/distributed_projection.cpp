@@ -72,31 +72,31 @@ void DistributedProjection::setWallNormalVelocity(int axis, int side, double vel
   applyWallVelocities();
 }
 
+int DistributedProjection::wallSide(int axis, const IVec<3>& face) const {
+  const IVec<3> g = face + origin_;
+  for (int side = 0; side < 2; ++side)
+    if (g[axis] == (side == 0 ? 0 : block_.global.res[axis]) && sides_.side[axis][side] == numerics::DomainSide::Wall)
+      return side;
+  return -1;
+}
+
 void DistributedProjection::applyWallVelocities() {
-  const IVec<3> res = block_.global.res;
   for (int a = 0; a < 3; ++a) {
     Grid<float, 3>& us = solidVelocity_.component(a);
     for (std::size_t i = 0; i < us.count(); ++i) {
-      const IVec<3> g = us.coord(i) + origin_;
-      for (int side = 0; side < 2; ++side)
-        if (g[a] == (side == 0 ? 0 : res[a]) && sides_.side[a][side] == numerics::DomainSide::Wall)
-          us[i] = wallNormalVelocity_[static_cast<std::size_t>(a)][static_cast<std::size_t>(side)];
+      const int side = wallSide(a, us.coord(i));
+      if (side >= 0) us[i] = wallNormalVelocity_[static_cast<std::size_t>(a)][static_cast<std::size_t>(side)];
     }
   }
 }
 
 void DistributedProjection::setOpenFractions(const MacGrid<3>& openFraction) {
   weights_ = MacGrid<3>(block_.localSpec());
-  const IVec<3> origin = block_.cellOrigin(), res = block_.global.res;
   for (int a = 0; a < 3; ++a) {
     Grid<float, 3>& w = weights_.component(a);
     const Grid<float, 3>& open = openFraction.component(a);
-    for (std::size_t i = 0; i < w.count(); ++i) {
-      const IVec<3> g = w.coord(i) + origin;
-      const bool wall = (g[a] == 0 && sides_.side[a][0] == numerics::DomainSide::Wall) ||
-                        (g[a] == res[a] && sides_.side[a][1] == numerics::DomainSide::Wall);
-      w[i] = !wall && open[i] >= minOpenFraction_ ? std::min(open[i], 1.0f) : 0.0f;
-    }
+    for (std::size_t i = 0; i < w.count(); ++i)
+      w[i] = wallSide(a, w.coord(i)) < 0 && open[i] >= minOpenFraction_ ? std::min(open[i], 1.0f) : 0.0f;
   }
   weightGhosts_.exchange(weights_);
   if (inverseTheta_.spec() != weights_.spec()) inverseTheta_ = MacGrid<3>(block_.localSpec(), 1.0f);

@@ -94,6 +94,8 @@ class DistributedProjection {
   std::array<std::array<float, 2>, 3> wallNormalVelocity_{};
   const Grid<float, 3>* cellTargetDivergence_ = nullptr;
   void applyWallVelocities();  // the walls' normal velocities into solidVelocity_
+  // The side (0 lower, 1 upper) of the domain wall that local face `face` of `axis` lies on, or -1.
+  int wallSide(int axis, const IVec<3>& face) const;
   std::optional<Grid<float, 3>> liquidPhi_;  // with ghosts; empty without a free surface
   MacGrid<3> inverseTheta_;                  // 1 / theta on liquid-air faces, 1 elsewhere
   MacGhostExchange<3> velocityGhosts_, weightGhosts_;

@@ -53,14 +53,14 @@ double CrowdWindows::area(std::size_t c) const {
 
 namespace {
 
-void requireSameGrid(const CrowdWindows& windows, const Grid<float, 2>& out) {
-  if (!(out.spec() == windows.spec())) throw std::invalid_argument("crowd pressure: the output grid differs from the sampled one");
+void requireSameGrid(const GridSpec<2>& sampled, const Grid<float, 2>& out) {
+  if (!(out.spec() == sampled)) throw std::invalid_argument("crowd pressure: the output grid differs from the sampled one");
 }
 
 }  // namespace
 
 void spatialPressure(const CrowdWindows& windows, Grid<float, 2>& pressure) {
-  requireSameGrid(windows, pressure);
+  requireSameGrid(windows.spec(), pressure);
   pressure.fill(0.0f);
   for (const std::uint32_t c : windows.cells()) {
     const CrowdWindows::Sums& w = windows.sums(c);
@@ -81,7 +81,7 @@ double meanLocalSpeed(const CrowdWindows& windows) {
 }
 
 StrainRateSummary strainRate(const CrowdWindows& windows, Grid<float, 2>& strain) {
-  requireSameGrid(windows, strain);
+  requireSameGrid(windows.spec(), strain);
   const GridSpec<2>& spec = windows.spec();
   const int nx = spec.res.x(), ny = spec.res.y();
   // The window-mean velocity of a cell whose window holds someone, or nothing.
@@ -166,7 +166,7 @@ double TemporalPressure::meanWhereOccupied(const Grid<float, 2>& p) const {
 }
 
 void TemporalPressure::pressure(Grid<float, 2>& out) const {
-  if (!(out.spec() == spec_)) throw std::invalid_argument("crowd pressure: the output grid differs from the sampled one");
+  requireSameGrid(spec_, out);
   for (std::size_t c = 0; c < cells_.size(); ++c) {
     const Cell& cell = cells_[c];
     if (cell.samples < 2 || !(total_ > 0.0)) {

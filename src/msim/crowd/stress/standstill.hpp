@@ -5,7 +5,6 @@
 // direction hold agents whose mean speed exceeds 0.2 m/s). A crowd that has stopped as a whole is
 // jammed, not in a stop-and-go wave: its standstills are not counted.
 #include <cstdint>
-#include <span>
 #include <vector>
 
 #include "msim/core/grid_spec.hpp"

@@ -4,6 +4,15 @@
 
 namespace msim::crowd::stress {
 
+PressureSummary summarizePressure(const Grid<float, 2>& pressure, double threshold) {
+  PressureSummary s;
+  for (std::size_t c = 0; c < pressure.count(); ++c) {
+    s.max = std::max(s.max, double(pressure[c]));
+    s.cellsOver += pressure[c] > threshold;
+  }
+  return s;
+}
+
 TurbulenceMetrics::TurbulenceMetrics(const GridSpec<2>& grid)
     : windows_(grid, kWindowCells), sampler_(grid, kWindowSeconds), standstills_(grid), spatial_(grid), temporal_(grid), strain_(grid), peak_(grid) {}
 
@@ -18,13 +27,13 @@ TurbulenceFrame TurbulenceMetrics::measure(const Agents& agents) {
   windows_.gather(agents.position, agents.velocity);
   stress::spatialPressure(windows_, spatial_);
   sampler_.pressure(temporal_);
-  for (std::size_t c = 0; c < spatial_.count(); ++c) {
-    f.pressureMax = std::max(f.pressureMax, double(spatial_[c]));
-    f.pressureCellsOver += spatial_[c] > kTurbulentPressure;
-    f.temporalPressureMax = std::max(f.temporalPressureMax, double(temporal_[c]));
-    f.temporalCellsOver += temporal_[c] > kTurbulentPressure;
-    peak_[c] = std::max(peak_[c], temporal_[c]);
-  }
+  const PressureSummary spatial = summarizePressure(spatial_, kTurbulentPressure);
+  const PressureSummary temporal = summarizePressure(temporal_, kTurbulentPressure);
+  f.pressureMax = spatial.max;
+  f.pressureCellsOver = spatial.cellsOver;
+  f.temporalPressureMax = temporal.max;
+  f.temporalCellsOver = temporal.cellsOver;
+  for (std::size_t c = 0; c < temporal_.count(); ++c) peak_[c] = std::max(peak_[c], temporal_[c]);
   f.temporalPressureMean = sampler_.meanWhereOccupied(temporal_);
   f.strainRate = stress::strainRate(windows_, strain_);
   f.localSpeed = stress::meanLocalSpeed(windows_);

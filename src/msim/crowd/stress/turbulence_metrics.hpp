@@ -11,6 +11,13 @@
 
 namespace msim::crowd::stress {
 
+// A pressure field's largest value and the cells above the turbulent threshold.
+struct PressureSummary {
+  double max = 0.0;  // [1/s^2]
+  long cellsOver = 0;
+};
+PressureSummary summarizePressure(const Grid<float, 2>& pressure, double threshold);
+
 struct TurbulenceFrame {
   double pressureMax = 0.0;           // spatial variance [1/s^2]
   long pressureCellsOver = 0;         // cells above the turbulent 0.02 /s^2

@@ -490,14 +490,10 @@ class CrowdPhenomenon final : public Phenomenon {
     plan.valueMax = 2.0 * TurbulenceMetrics::kTurbulentPressure;
     const render::CellField field{peak.spec(), std::span<const float>(peak.data())};
     io::writePng(file, render::renderFloorPlan(plan, render::Discs{}, staticOutlines(), &field));
-    double largest = 0.0;
-    long over = 0;
-    for (std::size_t c = 0; c < peak.count(); ++c) {
-      largest = std::max(largest, double(peak[c]));
-      over += peak[c] > TurbulenceMetrics::kTurbulentPressure;
-    }
-    return {{"pressure_temporal_peak_per_s2", largest},
-            {"cells_ever_turbulent", over},
+    const crowd::stress::PressureSummary summary =
+        crowd::stress::summarizePressure(peak, TurbulenceMetrics::kTurbulentPressure);
+    return {{"pressure_temporal_peak_per_s2", summary.max},
+            {"cells_ever_turbulent", summary.cellsOver},
             {"window_s", TurbulenceMetrics::kWindowSeconds}};
   }
 
