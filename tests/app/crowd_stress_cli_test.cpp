@@ -16,6 +16,7 @@ namespace {
 using nlohmann::json;
 
 const std::string kScene = std::string(MSIM_SOURCE_DIR) + "/scenes/crowd_stress_merge.json";
+const std::string kLoveParade = std::string(MSIM_SOURCE_DIR) + "/scenes/crowd_love_parade.json";
 
 }  // namespace
 
@@ -44,6 +45,34 @@ TEST(CrowdStressCli, MergePacksPastTheCriticalDensityAndEverySolveConverges) {
   EXPECT_GE(turbulence.at("pressure_temporal_peak_per_s2").get<double>(),
             run.at("frames").back().at("pressure_temporal_max_per_s2").get<double>() - 1e-6);
   EXPECT_TRUE(fs::exists(dir / "out" / "pressure_map.png"));
+}
+
+// The Love-Parade-like counter-flow: visitors from both tunnel inlets meet the people coming down
+// the ramp at its foot, where the crowd packs past the critical density; the run's samples by
+// density account for every crowd cell of every frame, and its peak pressure lies where people walk.
+TEST(CrowdStressCli, LoveParadeStreamsMeetAtTheRampFoot) {
+  const fs::path dir = scratch("love_parade");
+  const Result r = runMsim("run " + kLoveParade + " -q --out " + (dir / "out").string() +
+                           " --set time.duration=35 --set outputs.png=false --set outputs.mp4=false --set outputs.vdb=false");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  const json run = readJson(dir / "out" / "run.json");
+  const json& results = run.at("results");
+  EXPECT_EQ(results.at("stress").at("unconverged_solves").get<long>(), 0);
+  // Net crossings upwards: people come down past the ramp's top, none yet past its foot.
+  EXPECT_LT(results.at("measurement_lines").at("ramp_top").at("net_crossings").get<double>(), -100.0);
+  double densest = 0.0;
+  for (const json& f : run.at("frames")) densest = std::max(densest, f.at("max_density_per_m2").get<double>());
+  EXPECT_GT(densest, 3.5);
+  const json& turbulence = results.at("turbulence");
+  long samples = 0;
+  for (const json& b : turbulence.at("by_density")) {
+    samples += b.at("samples").get<long>();
+    EXPECT_GE(b.at("turbulent_fraction").get<double>(), 0.0);
+    EXPECT_LE(b.at("turbulent_fraction").get<double>(), 1.0);
+  }
+  EXPECT_GT(samples, 0);
+  const double x = turbulence.at("peak_at_m")[0].get<double>(), y = turbulence.at("peak_at_m")[1].get<double>();
+  EXPECT_TRUE(y < 14.0 || (x > 31.0 && x < 49.0)) << x << ", " << y;  // the tunnel or the ramp
 }
 
 TEST(CrowdStressCli, BadSettingsNameTheirKey) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "msim/crowd/stress/crowd_pressure.hpp"
+#include "msim/crowd/stress/turbulence_metrics.hpp"
 
 using namespace msim;
 using namespace msim::crowd;
@@ -186,4 +187,36 @@ TEST(CrowdPressure, TemporalPressureOfASteadyCrowdIsZero) {
   Grid<float, 2> p(spec);
   temporal.pressure(p);
   for (std::size_t c = 0; c < p.count(); ++c) EXPECT_NEAR(p[c], 0.0f, 1e-9f);
+}
+
+// The samples by density (checks T10, T15: at which densities P > 0.02): on 1 m cells, a block at
+// 4 /m^2 (four agents a cell) pushed to and fro (its velocity flips every step) beside a block at
+// 1 /m^2 walking steadily. Every window inside the steady block is calm, every one inside the
+// pushed block turbulent; windows across the border hold both and fall in between.
+TEST(CrowdPressure, SamplesByDensityTellTheTurbulentDensitiesApart) {
+  const GridSpec<2> grid(Vec2(0.0, 0.0), 1.0, IVec<2>(12, 6));
+  Agents a;
+  for (int j = 0; j < 6; ++j)
+    for (int i = 0; i < 12; ++i)
+      for (int k = 0; k < (i < 6 ? 4 : 1); ++k) {
+        AgentSpec s;
+        s.position = Vec2f(i + 0.2f + 0.2f * k, j + 0.5f);
+        a.add(s);
+      }
+  TurbulenceMetrics metrics(grid);
+  for (int step = 0; step < 100; ++step) {
+    for (std::size_t n = 0; n < a.size(); ++n)
+      a.velocity[n] = a.position[n].x() < 6.0f ? Vec2f(step % 2 ? 0.5f : -0.5f, 0.0f) : Vec2f(1.0f, 0.0f);
+    metrics.sample(a, 0.05);
+    if (step % 10 == 9) metrics.measure(a);
+  }
+  const PressureByDensity& bins = metrics.pressureByDensity();
+  long samples = 0;
+  for (long n : bins.samples) samples += n;
+  EXPECT_EQ(samples, 10 * grid.cellCount());  // every cell's window holds someone in each of 10 frames
+  const auto bin = [](double density) { return static_cast<std::size_t>(density / PressureByDensity::kBinWidth); };
+  EXPECT_EQ(bins.samples[bin(1.0)], 10 * 5 * 6);  // the steady block's windows off the border: 5 columns
+  EXPECT_EQ(bins.turbulent[bin(1.0)], 0);
+  EXPECT_EQ(bins.samples[bin(4.0)], 10 * 5 * 6);
+  EXPECT_EQ(bins.turbulent[bin(4.0)], bins.samples[bin(4.0)]);  // rho Var(v) = 4 x 0.25 = 1 /s^2
 }

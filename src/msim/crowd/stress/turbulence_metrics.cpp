@@ -13,6 +13,12 @@ PressureSummary summarizePressure(const Grid<float, 2>& pressure, double thresho
   return s;
 }
 
+void PressureByDensity::add(double density, bool isTurbulent) {
+  const int bin = std::clamp(static_cast<int>(density / kBinWidth), 0, kBins - 1);
+  ++samples[static_cast<std::size_t>(bin)];
+  turbulent[static_cast<std::size_t>(bin)] += isTurbulent;
+}
+
 TurbulenceMetrics::TurbulenceMetrics(const GridSpec<2>& grid)
     : windows_(grid, kWindowCells), sampler_(grid, kWindowSeconds), standstills_(grid), spatial_(grid), temporal_(grid), strain_(grid), peak_(grid) {}
 
@@ -34,6 +40,8 @@ TurbulenceFrame TurbulenceMetrics::measure(const Agents& agents) {
   f.temporalPressureMax = temporal.max;
   f.temporalCellsOver = temporal.cellsOver;
   for (std::size_t c = 0; c < temporal_.count(); ++c) peak_[c] = std::max(peak_[c], temporal_[c]);
+  for (const std::uint32_t c : windows_.cells())
+    byDensity_.add(windows_.sums(c).count / windows_.area(c), temporal_[c] > kTurbulentPressure);
   f.temporalPressureMean = sampler_.meanWhereOccupied(temporal_);
   f.strainRate = stress::strainRate(windows_, strain_);
   f.localSpeed = stress::meanLocalSpeed(windows_);

@@ -5,6 +5,8 @@
 // magnitude of Fig. 4.11, on the crowd's grid, and the standstill episodes of stop-and-go waves
 // (standstill.hpp). The crowd is sampled every step (the temporal variance and the standstills
 // need every step's velocities) and measured once per frame.
+#include <array>
+
 #include "msim/core/grid.hpp"
 #include "msim/crowd/stress/crowd_pressure.hpp"
 #include "msim/crowd/stress/standstill.hpp"
@@ -17,6 +19,17 @@ struct PressureSummary {
   long cellsOver = 0;
 };
 PressureSummary summarizePressure(const Grid<float, 2>& pressure, double threshold);
+
+// At which densities the crowd turns turbulent: the (cell, frame) samples of the crowd's cells,
+// binned by the window's density now, and how many of them had a temporal pressure above the
+// turbulent 0.02 /s^2 (the seed's checks T10 and T15: P > 0.02 only from 7 /m^2 in the Hajj, from
+// 5.5 /m^2 at the Love Parade).
+struct PressureByDensity {
+  static constexpr double kBinWidth = 0.5;  // [1/m^2]
+  static constexpr int kBins = 24;          // the last bin holds everything from 11.5 /m^2 on
+  std::array<long, kBins> samples{}, turbulent{};
+  void add(double density, bool isTurbulent);
+};
 
 struct TurbulenceFrame {
   double pressureMax = 0.0;           // spatial variance [1/s^2]
@@ -47,12 +60,15 @@ class TurbulenceMetrics {
   // Each cell's largest temporal pressure over the measured frames: where the crowd turned
   // turbulent during the run.
   const Grid<float, 2>& peakTemporalPressure() const { return peak_; }
+  // The measured frames' samples by density.
+  const PressureByDensity& pressureByDensity() const { return byDensity_; }
 
  private:
   CrowdWindows windows_;
   TemporalPressure sampler_;
   StandstillDetector standstills_;
   Grid<float, 2> spatial_, temporal_, strain_, peak_;
+  PressureByDensity byDensity_;
 };
 
 }  // namespace msim::crowd::stress

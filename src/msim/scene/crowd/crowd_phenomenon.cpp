@@ -492,9 +492,24 @@ class CrowdPhenomenon final : public Phenomenon {
     io::writePng(file, render::renderFloorPlan(plan, render::Discs{}, staticOutlines(), &field));
     const crowd::stress::PressureSummary summary =
         crowd::stress::summarizePressure(peak, TurbulenceMetrics::kTurbulentPressure);
+    // Where the largest temporal pressure of the run occurred (the seed's Love Parade: where the
+    // inflow meets the counter-flow), and the frames' samples of the crowd's cells by density.
+    const std::size_t peakCell = static_cast<std::size_t>(std::max_element(peak.data().begin(), peak.data().end()) - peak.data().begin());
+    const Vec2 peakAt = peak.position(peak.coord(peakCell));
+    json byDensity = json::array();
+    const crowd::stress::PressureByDensity& bins = turbulence_.pressureByDensity();
+    for (int b = 0; b < crowd::stress::PressureByDensity::kBins; ++b) {
+      const auto k = static_cast<std::size_t>(b);
+      if (bins.samples[k] == 0) continue;
+      byDensity.push_back({{"density_from_per_m2", b * bins.kBinWidth},
+                           {"samples", bins.samples[k]},
+                           {"turbulent_fraction", double(bins.turbulent[k]) / double(bins.samples[k])}});
+    }
     return {{"pressure_temporal_peak_per_s2", summary.max},
+            {"peak_at_m", {peakAt.x(), peakAt.y()}},
             {"cells_ever_turbulent", summary.cellsOver},
-            {"window_s", TurbulenceMetrics::kWindowSeconds}};
+            {"window_s", TurbulenceMetrics::kWindowSeconds},
+            {"by_density", byDensity}};
   }
 
   void writeFundamentalDiagram(const fs::path& file) const {
