@@ -11,9 +11,10 @@ double DeviationMoment::sigma(MetricMode mode) const {
   if (!(weight_ > 0.0)) return 0.0;
   const Eigen::Matrix2d c = sum_ / weight_;
   if (mode == MetricMode::Trace) return c.trace();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(c, Eigen::EigenvaluesOnly);
-  // C is positive semi-definite; rounding may leave an eigenvalue a hair below 0.
-  return std::sqrt(std::max(0.0, eigen.eigenvalues()[0])) + std::sqrt(std::max(0.0, eigen.eigenvalues()[1]));
+  // sqrt(l1) + sqrt(l2) of the symmetric positive semi-definite C without its eigenvalues:
+  // (sqrt(l1) + sqrt(l2))^2 = l1 + l2 + 2 sqrt(l1 l2) = tr C + 2 sqrt(det C). Rounding may leave
+  // det C a hair below 0.
+  return std::sqrt(std::max(0.0, c.trace() + 2.0 * std::sqrt(std::max(0.0, c.determinant()))));
 }
 
 Eigen::Matrix2d DeviationMoment::directions() const {
