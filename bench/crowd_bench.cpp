@@ -129,18 +129,19 @@ void BM_LookaheadCircle100k(benchmark::State& state) {
 }
 
 // Golas ch. 4's stress model on scenes/crowd_stress_merge.json once its crowd has packed (after
-// 40 s, about 1300 agents): the midpoint step's two friction solves are the `crowd: stress` counter.
-void BM_StressMerge(benchmark::State& state) { stepScene(state, scenePath("crowd_stress_merge"), {}, 800); }
+// 40 s of 0.01 s steps, about 1250 agents): the midpoint step's two friction solves are the
+// `crowd: stress` counter.
+void BM_StressMerge(benchmark::State& state) { stepScene(state, scenePath("crowd_stress_merge"), {}, 4000); }
 // The issue's size: the merge held at 6800 agents (5.8 /m^2) by recycling inflows, as the Hajj
-// sweep of docs/crowd_turbulence.md, after 10 s; range: the cells per metre (2: the scene's 0.5 m
-// cells, 1: 1 m cells).
+// sweep of docs/crowd_turbulence.md, after 10 s; range: the cells per metre (1: the scene's 1 m
+// cells, 2: 0.5 m cells).
 void BM_StressMerge6800(benchmark::State& state) {
   stepScene(state, scenePath("crowd_stress_merge"),
             {R"(groups=[{"count": 6800, "region": {"type": "box", "min": [0, 0], "max": [50, 30]}, "goal": "out"}])",
              R"(inflows=[{"region": {"type": "box", "min": [0.5, 18.5], "max": [3, 27.5]}, "rate": 0, "recycle": true, "goal": "out"},
                          {"region": {"type": "box", "min": [0.5, 2.5], "max": [3, 11.5]}, "rate": 0, "recycle": true, "goal": "out"}])",
              fmt::format("domain.resolution={}", 50 * state.range(0))},
-            200);
+            1000);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <random>
 #include <vector>
 
+#include "msim/crowd/stress/crowd_pressure.hpp"
 #include "msim/crowd/stress/stress_dynamics.hpp"
 
 using namespace msim;
@@ -113,4 +114,45 @@ TEST(CrowdStressDynamics, FrictionLocksShearedLayersTogether) {
   testing::Test::RecordProperty("difference_without", std::to_string(without));
   EXPECT_GT(without, 1.0);
   EXPECT_LT(withFriction, 0.8 * without);
+}
+
+// The step the stress model needs (crowd.turbulence.max_step, 0.01 s): a crowd packed at 5 /m^2
+// (random places) filling a closed room and wanting to stay where it is. The discomfort is stiff
+// there (its waves run at sqrt(g') = 10 m/s at 5 /m^2, 190 m/s just below the yield density), so a
+// step's clamped acceleration overshoots and turns, and agents shake by about a_max dt on top of
+// the crowd's own sloshing towards even density. The scene-mean temporal pressure (3 s window)
+// after 4 s falls as the step shrinks; with 0.01 s it lies closer to the 0.005 s value than half
+// of what 0.05 s (the crowd's usual step) adds.
+TEST(CrowdStressDynamics, TheDefaultStepIsWhereTheCrowdPressureSettles) {
+  const GridSpec<2> grid(Vec2(0.0, 0.0), 1.0, IVec<2>(24, 24));
+  const auto meanPressure = [&](double dt) {
+    std::vector<Vec2f> x, v, cf;
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> u(1.0f, 23.0f);
+    for (int k = 0; k < 2420; ++k) x.emplace_back(u(rng), u(rng));  // 5 /m^2 filling a 22 x 22 m room
+    v.assign(x.size(), Vec2f::Zero());
+    cf.assign(x.size(), Vec2f::Zero());
+    StressDynamics d(grid, {});
+    Grid<float, 2> free(grid, 0.0f);  // the room's walls: the ring of cells around it
+    for (int j = 1; j < 23; ++j)
+      for (int i = 1; i < 23; ++i) free(IVec<2>(i, j)) = 1.0f;
+    CrowdWindows windows(grid, 1);
+    TemporalPressure pressure(grid, 3.0);
+    Grid<float, 2> p(grid);
+    const int steps = static_cast<int>(std::lround(4.0 / dt));
+    for (int s = 0; s < steps; ++s) {
+      d.step(x, v, cf, free, dt);
+      windows.gather(x, v);
+      pressure.add(windows, dt);
+    }
+    pressure.pressure(p);
+    return pressure.meanWhereOccupied(p);
+  };
+  const double usual = meanPressure(0.05), standard = meanPressure(0.01), fine = meanPressure(0.005);
+  testing::Test::RecordProperty("pressure_at_0_05_s", std::to_string(usual));
+  testing::Test::RecordProperty("pressure_at_0_01_s", std::to_string(standard));
+  testing::Test::RecordProperty("pressure_at_0_005_s", std::to_string(fine));
+  EXPECT_GT(usual, standard);
+  EXPECT_GT(standard, fine);
+  EXPECT_LT(standard - fine, 0.5 * (usual - fine));
 }
