@@ -64,13 +64,17 @@ TEST(CrowdStressCli, LoveParadeStreamsMeetAtTheRampFoot) {
   for (const json& f : run.at("frames")) densest = std::max(densest, f.at("max_density_per_m2").get<double>());
   EXPECT_GT(densest, 3.5);
   const json& turbulence = results.at("turbulence");
-  long samples = 0;
+  long samples = 0, agentSamples = 0;
   for (const json& b : turbulence.at("by_density")) {
     samples += b.at("samples").get<long>();
-    EXPECT_GE(b.at("turbulent_fraction").get<double>(), 0.0);
-    EXPECT_LE(b.at("turbulent_fraction").get<double>(), 1.0);
+    agentSamples += b.at("agent_samples").get<long>();
+    for (const char* share : {"turbulent_fraction", "backward_fraction"}) {
+      EXPECT_GE(b.at(share).get<double>(), 0.0);
+      EXPECT_LE(b.at(share).get<double>(), 1.0);
+    }
   }
   EXPECT_GT(samples, 0);
+  EXPECT_GT(agentSamples, 0);
   const double x = turbulence.at("peak_at_m")[0].get<double>(), y = turbulence.at("peak_at_m")[1].get<double>();
   EXPECT_TRUE(y < 14.0 || (x > 31.0 && x < 49.0)) << x << ", " << y;  // the tunnel or the ramp
 }

@@ -189,10 +189,12 @@ TEST(CrowdPressure, TemporalPressureOfASteadyCrowdIsZero) {
   for (std::size_t c = 0; c < p.count(); ++c) EXPECT_NEAR(p[c], 0.0f, 1e-9f);
 }
 
-// The samples by density (checks T10, T15: at which densities P > 0.02): on 1 m cells, a block at
-// 4 /m^2 (four agents a cell) pushed to and fro (its velocity flips every step) beside a block at
-// 1 /m^2 walking steadily. Every window inside the steady block is calm, every one inside the
-// pushed block turbulent; windows across the border hold both and fall in between.
+// The samples by density (checks T10, T12, T15: at which densities P > 0.02, and how people move
+// there): on 1 m cells, a block at 4 /m^2 (four agents a cell) pushed to and fro (each agent's
+// velocity turns through a full circle over 8 steps while it wants to walk east) beside a block at
+// 1 /m^2 walking steadily east. Every window inside the steady block is calm and its agents walk
+// straight on, every one inside the pushed block turbulent, its agents moving backwards in half the
+// frames and as fast sideways as forwards; windows across the border hold both and fall in between.
 TEST(CrowdPressure, SamplesByDensityTellTheTurbulentDensitiesApart) {
   const GridSpec<2> grid(Vec2(0.0, 0.0), 1.0, IVec<2>(12, 6));
   Agents a;
@@ -201,22 +203,35 @@ TEST(CrowdPressure, SamplesByDensityTellTheTurbulentDensitiesApart) {
       for (int k = 0; k < (i < 6 ? 4 : 1); ++k) {
         AgentSpec s;
         s.position = Vec2f(i + 0.2f + 0.2f * k, j + 0.5f);
-        a.add(s);
+        const std::size_t n = a.add(s);
+        a.preferredVelocity[n] = Vec2f(1.2f, 0.0f);
       }
   TurbulenceMetrics metrics(grid);
   for (int step = 0; step < 100; ++step) {
+    const float angle = 0.25f * 3.14159265f * static_cast<float>(step % 8);
     for (std::size_t n = 0; n < a.size(); ++n)
-      a.velocity[n] = a.position[n].x() < 6.0f ? Vec2f(step % 2 ? 0.5f : -0.5f, 0.0f) : Vec2f(1.0f, 0.0f);
+      a.velocity[n] = a.position[n].x() < 6.0f ? 0.5f * Vec2f(std::cos(angle), std::sin(angle)) : Vec2f(1.0f, 0.0f);
     metrics.sample(a, 0.05);
     if (step % 10 == 9) metrics.measure(a);
   }
-  const PressureByDensity& bins = metrics.pressureByDensity();
-  long samples = 0;
-  for (long n : bins.samples) samples += n;
-  EXPECT_EQ(samples, 10 * grid.cellCount());  // every cell's window holds someone in each of 10 frames
-  const auto bin = [](double density) { return static_cast<std::size_t>(density / PressureByDensity::kBinWidth); };
-  EXPECT_EQ(bins.samples[bin(1.0)], 10 * 5 * 6);  // the steady block's windows off the border: 5 columns
-  EXPECT_EQ(bins.turbulent[bin(1.0)], 0);
-  EXPECT_EQ(bins.samples[bin(4.0)], 10 * 5 * 6);
-  EXPECT_EQ(bins.turbulent[bin(4.0)], bins.samples[bin(4.0)]);  // rho Var(v) = 4 x 0.25 = 1 /s^2
+  const SamplesByDensity& bins = metrics.samplesByDensity();
+  long cells = 0, agents = 0;
+  for (std::size_t b = 0; b < bins.cells.size(); ++b) cells += bins.cells[b], agents += bins.agents[b];
+  EXPECT_EQ(cells, 10 * grid.cellCount());  // every cell's window holds someone in each of 10 frames
+  EXPECT_EQ(agents, 10 * static_cast<long>(a.size()));
+  const std::size_t steady = SamplesByDensity::bin(1.0), pushed = SamplesByDensity::bin(4.0);
+  EXPECT_EQ(bins.cells[steady], 10 * 5 * 6);  // the steady block's windows off the border: 5 columns
+  EXPECT_EQ(bins.turbulentCells[steady], 0);
+  EXPECT_EQ(bins.cells[pushed], 10 * 5 * 6);
+  EXPECT_EQ(bins.turbulentCells[pushed], bins.cells[pushed]);  // rho Var(v) = 4 x 0.25 = 1 /s^2
+  // Agents: the steady block's 5 columns x 6 agents, the pushed block's 5 columns x 24.
+  EXPECT_EQ(bins.agents[steady], 10 * 30);
+  EXPECT_EQ(bins.backward[steady], 0);
+  EXPECT_NEAR(bins.sideways2[steady], 0.0, 1e-9);
+  EXPECT_NEAR(bins.forward2[steady], 10 * 30 * 1.0, 1e-6);
+  EXPECT_EQ(bins.agents[pushed], 10 * 120);
+  // The measured steps 9, 19, ..., 99 point the velocity at 45, 135, 225, 315, 45, 135, 225, 315,
+  // 45 and 135 degrees from east: backward in 5 of the 10 frames.
+  EXPECT_EQ(bins.backward[pushed], 5 * 120);
+  EXPECT_NEAR(bins.forward2[pushed] + bins.sideways2[pushed], 10 * 120 * 0.25, 1e-4);
 }

@@ -1,6 +1,7 @@
 #include "msim/crowd/stress/turbulence_metrics.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace msim::crowd::stress {
 
@@ -13,10 +14,24 @@ PressureSummary summarizePressure(const Grid<float, 2>& pressure, double thresho
   return s;
 }
 
-void PressureByDensity::add(double density, bool isTurbulent) {
-  const int bin = std::clamp(static_cast<int>(density / kBinWidth), 0, kBins - 1);
-  ++samples[static_cast<std::size_t>(bin)];
-  turbulent[static_cast<std::size_t>(bin)] += isTurbulent;
+std::size_t SamplesByDensity::bin(double density) {
+  return static_cast<std::size_t>(std::clamp(static_cast<int>(density / kBinWidth), 0, kBins - 1));
+}
+
+void SamplesByDensity::addCell(double density, bool isTurbulent) {
+  const std::size_t b = bin(density);
+  ++cells[b];
+  turbulentCells[b] += isTurbulent;
+}
+
+void SamplesByDensity::addAgent(double density, const Vec2f& velocity, const Vec2f& preferred) {
+  const std::size_t b = bin(density);
+  const Vec2f e = preferred.normalized();
+  const double forward = velocity.dot(e), sideways = e.x() * velocity.y() - e.y() * velocity.x();
+  ++agents[b];
+  backward[b] += forward < 0.0;
+  forward2[b] += forward * forward;
+  sideways2[b] += sideways * sideways;
 }
 
 TurbulenceMetrics::TurbulenceMetrics(const GridSpec<2>& grid)
@@ -41,7 +56,16 @@ TurbulenceFrame TurbulenceMetrics::measure(const Agents& agents) {
   f.temporalCellsOver = temporal.cellsOver;
   for (std::size_t c = 0; c < temporal_.count(); ++c) peak_[c] = std::max(peak_[c], temporal_[c]);
   for (const std::uint32_t c : windows_.cells())
-    byDensity_.add(windows_.sums(c).count / windows_.area(c), temporal_[c] > kTurbulentPressure);
+    byDensity_.addCell(windows_.sums(c).count / windows_.area(c), temporal_[c] > kTurbulentPressure);
+  const GridSpec<2>& spec = windows_.spec();
+  for (std::size_t i = 0; i < agents.size(); ++i) {
+    if (!(agents.preferredVelocity[i].squaredNorm() > 0.0f)) continue;  // arrived, or standing by choice
+    const Vec2 at = (agents.position[i].cast<double>() - spec.origin) / spec.dx;
+    const int x = std::clamp(static_cast<int>(std::floor(at.x())), 0, spec.res.x() - 1);
+    const int y = std::clamp(static_cast<int>(std::floor(at.y())), 0, spec.res.y() - 1);
+    const std::size_t c = static_cast<std::size_t>(y) * static_cast<std::size_t>(spec.res.x()) + static_cast<std::size_t>(x);
+    byDensity_.addAgent(windows_.sums(c).count / windows_.area(c), agents.velocity[i], agents.preferredVelocity[i]);
+  }
   f.temporalPressureMean = sampler_.meanWhereOccupied(temporal_);
   f.strainRate = stress::strainRate(windows_, strain_);
   f.localSpeed = stress::meanLocalSpeed(windows_);

@@ -20,15 +20,25 @@ struct PressureSummary {
 };
 PressureSummary summarizePressure(const Grid<float, 2>& pressure, double threshold);
 
-// At which densities the crowd turns turbulent: the (cell, frame) samples of the crowd's cells,
-// binned by the window's density now, and how many of them had a temporal pressure above the
-// turbulent 0.02 /s^2 (the seed's checks T10 and T15: P > 0.02 only from 7 /m^2 in the Hajj, from
-// 5.5 /m^2 at the Love Parade).
-struct PressureByDensity {
+// At which densities the crowd turns turbulent, binned by the density of a cell's window now:
+// - the (cell, frame) samples of the crowd's cells and how many had a temporal pressure above the
+//   turbulent 0.02 /s^2 (checks T10 and T15: P > 0.02 only from 7 /m^2 in the Hajj, from
+//   5.5 /m^2 at the Love Parade);
+// - the (agent, frame) samples of the agents that want to walk, by their cell's window: those
+//   moving away from their goal (backward: v . e < 0 with e the preferred direction) and the sums
+//   of the squared forward and sideways speeds (check T12: at least 1% backward and a sideways
+//   rms of at least 0.3 of the forward rms where the crowd is turbulent, under 0.1 in a laminar
+//   flow; Fig. 4.4's v_x and v_y).
+struct SamplesByDensity {
   static constexpr double kBinWidth = 0.5;  // [1/m^2]
   static constexpr int kBins = 24;          // the last bin holds everything from 11.5 /m^2 on
-  std::array<long, kBins> samples{}, turbulent{};
-  void add(double density, bool isTurbulent);
+  std::array<long, kBins> cells{}, turbulentCells{};
+  std::array<long, kBins> agents{}, backward{};
+  std::array<double, kBins> forward2{}, sideways2{};  // [m^2/s^2]
+  static std::size_t bin(double density);
+  void addCell(double density, bool isTurbulent);
+  // An agent walking at `velocity` that prefers `preferred` (nonzero).
+  void addAgent(double density, const Vec2f& velocity, const Vec2f& preferred);
 };
 
 struct TurbulenceFrame {
@@ -61,14 +71,14 @@ class TurbulenceMetrics {
   // turbulent during the run.
   const Grid<float, 2>& peakTemporalPressure() const { return peak_; }
   // The measured frames' samples by density.
-  const PressureByDensity& pressureByDensity() const { return byDensity_; }
+  const SamplesByDensity& samplesByDensity() const { return byDensity_; }
 
  private:
   CrowdWindows windows_;
   TemporalPressure sampler_;
   StandstillDetector standstills_;
   Grid<float, 2> spatial_, temporal_, strain_, peak_;
-  PressureByDensity byDensity_;
+  SamplesByDensity byDensity_;
 };
 
 }  // namespace msim::crowd::stress
