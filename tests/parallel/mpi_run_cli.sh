@@ -28,8 +28,8 @@ for key in ("smoke_mass_kg", "kinetic_energy_J", "max_speed_m_s", "enstrophy"):
 PY
 [[ $(ls "$tmp/two/vdb" | wc -l) -eq 6 && $(ls "$tmp/two/png" | wc -l) -eq 6 ]] || { echo "expected 6 frames"; exit 1; }
 # Around a static obstacle, around one that moves, in a wind blown in through a wall, with its
-# scalars in flux form, from an expanding source, and viscous fire under a mesh obstacle that one
-# rank's block does not touch.
+# scalars in flux form, from an expanding source, viscous fire under a mesh obstacle that one
+# rank's block does not touch, and with vortex particles (alone and around the ball).
 compare_scene() {  # compare_scene SCENE NAME KEYS...: one and two processes agree within 1e-4
   local scene=$1 name=$2
   shift 2
@@ -56,6 +56,11 @@ extra=(--set smoke.advection.scalars=conservative)  # the scalars moved in flux 
 compare_scene smoke_sphere conservative smoke_mass_kg kinetic_energy_J enstrophy
 extra=()  # viscous: the implicit viscosity's CG runs over the blocks
 compare_scene burning_log log fuel_kg flame_kg kinetic_energy_J
+# Vortex particles: every rank keeps all of them; the owner of a particle's cell reads the flow.
+compare_scene plume_vortex_particles vortex smoke_mass_kg kinetic_energy_J enstrophy vortex_particles
+extra=(--set smoke.vortex_particles.enabled=true --set smoke.vortex_particles.count=400 --set smoke.vortex_particles.rate=200
+       --set smoke.vortex_particles.in_solids=push_out)  # around the ball, pushed out of it
+compare_scene smoke_sphere vortex_sphere smoke_mass_kg kinetic_energy_J enstrophy vortex_particles
 
 # --resume under mpirun: 3 frames, then on to 6 from the third's VDB (full floats, no fog cut-off:
 # the saved frame is the whole state), against the 6 frames run at once.
@@ -84,7 +89,7 @@ expect_failure() {  # expect_failure CODE PATTERN ARGS...: exit CODE, PATTERN in
   [[ $(grep -c "msim.*error" <<< "$out") -eq 1 ]] || { echo "msim $*: expected one error message:"; echo "$out"; exit 1; }
   grep -q -- "$pattern" <<< "$out" || { echo "msim $*: no '$pattern' in:"; echo "$out"; exit 1; }
 }
-expect_failure 2 "smoke.vortex_particles.enabled" run "$scenes/plume_3d.json" --out "$tmp/bad" --set smoke.vortex_particles.enabled=true -q
+expect_failure 2 "smoke.vortex_particles.vorticity" run "$scenes/plume_3d.json" --out "$tmp/bad" --set smoke.vortex_particles.enabled=true --set smoke.vortex_particles.vorticity=local_flow -q
 expect_failure 2 "conservative scalar transport" run "$scenes/plume_3d.json" --out "$tmp/bad" --set smoke.advection.scalars=conservative --set mpi.ghost_layers=3 -q
 expect_failure 2 "cannot split" run "$scenes/plume_3d.json" --out "$tmp/bad" --set domain.resolution=4 -q
 expect_failure 2 "mpi.ghost_layers" run "$scenes/plume_3d.json" --out "$tmp/bad" --set mpi.ghost_layers=2 -q

@@ -4,6 +4,8 @@
 // global grid with ghost layers (placement()); it calls exchange() where a stencil is about to
 // read the neighbours' samples, reduces its scalars over the ranks, and hands the pressure solve,
 // the one global coupling, to project(). Without a split (the default) none of this is called.
+#include <span>
+
 #include "msim/core/block_placement.hpp"
 #include "msim/core/grid.hpp"
 #include "msim/core/mac_grid.hpp"
@@ -41,6 +43,8 @@ class DomainSplit {
   // The largest of `value` over every rank, and the sum. Collective.
   virtual double maxOverRanks(double value) = 0;
   virtual double sumOverRanks(double value) = 0;
+  // Each entry summed over every rank, in place (every rank passes as many). Collective.
+  virtual void sumOverRanks(std::span<double> values) = 0;
   // The local samples [lo, hi) of a field with the given layout (cell-centred: zero; face
   // component a: unit vector a) that are this rank's own: its owned cells, and along a face axis
   // the faces below them, the domain's last face belonging to the last block.

@@ -30,6 +30,10 @@ double MpiDomainSplit::sumOverRanks(double value) {
   return value;
 }
 
+void MpiDomainSplit::sumOverRanks(std::span<double> values) {
+  if (!values.empty()) MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE, MPI_SUM, comm_);
+}
+
 SplitSolveStats MpiDomainSplit::project(MacGrid<3>& velocity, Grid<float, 3>& pressure, double dt, double density) {
   return projection_.project(velocity, pressure, dt, density);
 }

@@ -29,6 +29,7 @@ class MpiDomainSplit final : public DomainSplit<3> {
   bool root() const override { return block_.rank == 0; }
   double maxOverRanks(double value) override;
   double sumOverRanks(double value) override;
+  void sumOverRanks(std::span<double> values) override;
   void setOpenFractions(const MacGrid<3>& openFraction) override { projection_.setOpenFractions(openFraction); }
   void setSolidVelocity(const MacGrid<3>& solidVelocity) override { projection_.setSolidVelocity(solidVelocity); }
   void setWallNormalVelocity(int axis, int side, double velocity) override {

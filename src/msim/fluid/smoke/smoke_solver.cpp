@@ -56,6 +56,7 @@ void SmokeSolver<D>::setObstacles(const Grid<float, D>& nodalSolidPhi) {
 template <int D>
 void SmokeSolver<D>::setVortexLayer(std::unique_ptr<VortexLayer<D>> layer) {
   vortex_ = std::move(layer);
+  if (vortex_ && split_) vortex_->setDomainSplit(split_);
   if (vortex_) vortex_->seedInitial(vortex_->flowVorticity(velocity_));
 }
 
@@ -152,6 +153,7 @@ template <int D>
 void SmokeSolver<D>::setDomainSplit(DomainSplit<D>* split) {
   split_ = split;
   advector_.setPlacement(split ? split->placement() : BlockPlacement<D>{});
+  if (vortex_) vortex_->setDomainSplit(split);
   if (split_)
     for (int a = 0; a < D; ++a)
       for (int side = 0; side < 2; ++side) split_->setWallNormalVelocity(a, side, params_.wallVelocity[a][side][a]);
@@ -167,7 +169,6 @@ void SmokeSolver<D>::checkDistributable() const {
   auto refuse = [](const std::string& what) {
     throw InputError("smoke split among MPI processes: " + what + " is not distributed; run it on one process");
   };
-  if (vortex_) refuse("vortex particles");
   if (advectionOffset_ || scalarsElsewhere_) refuse("procedural turbulence");
 }
 

@@ -34,7 +34,8 @@ double omegaCrossOffset(const VortexVector<D>& omega, const double* d, int a) {
 // has one square root and no exponential per face.
 template <int D>
 void addToSlabs(const VortexParticles<D>& particles, VortexKernel kernel, double dt, int a, int kBegin, int kEnd,
-                Grid<float, D>& faces, const Grid<float, D>* solid, std::vector<double>& table) {
+                Grid<float, D>& faces, const Grid<float, D>* solid, const BlockPlacement<D>& placement,
+                std::vector<double>& table) {
   const GridSpec<D>& spec = faces.spec();
   const double dx = spec.dx;
   const auto& x = particles.positions();
@@ -46,8 +47,11 @@ void addToSlabs(const VortexParticles<D>& particles, VortexKernel kernel, double
   float* data = faces.data().data();
 
   // Interior faces only: the domain walls belong to the projection; faces next to solids get none.
+  // On a block the walls are the global domain's, and ghost faces beyond them get none either.
+  const int wallLo = placement.whole() ? 0 : -placement.cellOrigin[a];
+  const int wallHi = placement.whole() ? spec.res[a] : placement.globalRes[a] - placement.cellOrigin[a];
   auto receivesForce = [&](const IVec<D>& f) {
-    if (f[a] == 0 || f[a] == spec.res[a]) return false;
+    if (f[a] <= wallLo || f[a] >= wallHi) return false;
     if (!solid) return true;
     IVec<D> left = f;
     left[a] -= 1;
@@ -129,7 +133,7 @@ void addToSlabs(const VortexParticles<D>& particles, VortexKernel kernel, double
 
 template <int D>
 void addVortexForce(const VortexParticles<D>& particles, VortexKernel kernel, double dt, MacGrid<D>& velocity,
-                    const Grid<float, D>* solid) {
+                    const Grid<float, D>* solid, const BlockPlacement<D>& placement) {
   requireValidVortexTimestep(dt, "addVortexForce");
   if (solid && !(solid->spec() == velocity.spec() && solid->size() == velocity.spec().res))
     throw std::invalid_argument("addVortexForce: the solid mask is not cell-centred on the velocity's grid");
@@ -141,7 +145,7 @@ void addVortexForce(const VortexParticles<D>& particles, VortexKernel kernel, do
     parallelFor(0, tasks, [&](std::size_t t) {
       thread_local std::vector<double> table;  // grows to the largest particle once per thread
       const int k0 = static_cast<int>(t) * kSlabsPerTask;
-      addToSlabs<D>(particles, kernel, dt, a, k0, std::min(slabs, k0 + kSlabsPerTask), faces, solid, table);
+      addToSlabs<D>(particles, kernel, dt, a, k0, std::min(slabs, k0 + kSlabsPerTask), faces, solid, placement, table);
     }, 1);
   }
 }
@@ -156,8 +160,10 @@ Vec<D> vortexForceAt(const VortexParticles<D>& particles, VortexKernel kernel, c
   return force;
 }
 
-template void addVortexForce<2>(const VortexParticles<2>&, VortexKernel, double, MacGrid<2>&, const Grid<float, 2>*);
-template void addVortexForce<3>(const VortexParticles<3>&, VortexKernel, double, MacGrid<3>&, const Grid<float, 3>*);
+template void addVortexForce<2>(const VortexParticles<2>&, VortexKernel, double, MacGrid<2>&, const Grid<float, 2>*,
+                                const BlockPlacement<2>&);
+template void addVortexForce<3>(const VortexParticles<3>&, VortexKernel, double, MacGrid<3>&, const Grid<float, 3>*,
+                                const BlockPlacement<3>&);
 template Vec<2> vortexForceAt<2>(const VortexParticles<2>&, VortexKernel, const Vec<2>&);
 template Vec<3> vortexForceAt<3>(const VortexParticles<3>&, VortexKernel, const Vec<3>&);
 

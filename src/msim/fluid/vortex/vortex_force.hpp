@@ -14,6 +14,7 @@
 // jump at the cut-off is a vortex sheet whose discrete divergence does not shrink under refinement
 // (whole-grid L2 grows as dx^{-1/2}); the projection that follows removes it. The tent kernel has
 // no such sheet.
+#include "msim/core/block_placement.hpp"
 #include "msim/core/grid.hpp"
 #include "msim/core/mac_grid.hpp"
 #include "msim/fluid/vortex/vortex_kernel.hpp"
@@ -25,10 +26,11 @@ namespace msim::fluid {
 // projection) and, with a solid mask (cell-centred, > 0.5 solid), not on faces next to a solid
 // cell (as VorticityConfinement). Use dt = 1 on a zeroed MacGrid to get the force field itself.
 // Parallel over slabs of faces; each face adds its particles in index order, so the result does not
-// depend on the thread count. std::invalid_argument if dt is negative or not finite.
+// depend on the thread count. On one block of a split domain (`placement`, with world positions)
+// the walls are the global domain's. std::invalid_argument if dt is negative or not finite.
 template <int D>
 void addVortexForce(const VortexParticles<D>& particles, VortexKernel kernel, double dt, MacGrid<D>& velocity,
-                    const Grid<float, D>* solid = nullptr);
+                    const Grid<float, D>* solid = nullptr, const BlockPlacement<D>& placement = {});
 
 // sum_p F_p(x) at one point (every particle visited: for checks and probes, not for grids).
 template <int D>

@@ -1,8 +1,13 @@
 #include "msim/fluid/vortex/vortex_layer.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <optional>
 #include <stdexcept>
 
+#include "msim/core/interpolation.hpp"
+#include "msim/core/parallel.hpp"
+#include "msim/fluid/vortex/velocity_gradient.hpp"
 #include "msim/fluid/vortex/vortex_advection.hpp"
 #include "msim/fluid/vortex/vortex_force.hpp"
 #include "msim/fluid/vortex/vortex_solids.hpp"
@@ -25,15 +30,96 @@ void VortexLayer<D>::seedInitial(const Vorticity<D>* flowVorticity) {
 }
 
 template <int D>
+void VortexLayer<D>::setDomainSplit(DomainSplit<D>* split) {
+  if (split && needsFlowVorticity())
+    throw std::invalid_argument("vortex particles on a split domain: seeding with the local flow's vorticity is not distributed");
+  split_ = split;
+}
+
+template <int D>
 void VortexLayer<D>::addForce(MacGrid<D>& velocity, double dt, const Grid<float, D>* solidMask) const {
-  if (!particles_.empty()) addVortexForce<D>(particles_, settings_.kernel, dt, velocity, solidMask);
+  if (!particles_.empty())
+    addVortexForce<D>(particles_, settings_.kernel, dt, velocity, solidMask, split_ ? split_->placement() : BlockPlacement<D>{});
+}
+
+template <int D>
+bool VortexLayer<D>::owns(const GridSpec<D>& local, const Vec<D>& x) const {
+  const BlockPlacement<D> where = split_->placement();
+  const IVec<D> lo = split_->ownedLo(), hi = split_->ownedHi();
+  for (int a = 0; a < D; ++a) {
+    const int global = std::clamp(static_cast<int>(std::floor((x[a] - local.origin[a]) / local.dx)) + where.cellOrigin[a], 0,
+                                  where.globalRes[a] - 1);
+    const int cell = global - where.cellOrigin[a];
+    if (cell < lo[a] || cell >= hi[a]) return false;
+  }
+  return true;
+}
+
+template <int D>
+void VortexLayer<D>::advanceSplit(const MacGrid<D>& velocity, double dt) {
+  auto& x = particles_.positions();
+  const GridSpec<D>& local = velocity.spec();
+  const std::size_t n = x.size();
+  // Advection (advectVortexParticles): each particle's displacement read by its owner.
+  reads_.assign(n * D, 0.0);
+  parallelFor(0, n, [&](std::size_t p) {
+    const Vec<D> position = x[p].template cast<double>();
+    if (!owns(local, position)) return;
+    const Vec<D> step = dt * sampleLinear<D>(velocity, position);
+    for (int a = 0; a < D; ++a) reads_[p * D + a] = step[a];
+  }, 256);
+  split_->sumOverRanks(reads_);
+  parallelFor(0, n, [&](std::size_t p) {
+    x[p] = (x[p].template cast<double>() + Vec<D>(Eigen::Map<const Vec<D>>(&reads_[p * D]))).template cast<float>();
+  }, 256);
+  // Stretching (stretchVortexParticles) at the new places.
+  if constexpr (D == 3) {
+    auto& omega = particles_.vorticities();
+    reads_.assign(n * 3, 0.0);
+    parallelFor(0, n, [&](std::size_t p) {
+      const Vec<3> position = x[p].template cast<double>();
+      if (!owns(local, position)) return;
+      const Eigen::Vector3d turned = stretchAndRescale(omega[p], velocityGradientAt<3>(velocity, position), dt);
+      for (int a = 0; a < 3; ++a) reads_[p * 3 + a] = turned[a];
+    }, 256);
+    split_->sumOverRanks(reads_);
+    parallelFor(0, n, [&](std::size_t p) { omega[p] = Eigen::Map<const Eigen::Vector3d>(&reads_[p * 3]); }, 256);
+  }
+  // Solids (vortex_solids.hpp): the owner decides whether a particle stays (1) and where it goes.
+  if (solidPhi_) {
+    const auto phi = [&](const Vec<D>& y) { return double(sampleLinear<D>(*solidPhi_, y)); };
+    const bool push = settings_.solids == VortexSolidHandling::PushOut;
+    reads_.assign(n * (D + 1), 0.0);
+    parallelFor(0, n, [&](std::size_t p) {
+      const Vec<D> position = x[p].template cast<double>();
+      if (!owns(local, position)) return;
+      std::optional<Vec<D>> kept = position;
+      if (phi(position) < 0.0) kept = push ? pushedOutOfSolid<D>(phi, position, 0.5 * solidPhi_->spec().dx, 0.5 * domain_.dx)
+                                           : std::nullopt;
+      if (!kept) return;
+      reads_[p * (D + 1)] = 1.0;
+      for (int a = 0; a < D; ++a) reads_[p * (D + 1) + 1 + a] = (*kept)[a];
+    }, 256);
+    split_->sumOverRanks(reads_);
+    // The predicate moves a survivor before removeIf moves it down (as pushVortexParticlesOutOfSolid).
+    particles_.removeIf([&](std::size_t p) {
+      if (!(reads_[p * (D + 1)] > 0.0)) return true;
+      x[p] = Vec<D>(Eigen::Map<const Vec<D>>(&reads_[p * (D + 1) + 1])).template cast<float>();
+      return false;
+    });
+  }
 }
 
 template <int D>
 void VortexLayer<D>::advance(const MacGrid<D>& velocity, double dt, double time, const Vorticity<D>* flowVorticity) {
-  advectVortexParticles<D>(particles_, velocity, dt);
-  stretchVortexParticles<D>(particles_, velocity, dt);
-  if (solidPhi_) {
+  if (split_) {
+    requireValidVortexTimestep(dt, "VortexLayer::advance");
+    advanceSplit(velocity, dt);
+  } else {
+    advectVortexParticles<D>(particles_, velocity, dt);
+    stretchVortexParticles<D>(particles_, velocity, dt);
+  }
+  if (solidPhi_ && !split_) {
     if (settings_.solids == VortexSolidHandling::Delete)
       removeVortexParticlesInSolid<D>(particles_, *solidPhi_);
     else

@@ -11,7 +11,9 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <vector>
 
+#include "msim/core/domain_split.hpp"
 #include "msim/core/grid.hpp"
 #include "msim/core/mac_grid.hpp"
 #include "msim/fluid/vortex/vortex_particles.hpp"
@@ -46,6 +48,12 @@ class VortexLayer {
   void setSolid(const Grid<float, D>& nodalSolidPhi) { solidPhi_ = nodalSolidPhi; }
   // The particles seeded at the start (initialCount), once; flowVorticity as for advance.
   void seedInitial(const Vorticity<D>* flowVorticity);
+  // Runs the layer on one block of a split domain (Selle ch. 8; null: the whole domain): the
+  // velocity, solid mask and signed distance it is given are then the block's (with ghosts).
+  // Every rank keeps every particle and moves them alike: the rank whose owned cells hold a
+  // particle reads the flow (and the solid) there, and the ranks sum what they read, one reduction
+  // per read. The seeding's local-flow vorticity is not distributed (std::invalid_argument).
+  void setDomainSplit(DomainSplit<D>* split);
 
   const VortexParticles<D>& particles() const { return particles_; }
   VortexParticles<D>& particles() { return particles_; }
@@ -60,8 +68,16 @@ class VortexLayer {
   GridSpec<D> domain_;
   VortexParticles<D> particles_;
   VortexEmitter<D> emitter_;
+  // The split run's advance: reads on the owning rank, summed over the ranks.
+  void advanceSplit(const MacGrid<D>& velocity, double dt);
+  // Whether the block owns the cell holding world position x (cell indices clamped to the global
+  // domain, so a particle on its border has an owner).
+  bool owns(const GridSpec<D>& local, const Vec<D>& x) const;
+
   std::optional<Grid<float, D>> solidPhi_;
   std::optional<Vorticity<D>> flowVorticity_;
+  DomainSplit<D>* split_ = nullptr;
+  std::vector<double> reads_;  // the split run's per-particle reads, summed over the ranks
 };
 
 }  // namespace msim::fluid

@@ -7,6 +7,7 @@
 // Grid<float, D> (any sample layout, read D-linearly; e.g. the nodal phi of SmokeSolver).
 #include <cmath>
 #include <cstddef>
+#include <optional>
 #include <stdexcept>
 
 #include "msim/core/grid.hpp"
@@ -27,10 +28,32 @@ std::size_t removeVortexParticlesInSolid(VortexParticles<D>& particles, const Si
   return particles.removeIf([&](std::size_t p) { return phi(Vec<D>(x[p].template cast<double>())) < 0.0; });
 }
 
-// Moves every particle with phi(x_p) < 0 along the level set's normal n = grad phi / |grad phi|
-// (central differences with step h) to phi = clearance: x <- x + (clearance - phi) n, repeated up
-// to three times for a distance that is not exact. A particle still inside, or where the gradient
-// vanishes, is deleted. std::invalid_argument unless h > 0 and clearance >= 0.
+// One particle at y inside the solid (phi(y) < 0) moved along the level set's normal
+// n = grad phi / |grad phi| (central differences with step h) to phi = clearance:
+// y <- y + (clearance - phi) n, repeated up to three times for a distance that is not exact. Its
+// new place, or none where it is still inside or the gradient vanishes (it is to be deleted).
+template <int D, typename SignedDistance>
+std::optional<Vec<D>> pushedOutOfSolid(const SignedDistance& phi, Vec<D> y, double h, double clearance) {
+  double d = phi(y);
+  for (int iteration = 0; iteration < 3 && d < clearance; ++iteration) {
+    Vec<D> g;
+    for (int a = 0; a < D; ++a) {
+      Vec<D> up = y, down = y;
+      up[a] += h;
+      down[a] -= h;
+      g[a] = (phi(up) - phi(down)) / (2.0 * h);
+    }
+    const double norm = g.norm();
+    if (!(norm > 0.0)) break;
+    y += (clearance - d) * (g / norm);
+    d = phi(y);
+  }
+  if (!(d >= 0.0)) return std::nullopt;
+  return y;
+}
+
+// Moves every particle with phi(x_p) < 0 out of the solid (pushedOutOfSolid); one that cannot be
+// moved out is deleted. std::invalid_argument unless h > 0 and clearance >= 0.
 template <int D, typename SignedDistance>
 SolidPushOutResult pushVortexParticlesOutOfSolid(VortexParticles<D>& particles, const SignedDistance& phi, double h,
                                                  double clearance) {
@@ -43,24 +66,11 @@ SolidPushOutResult pushVortexParticlesOutOfSolid(VortexParticles<D>& particles, 
   // The predicate writes the pushed position of particle p before removeIf moves p down, so the
   // survivors keep their new positions.
   const std::size_t deleted = particles.removeIf([&](std::size_t p) {
-    Vec<D> y = x[p].template cast<double>();
-    double d = phi(y);
-    if (!(d < 0.0)) return false;
-    for (int iteration = 0; iteration < 3 && d < clearance; ++iteration) {
-      Vec<D> g;
-      for (int a = 0; a < D; ++a) {
-        Vec<D> up = y, down = y;
-        up[a] += h;
-        down[a] -= h;
-        g[a] = (phi(up) - phi(down)) / (2.0 * h);
-      }
-      const double norm = g.norm();
-      if (!(norm > 0.0)) break;
-      y += (clearance - d) * (g / norm);
-      d = phi(y);
-    }
-    if (!(d >= 0.0)) return true;
-    x[p] = y.template cast<float>();
+    const Vec<D> y = x[p].template cast<double>();
+    if (!(phi(y) < 0.0)) return false;
+    const std::optional<Vec<D>> out = pushedOutOfSolid<D>(phi, y, h, clearance);
+    if (!out) return true;
+    x[p] = out->template cast<float>();
     ++result.pushed;
     return false;
   });

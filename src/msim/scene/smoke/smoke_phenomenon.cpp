@@ -69,8 +69,9 @@ std::unique_ptr<DomainSplit<D>> smokeSplit(const Scene& scene) {
     refuseSplit(file, "domain.resolution", "a 2D grid");
   } else {
     if (smoke.at("turbulence").at("enabled").get<bool>()) refuse("smoke.turbulence.enabled", "sub-grid turbulence");
-    if (smoke.at("vortex_particles").at("enabled").get<bool>())
-      refuse("smoke.vortex_particles.enabled", "the vortex particles");
+    const json& vortex = smoke.at("vortex_particles");
+    if (vortex.at("enabled").get<bool>() && vortex.at("vorticity").get<std::string>() == "local_flow")
+      refuse("smoke.vortex_particles.vorticity", "seeding vortex particles with the local flow's vorticity");
     const fluid::SmokeParams<3> p = smokeParams<3>(scene);
     // Enough ghost layers for the scheme at the solver's CFL number (and blocks at least that thick).
     const bool conservative = p.scalarTransport == fluid::ScalarTransport::Conservative;
