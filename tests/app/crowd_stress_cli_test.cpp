@@ -18,14 +18,20 @@ using nlohmann::json;
 const std::string kScene = std::string(MSIM_SOURCE_DIR) + "/scenes/crowd_stress_merge.json";
 const std::string kLoveParade = std::string(MSIM_SOURCE_DIR) + "/scenes/crowd_love_parade.json";
 
+// run.json of `scene` run for `seconds` without pictures into dir/out (an empty object on failure).
+json runScene(const std::string& scene, const fs::path& dir, int seconds) {
+  const Result r = runMsim("run " + scene + " -q --out " + (dir / "out").string() + " --set time.duration=" +
+                           std::to_string(seconds) + " --set outputs.png=false --set outputs.mp4=false --set outputs.vdb=false");
+  EXPECT_EQ(r.exitCode, 0) << r.output;
+  return r.exitCode == 0 ? readJson(dir / "out" / "run.json") : json::object();
+}
+
 }  // namespace
 
 TEST(CrowdStressCli, MergePacksPastTheCriticalDensityAndEverySolveConverges) {
   const fs::path dir = scratch("stress_merge");
-  const Result r = runMsim("run " + kScene + " -q --out " + (dir / "out").string() +
-                           " --set time.duration=40 --set outputs.png=false --set outputs.mp4=false --set outputs.vdb=false");
-  ASSERT_EQ(r.exitCode, 0) << r.output;
-  const json run = readJson(dir / "out" / "run.json");
+  const json run = runScene(kScene, dir, 40);
+  ASSERT_FALSE(run.empty());
   const json& stress = run.at("results").at("stress");
   EXPECT_GT(stress.at("friction_solves").get<long>(), 0);
   EXPECT_EQ(stress.at("unconverged_solves").get<long>(), 0);
@@ -48,14 +54,11 @@ TEST(CrowdStressCli, MergePacksPastTheCriticalDensityAndEverySolveConverges) {
 }
 
 // The Love-Parade-like counter-flow: visitors from both tunnel inlets meet the people coming down
-// the ramp at its foot, where the crowd packs past the critical density; the run's samples by
-// density account for every crowd cell of every frame, and its peak pressure lies where people walk.
+// the ramp at its foot, where the crowd packs past the critical density; the run reports its
+// samples by density (crowd cells and agents) and its peak pressure where people walk.
 TEST(CrowdStressCli, LoveParadeStreamsMeetAtTheRampFoot) {
-  const fs::path dir = scratch("love_parade");
-  const Result r = runMsim("run " + kLoveParade + " -q --out " + (dir / "out").string() +
-                           " --set time.duration=35 --set outputs.png=false --set outputs.mp4=false --set outputs.vdb=false");
-  ASSERT_EQ(r.exitCode, 0) << r.output;
-  const json run = readJson(dir / "out" / "run.json");
+  const json run = runScene(kLoveParade, scratch("love_parade"), 35);
+  ASSERT_FALSE(run.empty());
   const json& results = run.at("results");
   EXPECT_EQ(results.at("stress").at("unconverged_solves").get<long>(), 0);
   // Net crossings upwards: people come down past the ramp's top, none yet past its foot.
