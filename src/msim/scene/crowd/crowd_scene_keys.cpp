@@ -393,9 +393,9 @@ struct Builder {
     // The stress model's discomfort is stiff: its waves run at sqrt(g'(rho)), 10 m/s at 5 /m^2 and
     // 190 m/s just below the yield density, and its acceleration, clamped at a_max (eq. 4.7),
     // overshoots and turns from one step to the next, shaking agents by about a_max dt. The crowd
-    // pressure and speeds depend on the step: the Hajj merge at 5.8 /m^2 moves at a mean local
-    // speed of 0.41 m/s with 0.05 s steps, 0.21 with 0.01 s and 0.19 with 0.005 s. 0.01 s is the
-    // step of Golas' Table 3.1 (docs/crowd_turbulence.md).
+    // pressure and speeds depend on the step: the Hajj merge at 5.8 /m^2 (1 m cells, no lookahead)
+    // moves at a mean local speed of 0.41 m/s with 0.05 s steps, 0.21 with 0.01 s and 0.19 with
+    // 0.005 s. 0.01 s is the step of Golas' Table 3.1 (docs/crowd_turbulence.md).
     if (tu.at("enabled").get<bool>()) out.maxStep = std::min(out.maxStep, tu.at("max_step").get<double>());
     out.gridCfl = c.at("grid_cfl").get<double>();
     out.colourBy = c.at("colour_by").get<std::string>();
