@@ -16,9 +16,11 @@ float cross(const Vec2f& a, const Vec2f& b) { return a.x() * b.y() - a.y() * b.x
 float clearDistance(const StaticObstacles& obstacles, const Vec2f& x, const Vec2f& d, float length) {
   float clear = length;
   if (obstacles.empty()) return clear;
-  // Edges near points every `reach` along the ray: a superset of the edges the ray crosses.
+  // Edges near points every `reach` along the ray: a superset of the edges the ray crosses. An
+  // edge the ray crosses at t is near the point within half a stride of t, so once a crossing is
+  // known the points beyond it by more than a stride find none closer.
   const float stride = std::max(obstacles.reach(), 1e-3f);
-  for (float s = 0.0f; s <= length + stride; s += stride) {
+  for (float s = 0.0f; s <= clear + stride; s += stride) {
     obstacles.forEachEdgeNear(x + std::min(s, length) * d, [&](const Vec2f& a, const Vec2f& b) {
       const Vec2f e = b - a;
       const float denom = cross(d, e);
