@@ -73,4 +73,21 @@ nlohmann::json toJson(const WeidmannParams& p) {
   return {{"v0", p.v0}, {"gamma", p.gamma}, {"rhoJam", p.rhoJam}};
 }
 
+nlohmann::json toJson(const stress::SamplesByDensity& bins) {
+  nlohmann::json j = nlohmann::json::array();
+  for (std::size_t b = 0; b < bins.cells.size(); ++b) {
+    const double cells = double(bins.cells[b]), agents = double(bins.agents[b]);
+    if (cells == 0.0 && agents == 0.0) continue;
+    const auto per = [](double sum, double count) { return count > 0.0 ? sum / count : 0.0; };
+    j.push_back({{"density_from_per_m2", double(b) * bins.kBinWidth},
+                 {"samples", bins.cells[b]},
+                 {"turbulent_fraction", per(double(bins.turbulentCells[b]), cells)},
+                 {"agent_samples", bins.agents[b]},
+                 {"backward_fraction", per(double(bins.backward[b]), agents)},
+                 {"rms_forward_mps", std::sqrt(per(bins.forward2[b], agents))},
+                 {"rms_sideways_mps", std::sqrt(per(bins.sideways2[b], agents))}});
+  }
+  return j;
+}
+
 }  // namespace msim::crowd

@@ -8,6 +8,7 @@
 #include "msim/crowd/fundamental_diagram.hpp"
 #include "msim/crowd/measurement_line.hpp"
 #include "msim/crowd/metrics.hpp"
+#include "msim/crowd/stress/turbulence_metrics.hpp"
 #include "msim/crowd/voronoi_density.hpp"
 
 namespace msim::crowd {
@@ -24,5 +25,8 @@ nlohmann::json toJson(const EvacuationTimes& times);
 nlohmann::json toJson(const FdBin& bin);
 nlohmann::json toJson(std::span<const FdBin> bins);
 nlohmann::json toJson(const WeidmannParams& params);
+// The bins that hold samples: the share of crowd cells over the turbulent pressure, of agents
+// moving away from their goal, and the agents' rms forward and sideways speeds.
+nlohmann::json toJson(const stress::SamplesByDensity& bins);
 
 }  // namespace msim::crowd

@@ -66,7 +66,7 @@ void spatialPressure(const CrowdWindows& windows, Grid<float, 2>& pressure) {
     const CrowdWindows::Sums& w = windows.sums(c);
     if (w.count < 2.0) continue;
     const double variance = std::max(0.0, w.v2 / w.count - (w.vx * w.vx + w.vy * w.vy) / (w.count * w.count));
-    pressure[c] = static_cast<float>(w.count / windows.area(c) * variance);
+    pressure[c] = static_cast<float>(windows.density(c) * variance);
   }
 }
 
@@ -142,7 +142,7 @@ void TemporalPressure::add(const CrowdWindows& windows, double dt) {
     // Most cells were updated by the last sample too: their decay is the step's.
     const double f = cell.time == previous ? stepDecay : decay(time_ - cell.time);
     const CrowdWindows::Sums& w = windows.sums(c);
-    const double density = w.count / windows.area(c);
+    const double density = windows.density(c);
     const Vec2 v(w.vx / w.count, w.vy / w.count);
     cell.occupied = cell.occupied * f + dt;
     cell.density = cell.density * f + dt * density;

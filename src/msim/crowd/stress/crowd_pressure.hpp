@@ -35,6 +35,8 @@ class CrowdWindows {
   const Sums& sums(std::size_t c) const { return totals_[c]; }
   // The area of cell c's window inside the grid [m^2].
   double area(std::size_t c) const;
+  // The local density of cell c: its window's agents over the window's area [1/m^2].
+  double density(std::size_t c) const { return totals_[c].count / area(c); }
 
  private:
   GridSpec<2> spec_;

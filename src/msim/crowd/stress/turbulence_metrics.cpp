@@ -1,7 +1,6 @@
 #include "msim/crowd/stress/turbulence_metrics.hpp"
 
 #include <algorithm>
-#include <cmath>
 
 namespace msim::crowd::stress {
 
@@ -56,16 +55,11 @@ TurbulenceFrame TurbulenceMetrics::measure(const Agents& agents) {
   f.temporalCellsOver = temporal.cellsOver;
   for (std::size_t c = 0; c < temporal_.count(); ++c) peak_[c] = std::max(peak_[c], temporal_[c]);
   for (const std::uint32_t c : windows_.cells())
-    byDensity_.addCell(windows_.sums(c).count / windows_.area(c), temporal_[c] > kTurbulentPressure);
-  const GridSpec<2>& spec = windows_.spec();
-  for (std::size_t i = 0; i < agents.size(); ++i) {
-    if (!(agents.preferredVelocity[i].squaredNorm() > 0.0f)) continue;  // arrived, or standing by choice
-    const Vec2 at = (agents.position[i].cast<double>() - spec.origin) / spec.dx;
-    const int x = std::clamp(static_cast<int>(std::floor(at.x())), 0, spec.res.x() - 1);
-    const int y = std::clamp(static_cast<int>(std::floor(at.y())), 0, spec.res.y() - 1);
-    const std::size_t c = static_cast<std::size_t>(y) * static_cast<std::size_t>(spec.res.x()) + static_cast<std::size_t>(x);
-    byDensity_.addAgent(windows_.sums(c).count / windows_.area(c), agents.velocity[i], agents.preferredVelocity[i]);
-  }
+    byDensity_.addCell(windows_.density(c), temporal_[c] > kTurbulentPressure);
+  for (std::size_t i = 0; i < agents.size(); ++i)
+    if (agents.preferredVelocity[i].squaredNorm() > 0.0f)  // not arrived, nor standing by choice
+      byDensity_.addAgent(windows_.density(windows_.spec().clampedCellIndex(agents.position[i])), agents.velocity[i],
+                          agents.preferredVelocity[i]);
   f.temporalPressureMean = sampler_.meanWhereOccupied(temporal_);
   f.strainRate = stress::strainRate(windows_, strain_);
   f.localSpeed = stress::meanLocalSpeed(windows_);

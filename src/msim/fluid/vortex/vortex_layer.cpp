@@ -34,77 +34,76 @@ void VortexLayer<D>::setDomainSplit(DomainSplit<D>* split) {
   if (split && needsFlowVorticity())
     throw std::invalid_argument("vortex particles on a split domain: seeding with the local flow's vorticity is not distributed");
   split_ = split;
+  if (!split) return;
+  placement_ = split->placement();
+  ownedLo_ = split->ownedLo();
+  ownedHi_ = split->ownedHi();
 }
 
 template <int D>
 void VortexLayer<D>::addForce(MacGrid<D>& velocity, double dt, const Grid<float, D>* solidMask) const {
-  if (!particles_.empty())
-    addVortexForce<D>(particles_, settings_.kernel, dt, velocity, solidMask, split_ ? split_->placement() : BlockPlacement<D>{});
+  if (!particles_.empty()) addVortexForce<D>(particles_, settings_.kernel, dt, velocity, solidMask, placement_);
 }
 
 template <int D>
 bool VortexLayer<D>::owns(const GridSpec<D>& local, const Vec<D>& x) const {
-  const BlockPlacement<D> where = split_->placement();
-  const IVec<D> lo = split_->ownedLo(), hi = split_->ownedHi();
   for (int a = 0; a < D; ++a) {
-    const int global = std::clamp(static_cast<int>(std::floor((x[a] - local.origin[a]) / local.dx)) + where.cellOrigin[a], 0,
-                                  where.globalRes[a] - 1);
-    const int cell = global - where.cellOrigin[a];
-    if (cell < lo[a] || cell >= hi[a]) return false;
+    const int global = std::clamp(static_cast<int>(std::floor((x[a] - local.origin[a]) / local.dx)) + placement_.cellOrigin[a],
+                                  0, placement_.globalRes[a] - 1);
+    const int cell = global - placement_.cellOrigin[a];
+    if (cell < ownedLo_[a] || cell >= ownedHi_[a]) return false;
   }
   return true;
 }
 
 template <int D>
-void VortexLayer<D>::advanceSplit(const MacGrid<D>& velocity, double dt) {
-  auto& x = particles_.positions();
-  const GridSpec<D>& local = velocity.spec();
-  const std::size_t n = x.size();
-  // Advection (advectVortexParticles): each particle's displacement read by its owner.
-  reads_.assign(n * D, 0.0);
-  parallelFor(0, n, [&](std::size_t p) {
+template <typename Read>
+void VortexLayer<D>::readAtOwners(const GridSpec<D>& local, std::size_t width, Read&& read) {
+  const auto& x = particles_.positions();
+  reads_.assign(x.size() * width, 0.0);
+  parallelFor(0, x.size(), [&](std::size_t p) {
     const Vec<D> position = x[p].template cast<double>();
-    if (!owns(local, position)) return;
-    const Vec<D> step = dt * sampleLinear<D>(velocity, position);
-    for (int a = 0; a < D; ++a) reads_[p * D + a] = step[a];
+    if (owns(local, position)) read(position, p, &reads_[p * width]);
   }, 256);
   split_->sumOverRanks(reads_);
-  parallelFor(0, n, [&](std::size_t p) {
-    x[p] = (x[p].template cast<double>() + Vec<D>(Eigen::Map<const Vec<D>>(&reads_[p * D]))).template cast<float>();
+}
+
+template <int D>
+void VortexLayer<D>::advanceSplit(const MacGrid<D>& velocity, double dt) {
+  requireValidVortexTimestep(dt, "VortexLayer::advance");
+  auto& x = particles_.positions();
+  const GridSpec<D>& local = velocity.spec();
+  // Advection (advectVortexParticles): each particle's displacement.
+  readAtOwners(local, D, [&](const Vec<D>& position, std::size_t, double* out) {
+    Eigen::Map<Vec<D>>{out} = dt * sampleLinear<D>(velocity, position);
+  });
+  parallelFor(0, x.size(), [&](std::size_t p) {
+    x[p] = (x[p].template cast<double>() + Eigen::Map<const Vec<D>>(&reads_[p * D])).template cast<float>();
   }, 256);
   // Stretching (stretchVortexParticles) at the new places.
   if constexpr (D == 3) {
     auto& omega = particles_.vorticities();
-    reads_.assign(n * 3, 0.0);
-    parallelFor(0, n, [&](std::size_t p) {
-      const Vec<3> position = x[p].template cast<double>();
-      if (!owns(local, position)) return;
-      const Eigen::Vector3d turned = stretchAndRescale(omega[p], velocityGradientAt<3>(velocity, position), dt);
-      for (int a = 0; a < 3; ++a) reads_[p * 3 + a] = turned[a];
-    }, 256);
-    split_->sumOverRanks(reads_);
-    parallelFor(0, n, [&](std::size_t p) { omega[p] = Eigen::Map<const Eigen::Vector3d>(&reads_[p * 3]); }, 256);
+    readAtOwners(local, 3, [&](const Vec<3>& position, std::size_t p, double* out) {
+      Eigen::Map<Eigen::Vector3d>{out} = stretchAndRescale(omega[p], velocityGradientAt<3>(velocity, position), dt);
+    });
+    parallelFor(0, x.size(), [&](std::size_t p) { omega[p] = Eigen::Map<const Eigen::Vector3d>(&reads_[p * 3]); }, 256);
   }
-  // Solids (vortex_solids.hpp): the owner decides whether a particle stays (1) and where it goes.
+  // Solids (vortex_solids.hpp): whether a particle stays (1) and where it goes.
   if (solidPhi_) {
     const auto phi = [&](const Vec<D>& y) { return double(sampleLinear<D>(*solidPhi_, y)); };
     const bool push = settings_.solids == VortexSolidHandling::PushOut;
-    reads_.assign(n * (D + 1), 0.0);
-    parallelFor(0, n, [&](std::size_t p) {
-      const Vec<D> position = x[p].template cast<double>();
-      if (!owns(local, position)) return;
+    readAtOwners(local, D + 1, [&](const Vec<D>& position, std::size_t, double* out) {
       std::optional<Vec<D>> kept = position;
-      if (phi(position) < 0.0) kept = push ? pushedOutOfSolid<D>(phi, position, 0.5 * solidPhi_->spec().dx, 0.5 * domain_.dx)
-                                           : std::nullopt;
+      if (phi(position) < 0.0)
+        kept = push ? pushedOutOfSolid<D>(phi, position, 0.5 * solidPhi_->spec().dx, 0.5 * domain_.dx) : std::nullopt;
       if (!kept) return;
-      reads_[p * (D + 1)] = 1.0;
-      for (int a = 0; a < D; ++a) reads_[p * (D + 1) + 1 + a] = (*kept)[a];
-    }, 256);
-    split_->sumOverRanks(reads_);
+      out[0] = 1.0;
+      Eigen::Map<Vec<D>>{out + 1} = *kept;
+    });
     // The predicate moves a survivor before removeIf moves it down (as pushVortexParticlesOutOfSolid).
     particles_.removeIf([&](std::size_t p) {
       if (!(reads_[p * (D + 1)] > 0.0)) return true;
-      x[p] = Vec<D>(Eigen::Map<const Vec<D>>(&reads_[p * (D + 1) + 1])).template cast<float>();
+      x[p] = Eigen::Map<const Vec<D>>(&reads_[p * (D + 1) + 1]).template cast<float>();
       return false;
     });
   }
@@ -113,17 +112,16 @@ void VortexLayer<D>::advanceSplit(const MacGrid<D>& velocity, double dt) {
 template <int D>
 void VortexLayer<D>::advance(const MacGrid<D>& velocity, double dt, double time, const Vorticity<D>* flowVorticity) {
   if (split_) {
-    requireValidVortexTimestep(dt, "VortexLayer::advance");
     advanceSplit(velocity, dt);
   } else {
     advectVortexParticles<D>(particles_, velocity, dt);
     stretchVortexParticles<D>(particles_, velocity, dt);
-  }
-  if (solidPhi_ && !split_) {
-    if (settings_.solids == VortexSolidHandling::Delete)
-      removeVortexParticlesInSolid<D>(particles_, *solidPhi_);
-    else
-      pushVortexParticlesOutOfSolid<D>(particles_, *solidPhi_, 0.5 * domain_.dx);
+    if (solidPhi_) {
+      if (settings_.solids == VortexSolidHandling::Delete)
+        removeVortexParticlesInSolid<D>(particles_, *solidPhi_);
+      else
+        pushVortexParticlesOutOfSolid<D>(particles_, *solidPhi_, 0.5 * domain_.dx);
+    }
   }
   removeVortexParticlesOutside<D>(particles_, domain_);
   // The part of the step inside the seeding window.

@@ -73,10 +73,16 @@ class VortexLayer {
   // Whether the block owns the cell holding world position x (cell indices clamped to the global
   // domain, so a particle on its border has an owner).
   bool owns(const GridSpec<D>& local, const Vec<D>& x) const;
+  // reads_ = `width` numbers per particle: read(position, particle, out) on the rank that owns the
+  // particle, zeros elsewhere, summed over the ranks.
+  template <typename Read>
+  void readAtOwners(const GridSpec<D>& local, std::size_t width, Read&& read);
 
   std::optional<Grid<float, D>> solidPhi_;
   std::optional<Vorticity<D>> flowVorticity_;
   DomainSplit<D>* split_ = nullptr;
+  BlockPlacement<D> placement_;  // the block's place, and its own cells, in a split run
+  IVec<D> ownedLo_ = IVec<D>::Zero(), ownedHi_ = IVec<D>::Zero();
   std::vector<double> reads_;  // the split run's per-particle reads, summed over the ranks
 };
 

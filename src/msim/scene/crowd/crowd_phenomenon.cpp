@@ -496,24 +496,11 @@ class CrowdPhenomenon final : public Phenomenon {
     // inflow meets the counter-flow), and the frames' samples of the crowd's cells by density.
     const std::size_t peakCell = static_cast<std::size_t>(std::max_element(peak.data().begin(), peak.data().end()) - peak.data().begin());
     const Vec2 peakAt = peak.position(peak.coord(peakCell));
-    json byDensity = json::array();
-    const crowd::stress::SamplesByDensity& bins = turbulence_.samplesByDensity();
-    for (std::size_t b = 0; b < bins.cells.size(); ++b) {
-      if (bins.cells[b] == 0 && bins.agents[b] == 0) continue;
-      const auto share = [](long part, long whole) { return whole > 0 ? double(part) / double(whole) : 0.0; };
-      byDensity.push_back({{"density_from_per_m2", double(b) * bins.kBinWidth},
-                           {"samples", bins.cells[b]},
-                           {"turbulent_fraction", share(bins.turbulentCells[b], bins.cells[b])},
-                           {"agent_samples", bins.agents[b]},
-                           {"backward_fraction", share(bins.backward[b], bins.agents[b])},
-                           {"rms_forward_mps", bins.agents[b] > 0 ? std::sqrt(bins.forward2[b] / double(bins.agents[b])) : 0.0},
-                           {"rms_sideways_mps", bins.agents[b] > 0 ? std::sqrt(bins.sideways2[b] / double(bins.agents[b])) : 0.0}});
-    }
     return {{"pressure_temporal_peak_per_s2", summary.max},
             {"peak_at_m", {peakAt.x(), peakAt.y()}},
             {"cells_ever_turbulent", summary.cellsOver},
             {"window_s", TurbulenceMetrics::kWindowSeconds},
-            {"by_density", byDensity}};
+            {"by_density", crowd::toJson(turbulence_.samplesByDensity())}};
   }
 
   void writeFundamentalDiagram(const fs::path& file) const {
