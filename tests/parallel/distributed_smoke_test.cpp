@@ -63,8 +63,9 @@ fluid::SmokeSource<3> plumeSource(const GridSpec<3>& spec, double expansion = 0.
 // steps (a moving obstacle: its faces push the smoke through the pressure solve); the plume and
 // the ball in a wind tunnel; the plume from a source whose gas expands (a target divergence); the
 // plume around the ball with viscosity, with the conservative (flux-form MUSCL) scalar transport, and
-// with vortex particles seeded in the vent that spin the air and are pushed out of the ball.
-enum class Variant { Plume, Ball, MovingBall, Tunnel, Expanding, Viscous, Conservative, Vortex };
+// with vortex particles seeded in the vent that spin the air and are pushed out of the ball, seeded
+// with random vorticity or with the flow's own.
+enum class Variant { Plume, Ball, MovingBall, Tunnel, Expanding, Viscous, Conservative, Vortex, VortexLocalFlow };
 const Vec<3> kSwing(0.1, 0.0, 0.04);                   // amplitude [m]
 const double kOmega = 2.0 * 3.14159265358979 / 0.4;   // [1/s]
 
@@ -94,6 +95,7 @@ fluid::SmokeParams<3> variantParams(Variant variant) {
 
 Grid<float, 3> runPlume(const GridSpec<3>& spec, DomainSplit<3>* split, Variant variant) {
   fluid::SmokeSolver<3> solver(spec, variantParams(variant));
+  solver.setDomainSplit(split);  // first, as the smoke phenomenon does: the vortex particles seed on the split
   const auto place = [&](double t) {
     solver.setObstacles(numerics::sampleNodes<3>(spec, [&](const Vec<3>& x) { return ballDistance(x, variant, t); }));
     if (variant == Variant::MovingBall) {
@@ -102,7 +104,7 @@ Grid<float, 3> runPlume(const GridSpec<3>& spec, DomainSplit<3>* split, Variant 
       solver.setObstacleVelocity(velocity);
     }
   };
-  if (variant == Variant::Vortex) {
+  if (variant == Variant::Vortex || variant == Variant::VortexLocalFlow) {
     // Every rank seeds the same particles over the global domain (the same random stream); set
     // before the obstacle, which the layer then takes.
     fluid::VortexLayerSettings<3> v;
@@ -114,11 +116,14 @@ Grid<float, 3> runPlume(const GridSpec<3>& spec, DomainSplit<3>* split, Variant 
     v.initialCount = 100;
     v.rate = 2000.0;
     v.solids = fluid::VortexSolidHandling::PushOut;
+    if (variant == Variant::VortexLocalFlow) {  // the flow's vorticity where it exceeds 5 /s, read by the owners
+      v.seed.vorticity = fluid::SeedVorticity::LocalFlow;
+      v.seed.minimumFlowVorticity = 5.0;
+    }
     solver.setVortexLayer(std::make_unique<fluid::VortexLayer<3>>(v, kGlobal, "test vortex particles"));
   }
   if (variant != Variant::Plume && variant != Variant::Expanding) place(0.0);
   solver.addSource(plumeSource(spec, variant == Variant::Expanding ? 4.0 : 0.0));
-  solver.setDomainSplit(split);
   for (int s = 0; s < kSteps; ++s) {
     EXPECT_LE(kDt, solver.cflTimestep()) << "step " << s;
     if (variant == Variant::MovingBall) place((s + 0.5) * kDt);
@@ -177,6 +182,7 @@ TEST_P(DistributedSmoke, FiftyStepsMatchOneRankWithin1e4Relative) {
                        : variant == Variant::Expanding  ? " from an expanding source"
                        : variant == Variant::Viscous    ? " around a ball, viscous"
                        : variant == Variant::Vortex     ? " around a ball, with vortex particles"
+                       : variant == Variant::VortexLocalFlow ? " around a ball, with vortex particles of the flow's vorticity"
                                                         : " around a ball, scalars in flux form";
     std::printf("smoke plume%s, %d steps on %d ranks: max density %.3f; relative difference to 1 rank %.1e, to the "
                 "serial MG-PCG solver %.1e\n", name, kSteps, worldSize(), scale, toOne, toSerial);
@@ -190,7 +196,8 @@ TEST_P(DistributedSmoke, FiftyStepsMatchOneRankWithin1e4Relative) {
 
 INSTANTIATE_TEST_SUITE_P(Variants, DistributedSmoke,
                          ::testing::Values(Variant::Plume, Variant::Ball, Variant::MovingBall, Variant::Tunnel,
-                                           Variant::Expanding, Variant::Viscous, Variant::Conservative, Variant::Vortex));
+                                           Variant::Expanding, Variant::Viscous, Variant::Conservative, Variant::Vortex,
+                                           Variant::VortexLocalFlow));
 
 }  // namespace
 }  // namespace msim::parallel

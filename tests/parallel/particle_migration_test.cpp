@@ -80,5 +80,74 @@ TEST(ParticleMigration, EveryParticleHasOneOwnerAndNoneIsLostOrDuplicated) {
   EXPECT_TRUE(fromRoot(ok));
 }
 
+// Rows of doubles (the particle level set's markers: position, radius, sign) after jumps: each row
+// on its owner, none lost or duplicated (gathered on rank 0), and every rank's neighbour copies
+// exactly the other ranks' rows within 1 and 2 cells of its own (checked against the gathered set).
+TEST(ParticleMigration, RowsMigrateAndNeighboursReceiveTheRowsNearTheirCells) {
+  const GridBlock<3> block(kGlobal, BlockDecomposition<3>(kGlobal.res, worldSize(), 2, "test"), worldRank(), 2);
+  constexpr int kTotal = 1500, kWidth = 4;  // position and an identity
+  std::vector<double> rows;
+  Rng seeder(11);
+  for (int n = 0; n < kTotal; ++n) {
+    Vec<3> x;
+    for (int a = 0; a < 3; ++a) x[a] = kGlobal.origin[a] + seeder.uniform() * kGlobal.res[a] * kGlobal.dx;
+    if (ownerOf<3>(x, block) == worldRank()) rows.insert(rows.end(), {x[0], x[1], x[2], double(n)});
+  }
+  for (std::size_t at = 0; at < rows.size(); at += kWidth) {
+    Rng r(static_cast<std::uint64_t>(rows[at + 3]));
+    for (int a = 0; a < 3; ++a) rows[at + a] += (2.0 * r.uniform() - 1.0) * 3 * kGlobal.dx;
+  }
+  long sent = static_cast<long>(migrateRows<3>(rows, kWidth, block, MPI_COMM_WORLD));
+  int misplaced = 0;
+  for (std::size_t at = 0; at < rows.size(); at += kWidth)
+    misplaced += ownerOf<3>(Vec<3>(rows[at], rows[at + 1], rows[at + 2]), block) != worldRank();
+  EXPECT_EQ(misplaced, 0) << "rank " << worldRank();
+  // The neighbour copies against the whole set: the rows of other ranks within `reach` cells of
+  // this rank's own (every rank gets every row through rank 0's broadcast).
+  std::vector<double> all = gatherRowsToRoot(rows, MPI_COMM_WORLD);
+  long count = static_cast<long>(all.size());
+  MPI_Bcast(&count, 1, MPI_LONG, 0, MPI_COMM_WORLD);
+  all.resize(static_cast<std::size_t>(count));
+  MPI_Bcast(all.data(), static_cast<int>(count), MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  bool someExpected = false;
+  for (const int reach : {1, 2}) {
+    const std::vector<double> received = neighbourRows<3>(rows, kWidth, reach, block, MPI_COMM_WORLD);
+    const IndexBox<3> own = block.owned();
+    std::vector<double> expected, got;
+    for (std::size_t at = 0; at < all.size(); at += kWidth) {
+      const Vec<3> x(all[at], all[at + 1], all[at + 2]);
+      IVec<3> c;
+      for (int a = 0; a < 3; ++a)
+        c[a] = std::clamp(static_cast<int>(std::floor((x[a] - kGlobal.origin[a]) / kGlobal.dx)), 0, kGlobal.res[a] - 1);
+      const bool near = (c.array() >= own.lo.array() - reach).all() && (c.array() < own.hi.array() + reach).all();
+      if (near && ownerOf<3>(x, block) != worldRank()) expected.push_back(all[at + 3]);
+    }
+    for (std::size_t at = 0; at < received.size(); at += kWidth) got.push_back(received[at + 3]);
+    std::sort(expected.begin(), expected.end());
+    std::sort(got.begin(), got.end());
+    EXPECT_EQ(got, expected) << "rank " << worldRank() << ", reach " << reach;
+    someExpected = someExpected || !expected.empty();
+  }
+  long sentEverywhere = 0;
+  MPI_Reduce(&sent, &sentEverywhere, 1, MPI_LONG, MPI_SUM, 0, MPI_COMM_WORLD);
+  bool ok = !::testing::Test::HasFailure();
+  if (worldRank() == 0) {
+    std::vector<double> ids;
+    for (std::size_t at = 0; at < all.size(); at += kWidth) ids.push_back(all[at + 3]);
+    std::sort(ids.begin(), ids.end());
+    std::vector<double> each(kTotal);
+    std::iota(each.begin(), each.end(), 0.0);
+    EXPECT_EQ(ids, each);
+    if (worldSize() > 1) {
+      EXPECT_GT(sentEverywhere, 0) << "no row crossed a block edge: the test tests nothing";
+      EXPECT_TRUE(someExpected) << "rank 0 has no neighbour rows: the test tests nothing";
+    }
+    ok = ok && !::testing::Test::HasFailure();
+  }
+  int allOk = ok;
+  MPI_Allreduce(MPI_IN_PLACE, &allOk, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  EXPECT_TRUE(allOk);
+}
+
 }  // namespace
 }  // namespace msim::parallel

@@ -4,7 +4,9 @@
 // global grid with ghost layers (placement()); it calls exchange() where a stencil is about to
 // read the neighbours' samples, reduces its scalars over the ranks, and hands the pressure solve,
 // the one global coupling, to project(). Without a split (the default) none of this is called.
+#include <cstddef>
 #include <span>
+#include <vector>
 
 #include "msim/core/block_placement.hpp"
 #include "msim/core/grid.hpp"
@@ -55,6 +57,17 @@ class DomainSplit {
     for (int a = 0; a < D; ++a)
       if (extra[a] > 0 && hi[a] + where.cellOrigin[a] == where.globalRes[a]) hi[a] += 1;
   }
+  // Particles as rows of `width` doubles whose first D entries are the position [m]; a particle
+  // belongs to the rank whose owned cells hold it (outside the domain: the nearest cell's).
+  // migrate: the rows this rank no longer owns go to their owners, those received are appended;
+  // returns how many left. Collective.
+  virtual std::size_t migrate(std::vector<double>& rows, int width) = 0;
+  // Copies of the other ranks' rows lying within `reach` cells of this rank's own cells (at most
+  // the ghost layers; each rank passes its own rows): the neighbours' particles whose stencils
+  // touch an owned cell. Collective.
+  virtual std::vector<double> neighbourRows(const std::vector<double>& rows, int width, int reach) = 0;
+  // Every rank's rows on rank 0, in rank order (elsewhere: empty). Collective.
+  virtual std::vector<double> gatherRows(const std::vector<double>& rows) = 0;
   // Static solids for the pressure solve: the open fraction of every local face. Collective.
   virtual void setOpenFractions(const MacGrid<D>& openFraction) = 0;
   // Moving solids for the pressure solve: their velocity on every local face (the closed parts
@@ -65,6 +78,9 @@ class DomainSplit {
   // The divergence [1/s] project() leaves in each local cell (expanding gas; null: none). The
   // field must outlive the calls to project().
   virtual void setCellTargetDivergence(const Grid<float, D>* perCell) = 0;
+  // A free surface for the pressure solve (liquids): cells with liquidPhi >= 0 are air at
+  // pressure 0, as numerics::PressureProjection::setFreeSurface. Collective.
+  virtual void setFreeSurface(const Grid<float, D>& liquidPhi) = 0;
   // The pressure projection of the global grid on the local velocity:
   // u = u* - (dt / rho) grad p with div u = 0 on the owned cells; `pressure` [Pa] warm-starts
   // the solve and receives p on the owned cells. Collective.

@@ -3,6 +3,7 @@
 // so each task walks contiguous memory. Reductions go through fixed-size blocks combined in a fixed
 // order, so a sum is the same whatever the thread count (deterministic reruns).
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <vector>
 
@@ -82,6 +83,11 @@ double parallelMax(std::size_t n, F&& f) {
         return m;
       },
       [](double a, double b) { return std::max(a, b); });
+}
+
+// Whether every value is finite (a solver's blow-up check), in parallel.
+inline bool allFinite(const std::vector<float>& v) {
+  return parallelMax(v.size(), [&](std::size_t i) { return std::isfinite(v[i]) ? 0.0 : 1.0; }) == 0.0;
 }
 
 }  // namespace msim

@@ -35,4 +35,11 @@ inline int smokeGhostLayers(const numerics::AdvectionSettings& s, double cfl, bo
   return std::max({advectionGhostLayers(s, cfl), kConfinementGhostLayers, conservativeScalars ? kFluxTransportGhostLayers : 0});
 }
 
+// The ghost layers a liquid step (particle level set) reads: its advection's, and ceil(band) for
+// the fast marching's band of distances (Selle ch. 8.1: a band of k valid cells needs ceil(k)
+// layers), within which the velocity extension (narrower than the band) also stays.
+inline int liquidGhostLayers(const numerics::AdvectionSettings& s, double cfl, double bandCells) {
+  return std::max(advectionGhostLayers(s, cfl), static_cast<int>(std::ceil(bandCells)));
+}
+
 }  // namespace msim::parallel

@@ -1,5 +1,7 @@
 #include "msim/parallel/mpi_domain_split.hpp"
 
+#include "msim/parallel/particle_migration.hpp"
+
 namespace msim::parallel {
 
 MpiDomainSplit::MpiDomainSplit(const GridBlock<3>& block, const numerics::DomainSides<3>& sides,
@@ -33,6 +35,16 @@ double MpiDomainSplit::sumOverRanks(double value) {
 void MpiDomainSplit::sumOverRanks(std::span<double> values) {
   if (!values.empty()) MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE, MPI_SUM, comm_);
 }
+
+std::size_t MpiDomainSplit::migrate(std::vector<double>& rows, int width) {
+  return migrateRows<3>(rows, width, block_, comm_);
+}
+
+std::vector<double> MpiDomainSplit::neighbourRows(const std::vector<double>& rows, int width, int reach) {
+  return parallel::neighbourRows<3>(rows, width, reach, block_, comm_);
+}
+
+std::vector<double> MpiDomainSplit::gatherRows(const std::vector<double>& rows) { return gatherRowsToRoot(rows, comm_); }
 
 SplitSolveStats MpiDomainSplit::project(MacGrid<3>& velocity, Grid<float, 3>& pressure, double dt, double density) {
   return projection_.project(velocity, pressure, dt, density);

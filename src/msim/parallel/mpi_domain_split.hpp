@@ -30,6 +30,10 @@ class MpiDomainSplit final : public DomainSplit<3> {
   double maxOverRanks(double value) override;
   double sumOverRanks(double value) override;
   void sumOverRanks(std::span<double> values) override;
+  std::size_t migrate(std::vector<double>& rows, int width) override;
+  std::vector<double> neighbourRows(const std::vector<double>& rows, int width, int reach) override;
+  std::vector<double> gatherRows(const std::vector<double>& rows) override;
+  void setFreeSurface(const Grid<float, 3>& liquidPhi) override { projection_.setFreeSurface(liquidPhi); }
   void setOpenFractions(const MacGrid<3>& openFraction) override { projection_.setOpenFractions(openFraction); }
   void setSolidVelocity(const MacGrid<3>& solidVelocity) override { projection_.setSolidVelocity(solidVelocity); }
   void setWallNormalVelocity(int axis, int side, double velocity) override {

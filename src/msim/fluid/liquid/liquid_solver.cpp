@@ -1,6 +1,7 @@
 #include "msim/fluid/liquid/liquid_solver.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -40,6 +41,23 @@ LiquidSolver<D>::LiquidSolver(const GridSpec<D>& spec, const LiquidParams<D>& pa
     facePhi_[a] = Grid<float, D>(spec, u.size(), u.offset());
     known_[a].assign(u.count(), 0);
   }
+  globalRes_ = ownedHi_ = spec.res;
+}
+
+template <int D>
+void LiquidSolver<D>::setDomainSplit(DomainSplit<D>* split) {
+  if (split && (params_.tracker != InterfaceTracker::ParticleLevelSet || vortex_ || steps_ > 0 || started_))
+    throw std::invalid_argument("liquid solver: a split run tracks the surface with the particle level set, has no "
+                                "vortex particles and is split before its first step");
+  split_ = split;
+  const BlockPlacement<D> where = split ? split->placement() : BlockPlacement<D>{};
+  cellOrigin_ = where.whole() ? IVec<D>::Zero() : where.cellOrigin;
+  globalRes_ = where.whole() ? spec_.res : where.globalRes;
+  ownedLo_ = split ? split->ownedLo() : IVec<D>::Zero();
+  ownedHi_ = split ? split->ownedHi() : spec_.res;
+  advector_.setPlacement(where);
+  particles_.setBlock(where, ownedLo_, ownedHi_);
+  if (split) controlDivergenceField_ = Grid<float, D>(spec_, 0.0f);
 }
 
 template <int D>
@@ -57,6 +75,7 @@ void LiquidSolver<D>::setObstacles(const Grid<float, D>& nodalSolidPhi) {
     });
   }
   projection_.setSolids(open);
+  if (split_) split_->setOpenFractions(projection_.faceWeights());
   solidDistance_ = nodalSolidPhi;
   if (vortex_) vortex_->setSolid(nodalSolidPhi);
   // phi continues three cells into the obstacles (a 90-degree contact, as the domain's clamped
@@ -85,11 +104,12 @@ void LiquidSolver<D>::addLiquid(const Grid<float, D>& cellPhi, const Vec<D>& vel
   // each pass reading the last one's values, so cells along an edge or in a corner get it too.
   Grid<float, D> body = cellPhi;
   for (int a = 0; a < D; ++a) {
-    if (spec_.res[a] < 3) continue;  // the inner neighbours must not be side cells themselves
+    if (globalRes_[a] < 3) continue;  // the inner neighbours must not be side cells themselves
     parallelForCells(body, [&](const IVec<D>& c, std::size_t i) {
-      if (c[a] != 0 && c[a] != spec_.res[a] - 1) return;
+      const int g = c[a] + cellOrigin_[a];  // a split run's block: in the global grid
+      if (g != 0 && g != globalRes_[a] - 1) return;
       IVec<D> inner = c;
-      inner[a] += c[a] == 0 ? 1 : -1;
+      inner[a] += g == 0 ? 1 : -1;
       if (body[i] < 0.0f) body[i] = std::min(body[i], body(inner));
     });
   }
@@ -108,6 +128,7 @@ void LiquidSolver<D>::addLiquid(const Grid<float, D>& cellPhi, const Vec<D>& vel
 template <int D>
 double LiquidSolver<D>::emit(const Grid<float, D>& region, const Vec<D>& velocity) {
   if (!region.sameLayout(phi_)) throw std::invalid_argument("liquid solver: emit needs a cell-centred region");
+  if (split_) throw std::invalid_argument("liquid solver: emitters do not run split among processes");
   if (!started_) start();
   ScopedStage s(timers_, "liquid: sources");
   for (int a = 0; a < D; ++a) {
@@ -155,6 +176,7 @@ void LiquidSolver<D>::markWallInflow(const Grid<float, D>& region, const Vec<D>&
 template <int D>
 double LiquidSolver<D>::drain(const Grid<float, D>& region) {
   if (!region.sameLayout(phi_)) throw std::invalid_argument("liquid solver: drain needs a cell-centred region");
+  if (split_) throw std::invalid_argument("liquid solver: sinks do not run split among processes");
   if (!started_) start();
   ScopedStage s(timers_, "liquid: sinks");
   if (params_.tracker == InterfaceTracker::Flip) return flip_.particleVolume() * double(flip_.removeInside(region));
@@ -183,13 +205,28 @@ void LiquidSolver<D>::restore(const Grid<float, D>& phi, const MacGrid<D>& veloc
   }
   steps_ = steps;
   started_ = true;
-  if (params_.tracker == InterfaceTracker::ParticleLevelSet && particles_.size() == 0) particles_.seed(phi_);
+  const bool saved = particles_.size() > 0;  // the same on every process: each read the whole frame
+  if (split_ && saved) {  // every process was given every saved particle: it keeps its own
+    particles_.takeRowsIf([&](const Vec<D>& x) { return !ownedCell(phi_.coord(spec_.clampedCellIndex(x))); });
+  }
+  if (params_.tracker == InterfaceTracker::ParticleLevelSet && !saved) particles_.seed(phi_);
+  if (split_) exchangeParticles();
   resetVolumeControl();
 }
 
 template <int D>
+double LiquidSolver<D>::liquidVolume() const {
+  if (!split_) return numerics::enclosedVolume(phi_, &solid_);
+  const double eps = 1.5 * spec_.dx;
+  const double own = spec_.cellVolume() * parallelSum(phi_.count(), [&](std::size_t i) {
+                       return ownedCell(phi_.coord(i)) && solid_[i] <= 0.5f ? numerics::smearedInside(phi_[i], eps) : 0.0;
+                     });
+  return split_->sumOverRanks(own);
+}
+
+template <int D>
 void LiquidSolver<D>::resetVolumeControl() {
-  targetVolume_ = numerics::enclosedVolume(phi_, &solid_);
+  targetVolume_ = liquidVolume();
   volumeErrorIntegral_ = leakRate_ = flipVolumeScale_ = 0.0;
   controlStarted_ = false;
 }
@@ -197,7 +234,11 @@ void LiquidSolver<D>::resetVolumeControl() {
 template <int D>
 void LiquidSolver<D>::reinitialize() {
   intoSolids_.extend(phi_);
+  // Split: the block marches with its ghost layers filled (Selle ch. 8.1: ceil(band) layers give
+  // the band's distances), then the ghosts take their owners' values.
+  if (split_) split_->exchange(phi_);
   numerics::reinitializeFastMarching(phi_, params_.bandCells);
+  if (split_) split_->exchange(phi_);
 }
 
 template <int D>
@@ -212,6 +253,7 @@ void LiquidSolver<D>::start() {
     reinitialize();
   } else {
     particles_.seed(phi_);
+    if (split_) exchangeParticles();  // the attraction may carry new particles over the block's edge
   }
   resetVolumeControl();
   started_ = true;
@@ -223,11 +265,13 @@ double LiquidSolver<D>::boundaryOutflow(double dt) const {
   const double faceArea = spec_.cellVolume() / spec_.dx;
   for (int a = 0; a < D; ++a) {
     // The faces of one side: the layer f[a] = 0 or res[a] of component a, visited as a grid of the
-    // other axes.
+    // other axes (a split run: the owned ones of the domain's sides).
     IVec<D> layerSize = spec_.res;
     layerSize[a] = 1;
     const auto& u = velocity_.component(a);
     for (int side = 0; side < 2; ++side) {
+      const bool domainSide = side == 0 ? cellOrigin_[a] == 0 : cellOrigin_[a] + spec_.res[a] == globalRes_[a];
+      if (!domainSide) continue;
       const double outward = side == 0 ? -1.0 : 1.0;
       std::size_t faces = 1;
       for (int b = 0; b < D; ++b) faces *= static_cast<std::size_t>(layerSize[b]);
@@ -238,10 +282,13 @@ double LiquidSolver<D>::boundaryOutflow(double dt) const {
           k /= static_cast<std::size_t>(layerSize[b]);
         }
         f[a] = side == 0 ? 0 : spec_.res[a];
+        for (int b = 0; b < D; ++b)
+          if (b != a && (f[b] < ownedLo_[b] || f[b] >= ownedHi_[b])) return 0.0;
         return faceTouches(a, f, [&](std::size_t cell) { return liquidCell(cell); }) ? outward * u(f) : 0.0;
       });
     }
   }
+  if (split_) outflow = split_->sumOverRanks(outflow);
   return outflow * faceArea * dt;
 }
 
@@ -281,7 +328,8 @@ double LiquidSolver<D>::volumeControlDivergence(double dt) {
 
 template <int D>
 double LiquidSolver<D>::cflTimestep() const {
-  const double speed = maxFaceSpeed(velocity_) + std::sqrt(params_.gravity.norm() * spec_.dx);
+  const double fastest = split_ ? split_->maxOverRanks(maxFaceSpeed(velocity_)) : maxFaceSpeed(velocity_);
+  const double speed = fastest + std::sqrt(params_.gravity.norm() * spec_.dx);
   return speed > 0.0 ? params_.cfl * spec_.dx / speed : std::numeric_limits<double>::infinity();
 }
 
@@ -312,6 +360,51 @@ void LiquidSolver<D>::moveSurface(double dt) {
 }
 
 template <int D>
+void LiquidSolver<D>::exchangeParticles() {
+  constexpr int width = numerics::ParticleLevelSet<D>::kRowWidth;
+  const auto cellOf = [&](const Vec<D>& x) { return phi_.coord(spec_.clampedCellIndex(x)); };
+  std::vector<double> moved = particles_.takeRowsIf([&](const Vec<D>& x) { return !ownedCell(cellOf(x)); });
+  split_->migrate(moved, width);
+  particles_.appendRows(moved);
+  // A particle's correction touches the cell centres around it, in its cell and the next ones: the
+  // neighbours need the particles in the owned cells along a block edge between them (not on the
+  // domain's sides, where this block stores no ghosts).
+  IVec<D> innerLo = ownedLo_, innerHi = ownedHi_;
+  for (int a = 0; a < D; ++a) {
+    if (ownedLo_[a] > 0) innerLo[a] += 1;
+    if (ownedHi_[a] < spec_.res[a]) innerHi[a] -= 1;
+  }
+  particles_.setNeighbours(split_->neighbourRows(particles_.rowsIf([&](const Vec<D>& x) {
+    const IVec<D> c = cellOf(x);
+    return (c.array() < innerLo.array()).any() || (c.array() >= innerHi.array()).any();
+  }), width, 1));
+}
+
+template <int D>
+void LiquidSolver<D>::moveSplitSurface(double dt) {
+  // Enright's step as moveSurface's, with the ghosts refilled before each stencil reads them: the
+  // escaped test and the correction read phi around particles in the ghost layers, the radii and
+  // reseeding around the own particles. An owned cell is corrected by every particle near it (its
+  // own and the neighbours' copies, max and min in any order), so the corrections equal the serial
+  // ones; the fast marching differs by what lies beyond the ghost layers.
+  ScopedStage s(timers_, "liquid: surface");
+  split_->exchange(phi_);
+  advector_.advect(phi_, velocity_, dt);
+  particles_.advect(velocity_, dt);
+  exchangeParticles();
+  split_->exchange(phi_);
+  lastEscaped_ = particles_.correct(phi_);
+  reinitialize();
+  particles_.correct(phi_);
+  split_->exchange(phi_);
+  particles_.adjustRadii(phi_);
+  if ((steps_ + 1) % params_.reseedInterval == 0) {
+    particles_.reseed(phi_);
+    exchangeParticles();
+  }
+}
+
+template <int D>
 void LiquidSolver<D>::moveFlipSurface(double dt) {
   ScopedStage s(timers_, "liquid: surface");
   flip_.advect(velocity_, dt, solidDistance_ ? &*solidDistance_ : nullptr, solid_, params_.sides);
@@ -322,6 +415,7 @@ void LiquidSolver<D>::moveFlipSurface(double dt) {
 template <int D>
 void LiquidSolver<D>::extendVelocity() {
   ScopedStage s(timers_, "liquid: extend velocity");
+  if (split_) split_->exchange(velocity_);  // the given faces in the ghost layers: their owners' values
   const MacGrid<D>& weights = projection_.faceWeights();
   const MacGrid<D>& solidVelocity = projection_.solidVelocity();
   for (int a = 0; a < D; ++a) {
@@ -342,6 +436,7 @@ void LiquidSolver<D>::extendVelocity() {
         u[i] = 0.0f;
     });
   }
+  if (split_) split_->exchange(velocity_);
 }
 
 template <int D>
@@ -359,7 +454,10 @@ void LiquidSolver<D>::step(double dt) {
     extendVelocity();
     gridVelocityBefore_ = velocity_;
   } else {
-    moveSurface(dt);
+    if (split_)
+      moveSplitSurface(dt);
+    else
+      moveSurface(dt);
     ScopedStage s(timers_, "liquid: advect velocity");
     advector_.advect(velocity_, velocity_, dt);
   }
@@ -382,13 +480,23 @@ void LiquidSolver<D>::step(double dt) {
     parallelFor(0, phi_.count(), [&](std::size_t i) {  // solids hold no liquid (their faces are closed)
       pressurePhi_[i] = solid_[i] > 0.5f ? std::max(phi_[i], static_cast<float>(0.5 * spec_.dx)) : phi_[i];
     });
-    projection_.setFreeSurface(pressurePhi_);
-    volume_ = numerics::enclosedVolume(phi_, &solid_);  // phi is final for this step from here on
+    volume_ = liquidVolume();  // phi is final for this step from here on
     controlDivergence_ = volumeControlDivergence(dt);
-    projection_.setTargetDivergence(controlDivergence_);
-    if (inflowThisStep_ || inflowApplied_) projection_.setWallFaceVelocity(inflowThisStep_ ? &*wallInflow_ : nullptr);
-    inflowApplied_ = inflowThisStep_;
-    lastSolve_ = projection_.project(velocity_, dt, params_.density);
+    if (split_) {
+      split_->setFreeSurface(pressurePhi_);
+      controlDivergenceField_.fill(static_cast<float>(controlDivergence_));
+      split_->setCellTargetDivergence(&controlDivergenceField_);
+      const SplitSolveStats solve = split_->project(velocity_, projection_.pressure(), dt, params_.density);
+      lastSolve_.iterations = solve.iterations;
+      lastSolve_.relativeResidual = solve.relativeResidual;
+      lastSolve_.converged = solve.converged;
+    } else {
+      projection_.setFreeSurface(pressurePhi_);
+      projection_.setTargetDivergence(controlDivergence_);
+      if (inflowThisStep_ || inflowApplied_) projection_.setWallFaceVelocity(inflowThisStep_ ? &*wallInflow_ : nullptr);
+      inflowApplied_ = inflowThisStep_;
+      lastSolve_ = projection_.project(velocity_, dt, params_.density);
+    }
   }
   extendVelocity();
   if (flip) {
@@ -402,10 +510,20 @@ void LiquidSolver<D>::step(double dt) {
   }
   ++steps_;
   time_ += dt;
+  if (split_) checkFiniteSplit();
+}
+
+template <int D>
+void LiquidSolver<D>::checkFiniteSplit() const {
+  bool finite = allFinite(phi_.data());
+  for (int a = 0; a < D; ++a) finite = finite && allFinite(velocity_.component(a).data());
+  if (split_->maxOverRanks(finite ? 0.0 : 1.0) != 0.0)
+    throw SimulationError(fmt::format("liquid: non-finite phi or velocity at step {} (on some process)", steps_));
 }
 
 template <int D>
 void LiquidSolver<D>::setVortexLayer(std::unique_ptr<VortexLayer<D>> layer) {
+  if (layer && split_) throw std::invalid_argument("liquid solver: vortex particles do not run split among processes");
   vortex_ = std::move(layer);
   if (!vortex_) return;
   if (solidDistance_) vortex_->setSolid(*solidDistance_);
@@ -428,8 +546,9 @@ void LiquidSolver<D>::dropVortexParticlesInAir() {
 
 template <int D>
 LiquidStatistics LiquidSolver<D>::statistics() const {
+  // A split run sums over the processes' own cells and particles (every process calls this).
   LiquidStatistics s;
-  s.volume = numerics::enclosedVolume(phi_, &solid_);
+  s.volume = liquidVolume();
   s.targetVolume = targetVolume_;
   s.controlDivergence = controlDivergence_;
   for (int a = 0; a < D; ++a) {
@@ -439,8 +558,9 @@ LiquidStatistics LiquidSolver<D>::statistics() const {
                             return wet ? std::abs(u[i]) : 0.0f;
                           }));
   }
+  const auto ownLiquidCell = [&](std::size_t cell) { return liquidCell(cell) && ownedCell(phi_.coord(cell)); };
   s.kineticEnergy = 0.5 * params_.density * spec_.cellVolume() * parallelSum(phi_.count(), [&](std::size_t i) {
-                      if (!liquidCell(i)) return 0.0;
+                      if (!ownLiquidCell(i)) return 0.0;
                       const IVec<D> c = phi_.coord(i);
                       double e = 0.0;
                       for (int a = 0; a < D; ++a) {
@@ -455,11 +575,20 @@ LiquidStatistics LiquidSolver<D>::statistics() const {
   s.pressureConverged = lastSolve_.converged;
   Vorticity<D> vorticity(spec_);
   computeVorticity(velocity_, vorticity);
-  s.enstrophy = enstrophy<D>(vorticity, [&](std::size_t cell) { return liquidCell(cell); });
+  s.enstrophy = enstrophy<D>(vorticity, ownLiquidCell);
   s.vortexParticles = vortex_ ? vortex_->particles().size() : 0;
   s.particles = params_.tracker == InterfaceTracker::Flip ? flip_.size() : particles_.size();
   s.escaped = lastEscaped_;
   s.step = steps_;
+  if (split_) {
+    s.maxSpeed = split_->maxOverRanks(s.maxSpeed);
+    std::array<double, 4> sums = {s.kineticEnergy, s.enstrophy, double(s.particles), double(s.escaped)};
+    split_->sumOverRanks(sums);
+    s.kineticEnergy = sums[0];
+    s.enstrophy = sums[1];
+    s.particles = static_cast<std::size_t>(sums[2]);
+    s.escaped = static_cast<std::size_t>(sums[3]);
+  }
   return s;
 }
 

@@ -30,6 +30,12 @@
 // Vortex particles (setVortexLayer; Selle ch. 3.3-3.5, fluid/vortex) add their force with gravity
 // in step 3 and move with the velocity after step 5; those that leave the liquid are deleted (the
 // air carries no vorticity: Fig. 3.3's river eddies live in the water).
+// Split among processes (setDomainSplit; Selle ch. 8.1) the solver runs on one block of the grid
+// with ghost layers: phi and the velocity are exchanged before the stencils that read the
+// neighbours' cells, each marker particle lives on the process whose cells hold it (migrated after
+// every move, the neighbours' copies near the block read by the correction), the fast marching
+// and the velocity extension run on the block with its ghosts, the volume and the statistics are
+// summed over the processes and the pressure is solved by the split (hypre).
 // Obstacles are solids given by a signed distance at the grid nodes, as for smoke; moving ones are
 // placed again before every step with the velocity of the solid on every face, which the pressure
 // uses as the boundary condition (the solid pushes the liquid through its faces' closed parts). Storage
@@ -40,6 +46,7 @@
 #include <optional>
 #include <vector>
 
+#include "msim/core/domain_split.hpp"
 #include "msim/core/grid.hpp"
 #include "msim/core/mac_grid.hpp"
 #include "msim/core/timer.hpp"
@@ -123,7 +130,10 @@ class LiquidSolver {
   // cells whose centre is inside are solid. Moving obstacles: call it before every step, with
   // setObstacleVelocity (the velocity of the solid on every face, 0 by default).
   void setObstacles(const Grid<float, D>& nodalSolidPhi);
-  void setObstacleVelocity(const MacGrid<D>& solidVelocity) { projection_.setSolidVelocity(solidVelocity); }
+  void setObstacleVelocity(const MacGrid<D>& solidVelocity) {
+    projection_.setSolidVelocity(solidVelocity);
+    if (split_) split_->setSolidVelocity(solidVelocity);
+  }
   // Adds liquid where cellPhi < 0 (the union with what is there), moving at `velocity`. Before
   // the first step: the particles are seeded then.
   void addLiquid(const Grid<float, D>& cellPhi, const Vec<D>& velocity = Vec<D>::Zero());
@@ -149,6 +159,11 @@ class LiquidSolver {
   // and the speed) when that would exceed params.maxSubsteps. Returns the number of substeps.
   int advance(double dt);
 
+  // Splits the liquid among processes (null: one process): the solver's grid is this process's
+  // block (split->localSpec()). Call it before the obstacles and the liquid are added. The particle
+  // level set tracker only, without emitters, sinks or vortex particles (std::invalid_argument).
+  void setDomainSplit(DomainSplit<D>* split);
+
   // Vortex particles in the liquid (null: none); the initial ones are seeded here, so call it
   // after the obstacles and the initial liquid are in place.
   void setVortexLayer(std::unique_ptr<VortexLayer<D>> layer);
@@ -160,6 +175,8 @@ class LiquidSolver {
   double time() const { return time_; }
 
   LiquidStatistics statistics() const;
+  // The liquid's volume now [m^3] (a split run: over every process; collective).
+  double liquidVolume() const;
   // The liquid's volume at the end of the last step [m^3] (measured once its surface had moved;
   // the rest of a step leaves phi as it is).
   double volume() const { return volume_; }
@@ -200,6 +217,16 @@ class LiquidSolver {
   template <typename Edit>
   double editLevelSet(const Grid<float, D>& region, Edit&& edit);
   bool liquidCell(std::size_t cell) const { return phi_[cell] < 0.0f && solid_[cell] <= 0.5f; }
+  // Whether local cell c is this process's own (every cell without a split).
+  bool ownedCell(const IVec<D>& c) const {
+    return (c.array() >= ownedLo_.array()).all() && (c.array() < ownedHi_.array()).all();
+  }
+  // A split run: the marker particles that left this block go to their owners, and the
+  // neighbours' particles near it are copied for the correction.
+  void exchangeParticles();
+  void moveSplitSurface(double dt);
+  // A split run: every process stops together when one holds a non-finite value.
+  void checkFiniteSplit() const;
   // The vortex particles' move (VortexLayer::advance), then those outside the liquid go.
   void advanceVortexParticles(double dt);
   void dropVortexParticlesInAir();
@@ -209,6 +236,10 @@ class LiquidSolver {
 
   GridSpec<D> spec_;
   LiquidParams<D> params_;
+  DomainSplit<D>* split_ = nullptr;
+  IVec<D> cellOrigin_ = IVec<D>::Zero(), globalRes_;  // the block's place in the global grid
+  IVec<D> ownedLo_ = IVec<D>::Zero(), ownedHi_;       // its own cells (local coordinates)
+  Grid<float, D> controlDivergenceField_;             // a split run: volume control's target per cell
   Grid<float, D> phi_;
   Grid<float, D> solid_;
   std::optional<Grid<float, D>> solidDistance_;  // the obstacles' nodal signed distance, if any

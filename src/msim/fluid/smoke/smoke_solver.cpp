@@ -10,14 +10,6 @@
 
 namespace msim::fluid {
 
-namespace {
-
-bool allFinite(const std::vector<float>& v) {
-  return parallelMax(v.size(), [&](std::size_t i) { return std::isfinite(v[i]) ? 0.0 : 1.0; }) == 0.0;
-}
-
-}  // namespace
-
 template <int D>
 SmokeSolver<D>::SmokeSolver(const GridSpec<D>& spec, const SmokeParams<D>& params)
     : spec_(spec),

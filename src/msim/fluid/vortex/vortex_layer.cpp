@@ -26,13 +26,26 @@ template <int D>
 void VortexLayer<D>::seedInitial(const Vorticity<D>* flowVorticity) {
   if (settings_.initialCount == 0) return;
   Rng rng(settings_.randomSeed ^ 0x5eedULL);
-  seedVortexParticles<D>(particles_, settings_.seed, domain_, settings_.initialCount, rng, flowVorticity);
+  if (split_ && needsFlowVorticity())
+    seedVortexParticles<D>(particles_, settings_.seed, domain_, settings_.initialCount, rng, flowAtOwners(flowVorticity));
+  else
+    seedVortexParticles<D>(particles_, settings_.seed, domain_, settings_.initialCount, rng, flowVorticity);
+}
+
+template <int D>
+FlowVorticitySampler<D> VortexLayer<D>::flowAtOwners(const Vorticity<D>* local) {
+  if (!local) throw std::invalid_argument("vortex particles: LocalFlow seeding needs the grid's vorticity");
+  return [this, local](const std::vector<Vec<D>>& positions, std::vector<VortexVector<D>>& out) {
+    constexpr std::size_t width = VortexVector<D>::RowsAtCompileTime;
+    readAt(local->spec(), positions.size(), [&](std::size_t n) { return positions[n]; }, width,
+           [&](const Vec<D>& x, std::size_t, double* read) { Eigen::Map<VortexVector<D>>{read} = flowVorticityAt<D>(*local, x); });
+    out.resize(positions.size());
+    for (std::size_t n = 0; n < positions.size(); ++n) out[n] = Eigen::Map<const VortexVector<D>>(&reads_[n * width]);
+  };
 }
 
 template <int D>
 void VortexLayer<D>::setDomainSplit(DomainSplit<D>* split) {
-  if (split && needsFlowVorticity())
-    throw std::invalid_argument("vortex particles on a split domain: seeding with the local flow's vorticity is not distributed");
   split_ = split;
   if (!split) return;
   placement_ = split->placement();
@@ -57,15 +70,23 @@ bool VortexLayer<D>::owns(const GridSpec<D>& local, const Vec<D>& x) const {
 }
 
 template <int D>
-template <typename Read>
-void VortexLayer<D>::readAtOwners(const GridSpec<D>& local, std::size_t width, Read&& read) {
-  const auto& x = particles_.positions();
-  reads_.assign(x.size() * width, 0.0);
-  parallelFor(0, x.size(), [&](std::size_t p) {
-    const Vec<D> position = x[p].template cast<double>();
+template <typename PositionOf, typename Read>
+void VortexLayer<D>::readAt(const GridSpec<D>& local, std::size_t count, PositionOf&& positionOf, std::size_t width,
+                            Read&& read) {
+  reads_.assign(count * width, 0.0);
+  parallelFor(0, count, [&](std::size_t p) {
+    const Vec<D> position = positionOf(p);
     if (owns(local, position)) read(position, p, &reads_[p * width]);
   }, 256);
   split_->sumOverRanks(reads_);
+}
+
+template <int D>
+template <typename Read>
+void VortexLayer<D>::readAtOwners(const GridSpec<D>& local, std::size_t width, Read&& read) {
+  const auto& x = particles_.positions();
+  readAt(local, x.size(), [&](std::size_t p) { return Vec<D>(x[p].template cast<double>()); }, width,
+         std::forward<Read>(read));
 }
 
 template <int D>
@@ -126,7 +147,11 @@ void VortexLayer<D>::advance(const MacGrid<D>& velocity, double dt, double time,
   removeVortexParticlesOutside<D>(particles_, domain_);
   // The part of the step inside the seeding window.
   const double from = std::max(time, settings_.start), to = std::min(time + dt, settings_.end);
-  if (to > from) emitter_.emit(particles_, to - from, flowVorticity);
+  if (!(to > from)) return;
+  if (split_ && needsFlowVorticity())
+    emitter_.emit(particles_, to - from, flowAtOwners(flowVorticity));
+  else
+    emitter_.emit(particles_, to - from, flowVorticity);
 }
 
 template <int D>

@@ -52,7 +52,8 @@ class VortexLayer {
   // velocity, solid mask and signed distance it is given are then the block's (with ghosts).
   // Every rank keeps every particle and moves them alike: the rank whose owned cells hold a
   // particle reads the flow (and the solid) there, and the ranks sum what they read, one reduction
-  // per read. The seeding's local-flow vorticity is not distributed (std::invalid_argument).
+  // per read; seeding with the local flow's vorticity reads it so at the drawn positions. Set it
+  // before seedInitial.
   void setDomainSplit(DomainSplit<D>* split);
 
   const VortexParticles<D>& particles() const { return particles_; }
@@ -73,10 +74,14 @@ class VortexLayer {
   // Whether the block owns the cell holding world position x (cell indices clamped to the global
   // domain, so a particle on its border has an owner).
   bool owns(const GridSpec<D>& local, const Vec<D>& x) const;
-  // reads_ = `width` numbers per particle: read(position, particle, out) on the rank that owns the
-  // particle, zeros elsewhere, summed over the ranks.
+  // reads_ = `width` numbers per position: read(position, index, out) on the rank that owns the
+  // position, zeros elsewhere, summed over the ranks; readAtOwners: at the particles.
+  template <typename PositionOf, typename Read>
+  void readAt(const GridSpec<D>& local, std::size_t count, PositionOf&& positionOf, std::size_t width, Read&& read);
   template <typename Read>
   void readAtOwners(const GridSpec<D>& local, std::size_t width, Read&& read);
+  // The split run's LocalFlow seeding: the block's vorticity `local` read on the owning ranks.
+  FlowVorticitySampler<D> flowAtOwners(const Vorticity<D>* local);
 
   std::optional<Grid<float, D>> solidPhi_;
   std::optional<Vorticity<D>> flowVorticity_;

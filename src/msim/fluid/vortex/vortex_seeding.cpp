@@ -53,15 +53,20 @@ VortexVector<D> azimuthalDirection(const Vec<D>& x, const Vec<D>& centre, int up
   }
 }
 
+// Adds `count` particles; LocalFlow reads the flow through `flow` (null: not needed).
 template <int D>
-VortexVector<D> sampleFlowVorticity(const Vorticity<D>& grid, const Vec<D>& x) {
+std::size_t seed(VortexParticles<D>& particles, const VortexSeedSettings<D>& settings, const GridSpec<D>& domain,
+                 std::size_t count, Rng& rng, const FlowVorticitySampler<D>* flow);
+
+}  // namespace
+
+template <int D>
+VortexVector<D> flowVorticityAt(const Vorticity<D>& grid, const Vec<D>& x) {
   const Vec<D> s = grid.toSampleSpace(x);
   std::array<LinearTap, D> taps;
   for (int a = 0; a < D; ++a) taps[a] = clampedTap(s[a], grid.size()[a], static_cast<std::size_t>(grid.stride(a)));
   return blendCorners<D>(taps, grid.data().data()).template cast<double>();
 }
-
-}  // namespace
 
 template <int D>
 void VortexSeedSettings<D>::validate(const GridSpec<D>& domain, const std::string& context) const {
@@ -91,19 +96,54 @@ template <int D>
 std::size_t seedVortexParticles(VortexParticles<D>& particles, const VortexSeedSettings<D>& settings,
                                 const GridSpec<D>& domain, std::size_t count, Rng& rng,
                                 const Vorticity<D>* flowVorticity) {
+  if (settings.vorticity != SeedVorticity::LocalFlow) return seed<D>(particles, settings, domain, count, rng, nullptr);
+  if (!flowVorticity) throw std::invalid_argument("seedVortexParticles: LocalFlow seeding needs the grid's vorticity");
+  if (!(flowVorticity->spec() == domain && flowVorticity->size() == domain.res))
+    throw std::invalid_argument("seedVortexParticles: the vorticity grid is not cell-centred on the domain");
+  const FlowVorticitySampler<D> flow = [&](const std::vector<Vec<D>>& positions, std::vector<VortexVector<D>>& out) {
+    out.resize(positions.size());
+    for (std::size_t n = 0; n < positions.size(); ++n) out[n] = flowVorticityAt<D>(*flowVorticity, positions[n]);
+  };
+  return seed<D>(particles, settings, domain, count, rng, &flow);
+}
+
+template <int D>
+std::size_t seedVortexParticles(VortexParticles<D>& particles, const VortexSeedSettings<D>& settings,
+                                const GridSpec<D>& domain, std::size_t count, Rng& rng,
+                                const FlowVorticitySampler<D>& flow) {
+  return seed<D>(particles, settings, domain, count, rng, &flow);
+}
+
+namespace {
+
+template <int D>
+std::size_t seed(VortexParticles<D>& particles, const VortexSeedSettings<D>& settings, const GridSpec<D>& domain,
+                 std::size_t count, Rng& rng, const FlowVorticitySampler<D>* flow) {
   settings.validate(domain);
-  if (settings.vorticity == SeedVorticity::LocalFlow) {
-    if (!flowVorticity) throw std::invalid_argument("seedVortexParticles: LocalFlow seeding needs the grid's vorticity");
-    if (!(flowVorticity->spec() == domain && flowVorticity->size() == domain.res))
-      throw std::invalid_argument("seedVortexParticles: the vorticity grid is not cell-centred on the domain");
-  }
-  const Vec<D> centre = 0.5 * (settings.regionMin + settings.regionMax);
-  particles.reserve(particles.size() + count);
-  std::size_t added = 0;
-  for (std::size_t n = 0; n < count; ++n) {
+  const auto position = [&] {
     Vec<D> x;
     for (int a = 0; a < D; ++a) x[a] = rng.uniform(settings.regionMin[a], settings.regionMax[a]);
-    x = x.template cast<float>().template cast<double>();  // the stored position, so omega fits it exactly
+    return Vec<D>(x.template cast<float>().template cast<double>());  // the stored position, so omega fits it exactly
+  };
+  particles.reserve(particles.size() + count);
+  std::size_t added = 0;
+  if (settings.vorticity == SeedVorticity::LocalFlow) {
+    // The positions only are drawn, then the flow read at all of them (a split run reads them on
+    // the owning ranks with one reduction); no particle where the flow is too calm.
+    std::vector<Vec<D>> positions(count);
+    for (auto& x : positions) x = position();
+    std::vector<VortexVector<D>> omega;
+    (*flow)(positions, omega);
+    for (std::size_t n = 0; n < count; ++n) {
+      if (!(omega[n].norm() > settings.minimumFlowVorticity)) continue;
+      particles.add(positions[n], omega[n], settings.radius, settings.strength);
+      ++added;
+    }
+    return added;
+  }
+  const Vec<D> centre = 0.5 * (settings.regionMin + settings.regionMax);
+  for (std::size_t n = 0; n < count; ++n) {
+    const Vec<D> x = position();
     VortexVector<D> omega;
     switch (settings.vorticity) {
       case SeedVorticity::Random:
@@ -126,15 +166,15 @@ std::size_t seedVortexParticles(VortexParticles<D>& particles, const VortexSeedS
         break;
       }
       case SeedVorticity::LocalFlow:
-        omega = sampleFlowVorticity<D>(*flowVorticity, x);
-        if (!(omega.norm() > settings.minimumFlowVorticity)) continue;
-        break;
+        break;  // above
     }
     particles.add(x, omega, settings.radius, settings.strength);
     ++added;
   }
   return added;
 }
+
+}  // namespace
 
 template <int D>
 VortexEmitter<D>::VortexEmitter(const VortexSeedSettings<D>& settings, const GridSpec<D>& domain, double rate,
@@ -146,13 +186,27 @@ VortexEmitter<D>::VortexEmitter(const VortexSeedSettings<D>& settings, const Gri
 }
 
 template <int D>
-std::size_t VortexEmitter<D>::emit(VortexParticles<D>& particles, double dt, const Vorticity<D>* flowVorticity) {
+std::size_t VortexEmitter<D>::due(double dt, Rng& rng) {
   requireValidVortexTimestep(dt, "VortexEmitter::emit");
   carry_ += rate_ * dt;
   const double whole = std::floor(carry_);
   carry_ -= whole;
-  Rng rng = root_.split(calls_++);
-  return seedVortexParticles<D>(particles, settings_, domain_, static_cast<std::size_t>(whole), rng, flowVorticity);
+  rng = root_.split(calls_++);
+  return static_cast<std::size_t>(whole);
+}
+
+template <int D>
+std::size_t VortexEmitter<D>::emit(VortexParticles<D>& particles, double dt, const Vorticity<D>* flowVorticity) {
+  Rng rng = root_;
+  const std::size_t count = due(dt, rng);
+  return seedVortexParticles<D>(particles, settings_, domain_, count, rng, flowVorticity);
+}
+
+template <int D>
+std::size_t VortexEmitter<D>::emit(VortexParticles<D>& particles, double dt, const FlowVorticitySampler<D>& flow) {
+  Rng rng = root_;
+  const std::size_t count = due(dt, rng);
+  return seedVortexParticles<D>(particles, settings_, domain_, count, rng, flow);
 }
 
 template struct VortexSeedSettings<2>;
@@ -163,5 +217,11 @@ template std::size_t seedVortexParticles<2>(VortexParticles<2>&, const VortexSee
                                             std::size_t, Rng&, const Vorticity<2>*);
 template std::size_t seedVortexParticles<3>(VortexParticles<3>&, const VortexSeedSettings<3>&, const GridSpec<3>&,
                                             std::size_t, Rng&, const Vorticity<3>*);
+template std::size_t seedVortexParticles<2>(VortexParticles<2>&, const VortexSeedSettings<2>&, const GridSpec<2>&,
+                                            std::size_t, Rng&, const FlowVorticitySampler<2>&);
+template std::size_t seedVortexParticles<3>(VortexParticles<3>&, const VortexSeedSettings<3>&, const GridSpec<3>&,
+                                            std::size_t, Rng&, const FlowVorticitySampler<3>&);
+template VortexVector<2> flowVorticityAt<2>(const Vorticity<2>&, const Vec<2>&);
+template VortexVector<3> flowVorticityAt<3>(const Vorticity<3>&, const Vec<3>&);
 
 }  // namespace msim::fluid

@@ -16,7 +16,9 @@
 // Everything is drawn from a msim::Rng, so a seed gives the same particles on every machine.
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -47,6 +49,16 @@ struct VortexSeedSettings {
   void validate(const GridSpec<D>& domain, const std::string& context = "vortex seeding") const;
 };
 
+// The flow's vorticity at each of `positions` (LocalFlow seeding), into `vorticities`: the grid's
+// (flowVorticityAt), or in a run split among processes read on the ranks that own the positions.
+template <int D>
+using FlowVorticitySampler =
+    std::function<void(const std::vector<Vec<D>>& positions, std::vector<VortexVector<D>>& vorticities)>;
+
+// The grid's cell-centred vorticity at x, D-linear (clamped at the grid's edges).
+template <int D>
+VortexVector<D> flowVorticityAt(const Vorticity<D>& grid, const Vec<D>& x);
+
 // Adds `count` particles (fewer for LocalFlow where the flow is too calm) drawn from `rng`;
 // flowVorticity is required for LocalFlow (std::invalid_argument without it or when its grid is not
 // the domain's). Returns how many were added.
@@ -54,6 +66,12 @@ template <int D>
 std::size_t seedVortexParticles(VortexParticles<D>& particles, const VortexSeedSettings<D>& settings,
                                 const GridSpec<D>& domain, std::size_t count, Rng& rng,
                                 const Vorticity<D>* flowVorticity = nullptr);
+// The same with the flow's vorticity read by `flow` (LocalFlow: the positions are drawn first, as
+// the grid's version draws them, then read at once).
+template <int D>
+std::size_t seedVortexParticles(VortexParticles<D>& particles, const VortexSeedSettings<D>& settings,
+                                const GridSpec<D>& domain, std::size_t count, Rng& rng,
+                                const FlowVorticitySampler<D>& flow);
 
 // A source emitting at a uniform rate [particles/s]: each emit(dt) adds floor(carry + rate dt)
 // particles and keeps the fraction for the next call, so the count after any sequence of steps is
@@ -64,9 +82,13 @@ class VortexEmitter {
   VortexEmitter(const VortexSeedSettings<D>& settings, const GridSpec<D>& domain, double rate, std::uint64_t seed,
                 const std::string& context = "vortex seeding");
   std::size_t emit(VortexParticles<D>& particles, double dt, const Vorticity<D>* flowVorticity = nullptr);
+  std::size_t emit(VortexParticles<D>& particles, double dt, const FlowVorticitySampler<D>& flow);
   double rate() const { return rate_; }
 
  private:
+  // The whole particles due after dt more (the fraction carried on), and this call's stream.
+  std::size_t due(double dt, Rng& rng);
+
   VortexSeedSettings<D> settings_;
   GridSpec<D> domain_;
   double rate_;

@@ -37,11 +37,46 @@ Vec<D> clampToDomain(const GridSpec<D>& spec, Vec<D> x) {
 
 template <int D>
 ParticleLevelSet<D>::ParticleLevelSet(const GridSpec<D>& spec, const ParticleLevelSetSettings& settings)
-    : spec_(spec), settings_(settings), perCell_(settings.particlesPerCell > 0 ? settings.particlesPerCell : (D == 2 ? 16 : 32)) {
+    : spec_(spec),
+      settings_(settings),
+      perCell_(settings.particlesPerCell > 0 ? settings.particlesPerCell : (D == 2 ? 16 : 32)),
+      ownedHi_(spec.res) {
   const auto& s = settings_;
   if (!(s.bandCells > 0.0) || !(s.minRadiusCells > 0.0) || !(s.maxRadiusCells >= s.minRadiusCells) ||
       !(s.minSeedCells >= 0.0) || !(s.maxSeedCells > s.minSeedCells) || s.attractionIterations < 1)
     throw std::invalid_argument("particle level set: band, radii and seeding range must be positive and ordered");
+}
+
+template <int D>
+void ParticleLevelSet<D>::setBlock(const BlockPlacement<D>& placement, const IVec<D>& ownedLo, const IVec<D>& ownedHi) {
+  placement_ = placement;
+  ownedLo_ = ownedLo;
+  ownedHi_ = ownedHi;
+}
+
+template <int D>
+bool ParticleLevelSet<D>::seeds(const IVec<D>& c) const {
+  return (c.array() >= ownedLo_.array()).all() && (c.array() < ownedHi_.array()).all();
+}
+
+template <int D>
+std::uint64_t ParticleLevelSet<D>::streamOf(const IVec<D>& c, std::size_t localIndex) const {
+  if (placement_.whole()) return localIndex;
+  std::uint64_t index = 0;  // the global grid's linear index (x fastest, as Grid's)
+  for (int a = D - 1; a >= 0; --a)
+    index = index * static_cast<std::uint64_t>(placement_.globalRes[a]) + static_cast<std::uint64_t>(c[a] + placement_.cellOrigin[a]);
+  return index;
+}
+
+template <int D>
+void ParticleLevelSet<D>::appendRows(const std::vector<double>& rows) {
+  for (std::size_t at = 0; at + kRowWidth <= rows.size(); at += kRowWidth) {
+    Vec<D> x;
+    for (int a = 0; a < D; ++a) x[a] = rows[at + a];
+    positions_.push_back(x);
+    radii_.push_back(static_cast<float>(rows[at + D]));
+    signs_.push_back(rows[at + D + 1] < 0.0 ? -1 : 1);
+  }
 }
 
 template <int D>
@@ -85,8 +120,10 @@ void ParticleLevelSet<D>::seed(const Grid<float, D>& phi) {
   signs_.clear();
   round_ = 0;
   const float band = static_cast<float>(settings_.bandCells * spec_.dx);
-  for (std::size_t i = 0; i < phi.count(); ++i)
-    if (std::abs(phi[i]) < band) seedCell(phi, phi.coord(i), perCell_, i);
+  for (std::size_t i = 0; i < phi.count(); ++i) {
+    const IVec<D> c = phi.coord(i);
+    if (std::abs(phi[i]) < band && seeds(c)) seedCell(phi, c, perCell_, streamOf(c, i));
+  }
 }
 
 template <int D>
@@ -110,10 +147,29 @@ void ParticleLevelSet<D>::advect(const MacGrid<D>& velocity, double dt) {
 
 template <int D>
 std::size_t ParticleLevelSet<D>::correct(Grid<float, D>& phi) const {
+  // The own particles, then the neighbours' copies (rows), as (position, radius, sign).
+  const std::size_t own = positions_.size(), count = own + neighbours_.size() / kRowWidth;
+  const auto particle = [&](std::size_t p, Vec<D>& x, double& radius, int& sign) {
+    if (p < own) {
+      x = positions_[p];
+      radius = radii_[p];
+      sign = signs_[p];
+      return;
+    }
+    const double* row = &neighbours_[(p - own) * kRowWidth];
+    for (int a = 0; a < D; ++a) x[a] = row[a];
+    radius = static_cast<float>(row[D]);
+    sign = row[D + 1] < 0.0 ? -1 : 1;
+  };
   std::vector<std::size_t>& escaped = escaped_;
   escaped.clear();
-  for (std::size_t p = 0; p < positions_.size(); ++p)
-    if (signs_[p] * sampleLinear<D>(phi, positions_[p]) < -radii_[p]) escaped.push_back(p);
+  Vec<D> x;
+  double radius = 0.0;
+  int sign = 1;
+  for (std::size_t p = 0; p < count; ++p) {
+    particle(p, x, radius, sign);
+    if (sign * sampleLinear<D>(phi, x) < -radius) escaped.push_back(p);
+  }
   if (escaped.empty()) return 0;
   // phi+ and phi- start as phi (copied into storage kept across steps).
   Grid<float, D>& plus = plus_;
@@ -121,7 +177,7 @@ std::size_t ParticleLevelSet<D>::correct(Grid<float, D>& phi) const {
   plus = phi;
   minus = phi;
   for (const std::size_t p : escaped) {
-    const Vec<D> x = positions_[p];
+    particle(p, x, radius, sign);
     // The 2^D cell centres around the particle (those its interpolation reads).
     const Vec<D> s = phi.toSampleSpace(x);
     IVec<D> base;
@@ -130,8 +186,8 @@ std::size_t ParticleLevelSet<D>::correct(Grid<float, D>& phi) const {
       IVec<D> c = base;
       for (int a = 0; a < D; ++a) c[a] += (corner >> a) & 1;
       const std::size_t i = phi.index(c);
-      const float sphere = static_cast<float>(signs_[p] * (radii_[p] - (phi.position(c) - x).norm()));
-      if (signs_[p] > 0)
+      const float sphere = static_cast<float>(sign * (radius - (phi.position(c) - x).norm()));
+      if (sign > 0)
         plus[i] = std::max(plus[i], sphere);
       else
         minus[i] = std::min(minus[i], sphere);
@@ -140,7 +196,7 @@ std::size_t ParticleLevelSet<D>::correct(Grid<float, D>& phi) const {
   parallelFor(0, phi.count(), [&](std::size_t i) {
     phi[i] = std::abs(plus[i]) <= std::abs(minus[i]) ? plus[i] : minus[i];
   });
-  return escaped.size();
+  return static_cast<std::size_t>(std::count_if(escaped.begin(), escaped.end(), [&](std::size_t p) { return p < own; }));
 }
 
 template <int D>
@@ -149,24 +205,6 @@ void ParticleLevelSet<D>::adjustRadii(const Grid<float, D>& phi) {
   parallelFor(0, positions_.size(), [&](std::size_t p) {
     radii_[p] = static_cast<float>(std::clamp(signs_[p] * double(sampleLinear<D>(phi, positions_[p])), lo, hi));
   });
-}
-
-template <int D>
-template <typename Keep>
-std::size_t ParticleLevelSet<D>::keepIf(Keep&& keep) {
-  std::size_t kept = 0;
-  for (std::size_t p = 0; p < positions_.size(); ++p) {
-    if (!keep(p)) continue;
-    positions_[kept] = positions_[p];
-    radii_[kept] = radii_[p];
-    signs_[kept] = signs_[p];
-    ++kept;
-  }
-  const std::size_t removed = positions_.size() - kept;
-  positions_.resize(kept);
-  radii_.resize(kept);
-  signs_.resize(kept);
-  return removed;
 }
 
 template <int D>
@@ -180,8 +218,10 @@ void ParticleLevelSet<D>::reseed(const Grid<float, D>& phi) {
   std::vector<int>& count = cellCount_;
   count.assign(phi.count(), 0);
   for (const Vec<D>& x : positions_) ++count[spec_.clampedCellIndex(x)];
-  for (std::size_t i = 0; i < phi.count(); ++i)
-    if (std::abs(phi[i]) < band && count[i] < perCell_) seedCell(phi, phi.coord(i), perCell_ - count[i], i);
+  for (std::size_t i = 0; i < phi.count(); ++i) {
+    const IVec<D> c = phi.coord(i);
+    if (std::abs(phi[i]) < band && count[i] < perCell_ && seeds(c)) seedCell(phi, c, perCell_ - count[i], streamOf(c, i));
+  }
 }
 
 template <int D>

@@ -19,8 +19,10 @@
 // Particles live in a structure of arrays; all work is deterministic (per-cell random streams).
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
+#include "msim/core/block_placement.hpp"
 #include "msim/core/grid.hpp"
 #include "msim/core/mac_grid.hpp"
 
@@ -57,7 +59,8 @@ class ParticleLevelSet {
   // Moves the particles by the MAC velocity over dt (midpoint rule, sampled D-linearly), keeping
   // them inside the domain.
   void advect(const MacGrid<D>& velocity, double dt);
-  // Enright's correction of phi by the escaped particles; returns how many there were.
+  // Enright's correction of phi by the escaped particles (the own and the neighbours'); returns
+  // how many of the own ones there were.
   std::size_t correct(Grid<float, D>& phi) const;
   // r_p = clamp(s_p phi(x_p), minRadius, maxRadius).
   void adjustRadii(const Grid<float, D>& phi);
@@ -69,6 +72,40 @@ class ParticleLevelSet {
   // by an emitter or a sink would make them escaped; the next reseeding fills the band again.
   // Returns how many.
   std::size_t removeInside(const Grid<float, D>& region);
+
+  // A block of a grid split among processes (core/domain_split.hpp): phi's grid is the block with
+  // its ghost layers, at `placement` in the global grid, and the particles are those in the owned
+  // cells [ownedLo, ownedHi) (local coordinates). Seeding then fills only the owned cells, each
+  // with the random stream of its global index: the particles a whole grid would seed there.
+  void setBlock(const BlockPlacement<D>& placement, const IVec<D>& ownedLo, const IVec<D>& ownedHi);
+  // The particles as rows of kRowWidth doubles (position, radius, sign), for moving them between
+  // processes: all of them, those at positions x with select(x), and taking out those with
+  // select(x) (the others keep their order); appendRows adds rows.
+  static constexpr int kRowWidth = D + 2;
+  std::vector<double> rows() const {
+    return rowsIf([](const Vec<D>&) { return true; });
+  }
+  template <typename Select>
+  std::vector<double> rowsIf(Select&& select) const {
+    std::vector<double> out;
+    for (std::size_t p = 0; p < positions_.size(); ++p)
+      if (select(positions_[p])) appendRow(p, out);
+    return out;
+  }
+  template <typename Select>
+  std::vector<double> takeRowsIf(Select&& select) {
+    std::vector<double> out;
+    keepIf([&](std::size_t p) {
+      if (!select(positions_[p])) return true;
+      appendRow(p, out);
+      return false;
+    });
+    return out;
+  }
+  void appendRows(const std::vector<double>& rows);
+  // The particles of other processes in the block's ghost layers (rows as above): correct() reads
+  // them with the own ones, so an owned cell is corrected by every particle near it.
+  void setNeighbours(std::vector<double> rows) { neighbours_ = std::move(rows); }
 
   // Replaces the particles (a resumed run's saved ones); std::invalid_argument for mismatched
   // lengths.
@@ -83,13 +120,38 @@ class ParticleLevelSet {
  private:
   // Keeps the particles p with keep(p) (order kept); returns how many went.
   template <typename Keep>
-  std::size_t keepIf(Keep&& keep);
+  std::size_t keepIf(Keep&& keep) {
+    std::size_t kept = 0;
+    for (std::size_t p = 0; p < positions_.size(); ++p) {
+      if (!keep(p)) continue;
+      positions_[kept] = positions_[p];
+      radii_[kept] = radii_[p];
+      signs_[kept] = signs_[p];
+      ++kept;
+    }
+    const std::size_t removed = positions_.size() - kept;
+    positions_.resize(kept);
+    radii_.resize(kept);
+    signs_.resize(kept);
+    return removed;
+  }
+  void appendRow(std::size_t p, std::vector<double>& out) const {
+    out.insert(out.end(), positions_[p].data(), positions_[p].data() + D);
+    out.push_back(radii_[p]);
+    out.push_back(signs_[p]);
+  }
+  // Whether cell c is seeded here (the owned cells of a block), and its random stream.
+  bool seeds(const IVec<D>& c) const;
+  std::uint64_t streamOf(const IVec<D>& c, std::size_t localIndex) const;
   // Appends up to `count` particles in cell c (random stream `stream`), attracted to phi.
   void seedCell(const Grid<float, D>& phi, const IVec<D>& c, int count, std::uint64_t stream);
 
   GridSpec<D> spec_;
   ParticleLevelSetSettings settings_;
   int perCell_;
+  BlockPlacement<D> placement_;
+  IVec<D> ownedLo_ = IVec<D>::Zero(), ownedHi_;  // the seeded cells
+  std::vector<double> neighbours_;               // other processes' particles (rows)
   std::uint64_t round_ = 0;  // reseeding rounds so far (new random streams each round)
   std::vector<Vec<D>> positions_;
   std::vector<float> radii_;

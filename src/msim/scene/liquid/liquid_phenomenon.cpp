@@ -17,7 +17,10 @@
 #include "msim/io/ply.hpp"
 #include "msim/io/vdb.hpp"
 #include "msim/numerics/level_set/level_set_measures.hpp"
+#include "msim/parallel/ghost_layers.hpp"
+#include "msim/parallel/mpi_session.hpp"
 #include "msim/scene/keys/json_vectors.hpp"
+#include "msim/scene/keys/mpi_split_keys.hpp"
 #include "msim/scene/liquid/liquid_sources.hpp"
 #include "msim/scene/phenomenon_support.hpp"
 #include "msim/scene/scene_file.hpp"
@@ -120,6 +123,41 @@ fluid::LiquidTurbulenceParams liquidTurbulenceParams(const Scene& scene) {
   return p;
 }
 
+// Under mpirun with several processes the grid is split among them (msim/parallel; docs/parallel.md):
+// each runs the solver on its block and rank 0 gathers every frame. What is not distributed yet is
+// refused here, naming the key.
+template <int D>
+std::unique_ptr<DomainSplit<D>> liquidSplit(const Scene& scene) {
+  if (parallel::worldSize() == 1) return nullptr;
+  const json& r = scene.resolved;
+  const json& l = r.at("liquid");
+  if constexpr (D != 3) {
+    refuseSplit(scene, "domain.resolution", "a 2D grid");
+  } else {
+    if (l.at("tracker").get<std::string>() == "flip") refuseSplit(scene, "liquid.tracker", "FLIP");
+    if (l.at("turbulence").at("enabled").get<bool>()) refuseSplit(scene, "liquid.turbulence.enabled", "sub-grid turbulence");
+    if (l.at("vortex_particles").at("enabled").get<bool>())
+      refuseSplit(scene, "liquid.vortex_particles.enabled", "vortex particles in a liquid");
+    if (!r.at("sources").empty()) refuseSplit(scene, "sources", "an emitter or sink");
+    const fluid::LiquidParams<3> p = liquidParams<3>(scene);
+    const int needed = parallel::liquidGhostLayers(p.advection, std::max(1.0, p.cfl), p.bandCells);
+    const std::string reads =
+        fmt::format("this liquid (its advection at CFL {:g}, the fast marching's band of {:g} cells)", p.cfl, p.bandCells);
+    return sceneDomainSplit(scene, needed, reads, p.sides, p.projection.pcg);
+  }
+}
+
+// A split run's frame on rank 0: the fields, the marker particles (rows of position, radius and
+// sign) and the statistics, reduced over the ranks.
+template <int D>
+struct GatheredLiquid {
+  Grid<float, D> phi, solid;
+  MacGrid<D> velocity;
+  std::vector<double> particles;
+  fluid::LiquidStatistics statistics;
+  bool solidGathered = false;
+};
+
 template <int D>
 class LiquidPhenomenon final : public Phenomenon {
  public:
@@ -128,9 +166,13 @@ class LiquidPhenomenon final : public Phenomenon {
         name_(scene.resolved.at("name").get<std::string>()),
         meshFormat_(scene.resolved.at("liquid").at("mesh_format").get<std::string>()),
         timers_(timers),
-        obstacles_(scene, scene.gridSpec<D>()),
-        solver_(scene.gridSpec<D>(), liquidParams<D>(scene)) {
-    const GridSpec<D> spec = scene.gridSpec<D>();
+        split_(liquidSplit<D>(scene)),
+        obstacles_(scene, split_ ? split_->localSpec() : scene.gridSpec<D>()),
+        solver_(split_ ? split_->localSpec() : scene.gridSpec<D>(), liquidParams<D>(scene)) {
+    const GridSpec<D> spec = solver_.spec();
+    solver_.setDomainSplit(split_.get());
+    // Rank 0 writes the obstacles of the whole grid with each frame of a split run.
+    if (split_ && split_->root() && !obstacles_.empty()) wholeObstacles_.emplace(scene, scene.gridSpec<D>());
     for (int a = 0; a < D; ++a)
       for (int s = 0; s < 2; ++s)
         if (solver_.params().sides.side[a][s] == numerics::DomainSide::Open)
@@ -146,7 +188,7 @@ class LiquidPhenomenon final : public Phenomenon {
     for (std::size_t i = 0; i < bodies.size(); ++i) {
       const std::string key = fmt::format("initial_liquid[{}].shape", i);
       const auto shape = sceneShape<D>(scene, bodies[i].at("shape"), key);
-      coveredOpenCells<D>(scene, *shape, solver_.solid(), key);  // InputError when it holds no open cell
+      coveredOpenCells<D>(scene, *shape, solver_.solid(), key, split_.get());  // InputError when it holds no open cell
       solver_.addLiquid(shape->distanceField(spec), sceneVector<D>(bodies[i].at("velocity")));
     }
     sources_.emplace(scene, solver_.solid(), volume());
@@ -156,7 +198,6 @@ class LiquidPhenomenon final : public Phenomenon {
                           obstacles_.empty() ? nullptr : &solver_.solid());
     preview_ = previewSettings(scene);
     preview_.colour = {0.30f, 0.58f, 0.85f};  // water reads as water in the side views
-    fraction_ = Grid<float, D>(surface().spec());
   }
 
   // The liquid's CFL step, and a moving obstacle crosses at most cfl cells per step.
@@ -199,6 +240,9 @@ class LiquidPhenomenon final : public Phenomenon {
   }
 
   void checkFinite(long stepIndex, double time) const override {
+    // A split run's solver checks every step on every rank together (one rank throwing alone
+    // would leave the others waiting).
+    if (split_) return;
     requireFinite(solver_.phi(), "liquid phi", stepIndex, time);
     static const char* axes[] = {"velocity x", "velocity y", "velocity z"};
     for (int a = 0; a < D; ++a) requireFinite(solver_.velocity().component(a), axes[a], stepIndex, time);
@@ -206,6 +250,22 @@ class LiquidPhenomenon final : public Phenomenon {
       requireFinite(turbulence_->phi(), "fine liquid phi", stepIndex, time);
       requireFinite(turbulence_->energy().energy(), "turbulent energy", stepIndex, time);
     }
+  }
+
+  // A split run's frame on rank 0 (every rank calls this; only rank 0 writes).
+  void endFrame() override {
+    if (!split_) return;
+    ScopedStage stage(timers_, "liquid: gather frame");
+    GatheredLiquid<D>& g = gathered_;
+    split_->gather(solver_.phi(), g.phi);
+    split_->gather(solver_.velocity(), g.velocity);
+    g.particles = split_->gatherRows(solver_.levelSetParticles().rows());
+    // Static solids once, moving ones every frame (decided alike on every rank).
+    if (!obstacles_.empty() && (!g.solidGathered || obstacles_.moving())) {
+      split_->gather(solver_.solid(), g.solid);
+      g.solidGathered = true;
+    }
+    g.statistics = solver_.statistics();
   }
 
   // liquid_phi (a level set; with sub-grid turbulence the fine surface, and the simulation's as
@@ -218,13 +278,14 @@ class LiquidPhenomenon final : public Phenomenon {
       writer.addLevelSet(kSimulationPhi, solver_.phi(), 3);
       writer.addFloatGrid("turbulent_energy", turbulence_->energy().energy());
     }
-    if constexpr (D == 3) writer.addVectorGrid("vel", solver_.velocity());
-    writeFaceVelocities(writer, solver_.velocity());
+    if constexpr (D == 3) writer.addVectorGrid("vel", velocity());
+    writeFaceVelocities(writer, velocity());
     if (solver_.params().tracker == fluid::InterfaceTracker::Flip)
       writer.addPoints(kFlipParticles, flipCloud(), solver_.spec().dx);
     else
       writer.addPoints(kLevelSetParticles, levelSetCloud(), solver_.spec().dx);
-    if (!obstacles_.empty()) writer.addLevelSet("obstacle_distance", obstacles_.cellDistance(time_));
+    if (!obstacles_.empty())
+      writer.addLevelSet("obstacle_distance", (wholeObstacles_ ? *wholeObstacles_ : obstacles_).cellDistance(time_));
     if (solver_.vortexLayer())
       writer.addPoints(kVortexPoints, vortexParticleCloud(solver_.vortexLayer()->particles()), solver_.spec().dx);
   }
@@ -252,10 +313,11 @@ class LiquidPhenomenon final : public Phenomenon {
   io::Image preview() const override {
     const Grid<float, D>& phi = surface();
     const double eps = 1.5 * phi.spec().dx;
+    if (!fraction_.sameLayout(phi)) fraction_ = Grid<float, D>(phi.spec());
     parallelFor(0, fraction_.count(), [&](std::size_t i) {
       fraction_[i] = static_cast<float>(numerics::smearedInside(phi[i], eps));
     });
-    const Grid<float, D>* solid = turbulence_ ? &turbulence_->fineSolid() : &solver_.solid();
+    const Grid<float, D>* solid = turbulence_ ? &turbulence_->fineSolid() : split_ ? &gathered_.solid : &solver_.solid();
     return render::renderDensityPreview(fraction_, preview_, obstacles_.empty() ? nullptr : solid);
   }
 
@@ -265,10 +327,12 @@ class LiquidPhenomenon final : public Phenomenon {
     time_ = time;
     if (obstacles_.moving()) placeObstacles(time);
     const io::VdbFile saved(vdbFile, io::VdbProvenance::MsimRun);
+    // A split run's ranks each read the whole frame and keep their block of it.
+    const BlockPlacement<D> block = split_ ? split_->placement() : BlockPlacement<D>{};
     Grid<float, D> phi(solver_.spec());
-    restoreGrid(saved, turbulence_ ? kSimulationPhi : kPhi, phi, source_);
+    restoreGrid(saved, turbulence_ ? kSimulationPhi : kPhi, phi, source_, block);
     MacGrid<D> velocity(solver_.spec());
-    restoreFaceVelocities(saved, velocity, source_);
+    restoreFaceVelocities(saved, velocity, source_, block);
     if (solver_.params().tracker == fluid::InterfaceTracker::Flip) {
       const io::PointCloud cloud = saved.points(kFlipParticles);
       std::vector<Vecf<D>> positions(cloud.positions.size()), velocities(cloud.positions.size());
@@ -309,7 +373,7 @@ class LiquidPhenomenon final : public Phenomenon {
   }
 
   json statistics() const override {
-    const fluid::LiquidStatistics s = solver_.statistics();
+    const fluid::LiquidStatistics s = split_ ? gathered_.statistics : solver_.statistics();
     json j = {{"volume_m3", s.volume},
             {"target_volume_m3", s.targetVolume},
             {"volume_control_divergence_1_s", s.controlDivergence},
@@ -332,9 +396,12 @@ class LiquidPhenomenon final : public Phenomenon {
   }
 
  private:
-  double volume() const { return numerics::enclosedVolume(solver_.phi(), &solver_.solid()); }
-  // The surface users see: the fine one with sub-grid turbulence.
-  const Grid<float, D>& surface() const { return turbulence_ ? turbulence_->phi() : solver_.phi(); }
+  double volume() const { return solver_.liquidVolume(); }
+  // The surface users see: the fine one with sub-grid turbulence; a split run's gathered on rank 0.
+  const Grid<float, D>& surface() const {
+    return turbulence_ ? turbulence_->phi() : split_ ? gathered_.phi : solver_.phi();
+  }
+  const MacGrid<D>& velocity() const { return split_ ? gathered_.velocity : solver_.velocity(); }
 
   // The obstacles where they are at time t, with their velocity when they move.
   void placeObstacles(double t) {
@@ -342,17 +409,19 @@ class LiquidPhenomenon final : public Phenomenon {
     if (obstacles_.moving()) solver_.setObstacleVelocity(obstacles_.faceVelocity(t));
   }
 
+  // The marker particles with their radius and sign (a split run: those gathered on rank 0).
   io::PointCloud levelSetCloud() const {
-    const auto& lp = solver_.levelSetParticles();
+    const std::vector<double> rows = split_ ? gathered_.particles : solver_.levelSetParticles().rows();
+    constexpr int width = numerics::ParticleLevelSet<D>::kRowWidth;
     io::PointCloud cloud;
-    cloud.positions.reserve(lp.size());
+    cloud.positions.reserve(rows.size() / width);
     io::PointAttribute radius{"radius", {}}, sign{"sign", {}};
-    for (std::size_t p = 0; p < lp.size(); ++p) {
+    for (std::size_t at = 0; at < rows.size(); at += width) {
       Vecf<3> x = Vecf<3>::Zero();
-      for (int a = 0; a < D; ++a) x[a] = static_cast<float>(lp.positions()[p][a]);
+      for (int a = 0; a < D; ++a) x[a] = static_cast<float>(rows[at + a]);
       cloud.positions.push_back(x);
-      radius.values.push_back(lp.radii()[p]);
-      sign.values.push_back(lp.signs()[p]);
+      radius.values.push_back(static_cast<float>(rows[at + D]));
+      sign.values.push_back(static_cast<float>(rows[at + D + 1]));
     }
     cloud.attributes = {std::move(radius), std::move(sign)};
     return cloud;
@@ -374,7 +443,10 @@ class LiquidPhenomenon final : public Phenomenon {
 
   std::string source_, name_, meshFormat_;
   StageTimers& timers_;
-  SceneObstacles<D> obstacles_;
+  std::unique_ptr<DomainSplit<D>> split_;           // null on one process
+  GatheredLiquid<D> gathered_;                      // split runs, rank 0: the last frame
+  SceneObstacles<D> obstacles_;                     // over the solver's grid (a block when split)
+  std::optional<SceneObstacles<D>> wholeObstacles_;  // split runs, rank 0: over the whole grid
   fluid::LiquidSolver<D> solver_;
   render::PreviewSettings preview_;
   mutable Grid<float, D> fraction_;  // the preview's liquid fraction (smeared Heaviside of the surface)
@@ -398,7 +470,7 @@ std::unique_ptr<Phenomenon> createLiquidFor(const Scene& scene, StageTimers& tim
 
 PhenomenonType liquidPhenomenonType() {
   return {"liquid", "water with a free surface: particle level set or FLIP (Selle ch. 4.4.3, Golas ch. 2.7)",
-          &declareLiquid, &liquidBytesPerCell, &createLiquidFor};
+          &declareLiquid, &liquidBytesPerCell, &createLiquidFor, true};
 }
 
 }  // namespace msim::scene

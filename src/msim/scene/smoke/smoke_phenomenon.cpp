@@ -14,10 +14,10 @@
 #include "msim/io/ply.hpp"
 #include "msim/io/vdb.hpp"
 #include "msim/parallel/ghost_layers.hpp"
-#include "msim/parallel/mpi_domain_split.hpp"
 #include "msim/parallel/mpi_session.hpp"
 #include "msim/render/density_preview.hpp"
 #include "msim/scene/keys/json_vectors.hpp"
+#include "msim/scene/keys/mpi_split_keys.hpp"
 #include "msim/scene/phenomenon_support.hpp"
 #include "msim/scene/scene_file.hpp"
 #include "msim/scene/keys/scene_obstacles.hpp"
@@ -52,58 +52,21 @@ double smokeBytesPerCell(int dimensions, const json& resolved) {
 // Under mpirun with several processes the grid is split among them (msim/parallel): each runs
 // the solver on its block, and rank 0 gathers the fields at the end of every frame and writes
 // them. What is not distributed yet is refused here, naming the key.
-[[noreturn]] void refuseSplit(const std::string& file, const std::string& key, const std::string& what) {
-  throw InputError(fmt::format("{}: '{}': {} does not run split among MPI processes yet; run the scene without mpirun",
-                               file, key, what));
-}
-
 template <int D>
 std::unique_ptr<DomainSplit<D>> smokeSplit(const Scene& scene) {
-  const int ranks = parallel::worldSize();
-  if (ranks == 1) return nullptr;
-  const std::string file = scene.file.string();
-  auto refuse = [&](const std::string& key, const std::string& what) { refuseSplit(file, key, what); };
-  const json& r = scene.resolved;
-  const json& smoke = r.at("smoke");
+  if (parallel::worldSize() == 1) return nullptr;
+  const json& smoke = scene.resolved.at("smoke");
   if constexpr (D != 3) {
-    refuseSplit(file, "domain.resolution", "a 2D grid");
+    refuseSplit(scene, "domain.resolution", "a 2D grid");
   } else {
-    if (smoke.at("turbulence").at("enabled").get<bool>()) refuse("smoke.turbulence.enabled", "sub-grid turbulence");
-    const json& vortex = smoke.at("vortex_particles");
-    if (vortex.at("enabled").get<bool>() && vortex.at("vorticity").get<std::string>() == "local_flow")
-      refuse("smoke.vortex_particles.vorticity", "seeding vortex particles with the local flow's vorticity");
+    if (smoke.at("turbulence").at("enabled").get<bool>()) refuseSplit(scene, "smoke.turbulence.enabled", "sub-grid turbulence");
     const fluid::SmokeParams<3> p = smokeParams<3>(scene);
     // Enough ghost layers for the scheme at the solver's CFL number (and blocks at least that thick).
     const bool conservative = p.scalarTransport == fluid::ScalarTransport::Conservative;
     const int needed = parallel::smokeGhostLayers(p.advection, std::max(1.0, p.cfl), conservative);
-    const json& mpi = r.at("mpi");
-    const int asked = mpi.at("ghost_layers").get<int>();
-    if (asked > 0 && asked < needed)
-      throw InputError(fmt::format("{}: 'mpi.ghost_layers' is {} but this smoke reads {} layers of its neighbours "
-                                   "(its advection at CFL {:g}, vorticity confinement{}); use {} or more, or 0",
-                                   file, asked, needed, p.cfl, conservative ? " and the conservative scalar transport" : "",
-                                   needed));
-    const int ghost = asked > 0 ? asked : needed;
-    const GridSpec<3> global = scene.gridSpec<3>();
-    const Vec<3> blocks = sceneVector<3>(mpi.at("blocks"));
-    IVec<3> lattice;
-    for (int a = 0; a < 3; ++a) {
-      if (!(blocks[a] >= 0.0) || blocks[a] != std::floor(blocks[a]) || blocks[a] > ranks)
-        throw InputError(fmt::format("{}: 'mpi.blocks' must hold whole numbers from 0 to {} (got {})", file, ranks,
-                                     blocks[a]));
-      lattice[a] = static_cast<int>(blocks[a]);
-    }
-    if (!lattice.isZero() && (lattice.array() == 0).any())
-      throw InputError(fmt::format("{}: 'mpi.blocks' sets some axes but not all: give all three or none", file));
-    const parallel::BlockDecomposition<3> decomposition =
-        lattice.isZero() ? parallel::BlockDecomposition<3>(global.res, ranks, ghost,
-                                                           file + ": mpirun -np " + std::to_string(ranks))
-                         : parallel::BlockDecomposition<3>(global.res, lattice, ghost, file + ": 'mpi.blocks'");
-    if (decomposition.ranks() != ranks)
-      throw InputError(fmt::format("{}: 'mpi.blocks' makes {} blocks for {} processes (mpirun -np {})", file,
-                                   decomposition.ranks(), ranks, ranks));
-    const parallel::GridBlock<3> block(global, decomposition, parallel::worldRank(), ghost);
-    return std::make_unique<parallel::MpiDomainSplit>(block, p.sides, p.projection.pcg, MPI_COMM_WORLD);
+    const std::string reads = fmt::format("this smoke (its advection at CFL {:g}, vorticity confinement{})", p.cfl,
+                                          conservative ? " and the conservative scalar transport" : "");
+    return sceneDomainSplit(scene, needed, reads, p.sides, p.projection.pcg);
   }
 }
 
@@ -134,6 +97,9 @@ class SmokePhenomenon final : public Phenomenon {
       for (const auto& wall : axis) boundarySpeed_ = std::max(boundarySpeed_, wall.norm());
     const Vec<D> u0 = sceneVector<D>(r.at("smoke").at("initial_velocity"));
     for (int a = 0; a < D; ++a) solver_.velocity().component(a).fill(static_cast<float>(u0[a]));
+    // A split run's solver knows its block before the vortex particles seed (with the local flow's
+    // vorticity they read it on the owning ranks) and the obstacles are placed.
+    if (split_) solver_.setDomainSplit(split_.get());
     // Vortex particles before the obstacles, which the solver hands them.
     solver_.setVortexLayer(vortexLayer<D>(scene, "smoke"));
     if (!obstacles_.empty()) placeObstacles(0.0);
@@ -150,7 +116,6 @@ class SmokePhenomenon final : public Phenomenon {
     for (auto& wind : turbulentWinds<D>(scene)) solver_.addWind(std::move(wind));
     preview_ = previewSettings(scene);
     preview_.emissionScale = r.at("fire").at("emission").get<double>();
-    if (split_) solver_.setDomainSplit(split_.get());
   }
 
   double stableTimestep() const override {

@@ -1,0 +1,147 @@
+// A 3D dam break tracked by the particle level set (Selle ch. 4.4.3), split among the ranks
+// (Selle ch. 8.1): phi and the velocity exchanged before every stencil, the marker particles
+// migrated to the rank whose cells hold them and their copies near a block read by the
+// correction, the fast marching on each block with ceil(band) ghost layers, the pressure through
+// hypre. Against the same run on one rank and the serial solver.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <tuple>
+
+#include "msim/fluid/liquid/liquid_solver.hpp"
+#include "msim/numerics/pressure/face_fractions.hpp"
+#include "msim/parallel/ghost_layers.hpp"
+#include "msim/parallel/mpi_domain_split.hpp"
+#include "msim/parallel/mpi_session.hpp"
+#include "msim/parallel/particle_migration.hpp"
+#include "mpi_test_support.hpp"
+
+namespace msim::parallel {
+namespace {
+
+using testing::fromRoot;
+using testing::worldRank;
+using testing::worldSize;
+
+const GridSpec<3> kGlobal(Vec<3>::Zero(), 1.0 / 32, IVec<3>(32, 28, 24));
+constexpr int kSteps = 40;
+constexpr double kDt = 0.004;  // [s]; the water reaches about 1.5 m/s: 0.2 cells per step
+
+struct LiquidRun {
+  Grid<float, 3> phi;     // on rank 0 (split runs: gathered)
+  double volume = 0.0;    // [m^3]
+  std::size_t particles = 0;
+  long particlesLost = 0;   // over the steps without reseeding: count before less count after
+  long strayParticles = 0;  // particles held by a rank that does not own their cell
+};
+
+// A column of water against the x_min wall, collapsing, and a ball of water falling beside it.
+Grid<float, 3> water(const GridSpec<3>& spec) {
+  Grid<float, 3> phi(spec);
+  for (std::size_t i = 0; i < phi.count(); ++i) {
+    const Vec<3> x = phi.position(phi.coord(i));
+    const double column = std::max(x[0] - 0.35, x[1] - 0.55);
+    const double ball = (x - Vec<3>(0.72, 0.5, 0.4)).norm() - 0.13;
+    phi[i] = static_cast<float>(std::min(column, ball));
+  }
+  return phi;
+}
+
+LiquidRun runDamBreak(const GridSpec<3>& spec, DomainSplit<3>* split, bool rock) {
+  fluid::LiquidSolver<3> solver(spec, fluid::LiquidParams<3>{});
+  solver.setDomainSplit(split);
+  if (rock)  // a ball the column runs against, cut by the blocks' edges
+    solver.setObstacles(numerics::sampleNodes<3>(spec, [](const Vec<3>& x) { return (x - Vec<3>(0.5, 0.1, 0.37)).norm() - 0.16; }));
+  solver.addLiquid(water(spec));
+  LiquidRun run;
+  for (int s = 0; s < kSteps; ++s) {
+    EXPECT_LE(kDt, solver.cflTimestep()) << "step " << s;
+    const std::size_t before = solver.statistics().particles;
+    solver.step(kDt);
+    const bool reseeded = solver.steps() % solver.params().reseedInterval == 0;
+    if (s > 0 && !reseeded) run.particlesLost += long(before) - long(solver.statistics().particles);
+  }
+  const fluid::LiquidStatistics stats = solver.statistics();
+  run.volume = stats.volume;
+  run.particles = stats.particles;
+  if (split) {
+    const auto& mpi = static_cast<const MpiDomainSplit&>(*split);
+    for (const Vec<3>& x : solver.levelSetParticles().positions())
+      run.strayParticles += ownerOf<3>(x, mpi.block()) != mpi.block().rank;
+    long stray = run.strayParticles;
+    MPI_Allreduce(MPI_IN_PLACE, &stray, 1, MPI_LONG, MPI_SUM, mpi.comm());
+    run.strayParticles = stray;
+    run.phi = gatherToRoot(solver.phi(), mpi.block(), mpi.comm());
+  } else {
+    run.phi = solver.phi();
+  }
+  return run;
+}
+
+// `extraLayers` beyond what liquidGhostLayers asks for (ceil(band) = 6).
+LiquidRun runSplit(MPI_Comm comm, bool rock, int extraLayers = 0) {
+  const fluid::LiquidParams<3> params;
+  const int ghost = liquidGhostLayers(params.advection, params.cfl, params.bandCells) + extraLayers;
+  const GridBlock<3> block(kGlobal, BlockDecomposition<3>(kGlobal.res, sizeOf(comm), ghost, "test"), rankOf(comm),
+                           ghost);
+  MpiDomainSplit split(block, params.sides, params.projection.pcg, comm);
+  return runDamBreak(block.localSpec(), &split, rock);
+}
+
+// Largest |a - b| [cells] over the cells within 3 cells of b's surface.
+double surfaceDifference(const Grid<float, 3>& a, const Grid<float, 3>& b) {
+  double worst = 0.0;
+  for (std::size_t i = 0; i < a.count(); ++i)
+    if (std::abs(b[i]) < 3.0 * kGlobal.dx) worst = std::max(worst, double(std::abs(a[i] - b[i])));
+  return worst / kGlobal.dx;
+}
+
+// The split run against the one-rank run and the serial solver (MG-PCG). With ceil(band) ghost
+// layers the fast marching of a block differs from the whole grid's where a cell's upwind cone
+// leaves the ghosts (tests/parallel/split_level_set_test.cpp), and the surface carries that from
+// step to step: 0.068 cells after 40 steps on 2, 4 and 8 ranks (0.134 with the rock, whose
+// solid extension of phi feeds the march); four layers more bring it to 5e-4 (1e-3).
+// Every particle lies in its owner's cells, and no step without reseeding changes their count.
+class DistributedLiquid : public ::testing::TestWithParam<std::tuple<bool, int>> {};
+
+TEST_P(DistributedLiquid, DamBreakFollowsTheOneRankRun) {
+  const auto [rock, extraLayers] = GetParam();
+  if (worldSize() != 2 && (worldSize() != 8 || extraLayers > 0 || !rock))
+    GTEST_SKIP() << "run on 2 ranks (and 8: the rock with ceil(band) layers)";
+  MPI_Comm alone;
+  MPI_Comm_split(MPI_COMM_WORLD, worldRank() == 0 ? 0 : MPI_UNDEFINED, 0, &alone);
+  std::optional<LiquidRun> one, serial;
+  if (worldRank() == 0) {
+    one = runSplit(alone, rock);
+    serial = runDamBreak(kGlobal, nullptr, rock);
+    MPI_Comm_free(&alone);
+  }
+  const LiquidRun split = runSplit(MPI_COMM_WORLD, rock, extraLayers);
+  EXPECT_EQ(split.strayParticles, 0);
+  EXPECT_EQ(split.particlesLost, 0);
+  if (worldRank() == 0) {
+    const double toOne = surfaceDifference(split.phi, one->phi), toSerial = surfaceDifference(split.phi, serial->phi);
+    const double volumeToOne = split.volume / one->volume - 1.0, volumeToSerial = split.volume / serial->volume - 1.0;
+    const double particlesToOne = double(split.particles) / double(one->particles) - 1.0;
+    std::printf("liquid dam break%s, %d steps on %d ranks with %d more ghost layers: surface within %.3g cells of the "
+                "one-rank run's (serial solver: %.3g), volume %+.2e (%+.2e), marker particles %zu vs %zu (%+.2e)\n",
+                rock ? " against a rock" : "", kSteps, worldSize(), extraLayers, toOne, toSerial, volumeToOne, volumeToSerial, split.particles,
+                one->particles, particlesToOne);
+    const double surfaceLimit = extraLayers == 0 ? 0.2 : 0.002;
+    EXPECT_LT(toOne, surfaceLimit);
+    EXPECT_LT(toSerial, surfaceLimit + 0.001);  // hypre and MG-PCG: 3e-4 cells apart on one rank
+    EXPECT_LT(std::abs(volumeToOne), 1e-5);
+    EXPECT_LT(std::abs(volumeToSerial), 1e-5);
+    EXPECT_LT(std::abs(particlesToOne), 1e-3);
+  }
+  EXPECT_TRUE(fromRoot(!::testing::Test::HasFailure()));
+}
+
+// The rock with wider ghost layers measured 0.001 cells (docs/parallel.md), not run here.
+INSTANTIATE_TEST_SUITE_P(RockAndGhostLayers, DistributedLiquid,
+                         ::testing::Values(std::make_tuple(false, 0), std::make_tuple(false, 4), std::make_tuple(true, 0)));
+
+}  // namespace
+}  // namespace msim::parallel
