@@ -11,7 +11,6 @@
 #include "msim/core/interpolation.hpp"
 #include "msim/core/parallel.hpp"
 #include "msim/core/resample.hpp"
-#include "msim/fluid/vortex/vortex_solids.hpp"
 #include "msim/numerics/level_set/extrapolation.hpp"
 #include "msim/numerics/level_set/fast_marching.hpp"
 #include "msim/numerics/level_set/level_set_measures.hpp"
@@ -47,8 +46,8 @@ LiquidSolver<D>::LiquidSolver(const GridSpec<D>& spec, const LiquidParams<D>& pa
 template <int D>
 void LiquidSolver<D>::setDomainSplit(DomainSplit<D>* split) {
   if (split && (params_.tracker != InterfaceTracker::ParticleLevelSet || vortex_ || steps_ > 0 || started_))
-    throw std::invalid_argument("liquid solver: a split run tracks the surface with the particle level set, has no "
-                                "vortex particles and is split before its first step");
+    throw std::invalid_argument("liquid solver: a split run tracks the surface with the particle level set and is "
+                                "split before its vortex particles and its first step");
   split_ = split;
   const BlockPlacement<D> where = split ? split->placement() : BlockPlacement<D>{};
   cellOrigin_ = where.whole() ? IVec<D>::Zero() : where.cellOrigin;
@@ -523,9 +522,9 @@ void LiquidSolver<D>::checkFiniteSplit() const {
 
 template <int D>
 void LiquidSolver<D>::setVortexLayer(std::unique_ptr<VortexLayer<D>> layer) {
-  if (layer && split_) throw std::invalid_argument("liquid solver: vortex particles do not run split among processes");
   vortex_ = std::move(layer);
   if (!vortex_) return;
+  vortex_->setDomainSplit(split_);
   if (solidDistance_) vortex_->setSolid(*solidDistance_);
   vortex_->seedInitial(vortex_->flowVorticity(velocity_));
   dropVortexParticlesInAir();
@@ -541,7 +540,7 @@ void LiquidSolver<D>::advanceVortexParticles(double dt) {
 template <int D>
 void LiquidSolver<D>::dropVortexParticlesInAir() {
   // phi > 0 (read D-linearly at the cell centres) is air, which carries no vorticity.
-  removeVortexParticlesInSolid<D>(vortex_->particles(), [&](const Vec<D>& x) { return -double(sampleLinear<D>(phi_, x)); });
+  vortex_->removeWherePositive(phi_);
 }
 
 template <int D>

@@ -160,8 +160,9 @@ class LiquidSolver {
   int advance(double dt);
 
   // Splits the liquid among processes (null: one process): the solver's grid is this process's
-  // block (split->localSpec()). Call it before the obstacles and the liquid are added. The particle
-  // level set tracker only, without emitters, sinks or vortex particles (std::invalid_argument).
+  // block (split->localSpec()). Call it before the obstacles, the liquid and the vortex particles
+  // are added. The particle level set tracker only, without emitters or sinks
+  // (std::invalid_argument); vortex particles are kept whole on every process (VortexLayer).
   void setDomainSplit(DomainSplit<D>* split);
 
   // Vortex particles in the liquid (null: none); the initial ones are seeded here, so call it

@@ -33,6 +33,17 @@ void VortexLayer<D>::seedInitial(const Vorticity<D>* flowVorticity) {
 }
 
 template <int D>
+std::size_t VortexLayer<D>::removeWherePositive(const Grid<float, D>& field) {
+  const auto& x = particles_.positions();
+  if (!split_)
+    return particles_.removeIf([&](std::size_t p) { return sampleLinear<D>(field, Vec<D>(x[p].template cast<double>())) > 0.0f; });
+  readAtOwners(field.spec(), 1, [&](const Vec<D>& position, std::size_t, double* out) {
+    out[0] = sampleLinear<D>(field, position) > 0.0f ? 1.0 : 0.0;
+  });
+  return particles_.removeIf([&](std::size_t p) { return reads_[p] > 0.0; });
+}
+
+template <int D>
 FlowVorticitySampler<D> VortexLayer<D>::flowAtOwners(const Vorticity<D>* local) {
   if (!local) throw std::invalid_argument("vortex particles: LocalFlow seeding needs the grid's vorticity");
   return [this, local](const std::vector<Vec<D>>& positions, std::vector<VortexVector<D>>& out) {

@@ -48,6 +48,10 @@ class VortexLayer {
   void setSolid(const Grid<float, D>& nodalSolidPhi) { solidPhi_ = nodalSolidPhi; }
   // The particles seeded at the start (initialCount), once; flowVorticity as for advance.
   void seedInitial(const Vorticity<D>* flowVorticity);
+  // Deletes the particles where `field` (cell-centred over the solver's grid, a block with ghosts
+  // in a split run; read D-linearly, on the owning rank) is positive: a liquid's phi deletes those
+  // in the air. Returns how many.
+  std::size_t removeWherePositive(const Grid<float, D>& field);
   // Runs the layer on one block of a split domain (Selle ch. 8; null: the whole domain): the
   // velocity, solid mask and signed distance it is given are then the block's (with ghosts).
   // Every rank keeps every particle and moves them alike: the rank whose owned cells hold a

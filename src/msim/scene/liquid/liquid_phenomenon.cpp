@@ -136,8 +136,6 @@ std::unique_ptr<DomainSplit<D>> liquidSplit(const Scene& scene) {
   } else {
     if (l.at("tracker").get<std::string>() == "flip") refuseSplit(scene, "liquid.tracker", "FLIP");
     if (l.at("turbulence").at("enabled").get<bool>()) refuseSplit(scene, "liquid.turbulence.enabled", "sub-grid turbulence");
-    if (l.at("vortex_particles").at("enabled").get<bool>())
-      refuseSplit(scene, "liquid.vortex_particles.enabled", "vortex particles in a liquid");
     if (!r.at("sources").empty()) refuseSplit(scene, "sources", "an emitter or sink");
     const fluid::LiquidParams<3> p = liquidParams<3>(scene);
     const int needed = parallel::liquidGhostLayers(p.advection, std::max(1.0, p.cfl), p.bandCells);
