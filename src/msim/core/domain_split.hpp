@@ -75,6 +75,9 @@ class DomainSplit {
   virtual void setSolidVelocity(const MacGrid<D>& solidVelocity) = 0;
   // A domain wall moving along its normal (an inlet) [m/s along +axis]; others stay at rest.
   virtual void setWallNormalVelocity(int axis, int side, double velocity) = 0;
+  // Besides, the wall faces of the block given their own normal velocity (a liquid's inflow where an
+  // emitter lies against a wall; null: none), as PressureProjection::setWallFaceVelocity. Local.
+  virtual void setWallFaceVelocity(const MacGrid<D>* velocity) = 0;
   // The divergence [1/s] project() leaves in each local cell (expanding gas; null: none). The
   // field must outlive the calls to project().
   virtual void setCellTargetDivergence(const Grid<float, D>* perCell) = 0;

@@ -67,6 +67,14 @@ void DistributedProjection::setSolidVelocity(const MacGrid<3>& solidVelocity) {
   applyWallVelocities();
 }
 
+void DistributedProjection::setWallFaceVelocity(const MacGrid<3>* velocity) {
+  if (velocity)
+    wallFaceVelocity_ = *velocity;
+  else
+    wallFaceVelocity_.reset();
+  applyWallVelocities();
+}
+
 void DistributedProjection::setWallNormalVelocity(int axis, int side, double velocity) {
   wallNormalVelocity_[static_cast<std::size_t>(axis)][static_cast<std::size_t>(side)] = static_cast<float>(velocity);
   applyWallVelocities();
@@ -85,7 +93,9 @@ void DistributedProjection::applyWallVelocities() {
     Grid<float, 3>& us = solidVelocity_.component(a);
     for (std::size_t i = 0; i < us.count(); ++i) {
       const int side = wallSide(a, us.coord(i));
-      if (side >= 0) us[i] = wallNormalVelocity_[static_cast<std::size_t>(a)][static_cast<std::size_t>(side)];
+      if (side >= 0)
+        us[i] = wallNormalVelocity_[static_cast<std::size_t>(a)][static_cast<std::size_t>(side)] +
+                (wallFaceVelocity_ ? wallFaceVelocity_->component(a)[i] : 0.0f);
     }
   }
 }

@@ -57,6 +57,9 @@ class DistributedProjection {
   // A domain wall that moves along its normal (fluid enters or leaves through it: a wind
   // tunnel's inlet), as numerics::PressureProjection::setWallNormalVelocity [m/s along +axis].
   void setWallNormalVelocity(int axis, int side, double velocity);
+  // Per wall face, added to its wall's normal velocity (a liquid's inflow under an emitter lying
+  // against a wall; null: none), as numerics::PressureProjection::setWallFaceVelocity: local faces.
+  void setWallFaceVelocity(const MacGrid<3>* velocity);
   // The divergence [1/s] the projection leaves in each local cell (expanding gas), as
   // numerics::PressureProjection::setCellTargetDivergence; null: none. Kept by pointer: the field
   // must outlive the calls to project().
@@ -92,6 +95,7 @@ class DistributedProjection {
   MacGrid<3> weights_;
   MacGrid<3> solidVelocity_;                 // with ghosts; the walls' own on the domain's walls
   std::array<std::array<float, 2>, 3> wallNormalVelocity_{};
+  std::optional<MacGrid<3>> wallFaceVelocity_;  // setWallFaceVelocity
   const Grid<float, 3>* cellTargetDivergence_ = nullptr;
   void applyWallVelocities();  // the walls' normal velocities into solidVelocity_
   // The side (0 lower, 1 upper) of the domain wall that local face `face` of `axis` lies on, or -1.

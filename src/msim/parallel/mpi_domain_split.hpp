@@ -39,6 +39,7 @@ class MpiDomainSplit final : public DomainSplit<3> {
   void setWallNormalVelocity(int axis, int side, double velocity) override {
     projection_.setWallNormalVelocity(axis, side, velocity);
   }
+  void setWallFaceVelocity(const MacGrid<3>* velocity) override { projection_.setWallFaceVelocity(velocity); }
   void setCellTargetDivergence(const Grid<float, 3>* perCell) override { projection_.setCellTargetDivergence(perCell); }
   SplitSolveStats project(MacGrid<3>& velocity, Grid<float, 3>& pressure, double dt, double density) override;
 

@@ -127,7 +127,6 @@ void LiquidSolver<D>::addLiquid(const Grid<float, D>& cellPhi, const Vec<D>& vel
 template <int D>
 double LiquidSolver<D>::emit(const Grid<float, D>& region, const Vec<D>& velocity) {
   if (!region.sameLayout(phi_)) throw std::invalid_argument("liquid solver: emit needs a cell-centred region");
-  if (split_) throw std::invalid_argument("liquid solver: emitters do not run split among processes");
   if (!started_) start();
   ScopedStage s(timers_, "liquid: sources");
   for (int a = 0; a < D; ++a) {
@@ -159,6 +158,8 @@ void LiquidSolver<D>::markWallInflow(const Grid<float, D>& region, const Vec<D>&
       if (!(inward > 0.0)) continue;
       if (!wallInflow_) wallInflow_.emplace(spec_, 0.0f);
       auto& u = wallInflow_->component(a);
+      const bool domainSide = side == 0 ? cellOrigin_[a] == 0 : cellOrigin_[a] + spec_.res[a] == globalRes_[a];
+      if (!domainSide) continue;  // a split run's block: its edge here lies inside the domain
       parallelForCells(u, [&](const IVec<D>& f, std::size_t lin) {
         if (f[a] != (side == 0 ? 0 : spec_.res[a])) return;
         IVec<D> cell = f;
@@ -173,9 +174,18 @@ void LiquidSolver<D>::markWallInflow(const Grid<float, D>& region, const Vec<D>&
 }
 
 template <int D>
+void LiquidSolver<D>::applyWallInflow() {
+  if (inflowThisStep_ || inflowApplied_) {
+    const MacGrid<D>* faces = inflowThisStep_ ? &*wallInflow_ : nullptr;
+    projection_.setWallFaceVelocity(faces);  // also what extendVelocity gives the closed faces
+    if (split_) split_->setWallFaceVelocity(faces);
+  }
+  inflowApplied_ = inflowThisStep_;
+}
+
+template <int D>
 double LiquidSolver<D>::drain(const Grid<float, D>& region) {
   if (!region.sameLayout(phi_)) throw std::invalid_argument("liquid solver: drain needs a cell-centred region");
-  if (split_) throw std::invalid_argument("liquid solver: sinks do not run split among processes");
   if (!started_) start();
   ScopedStage s(timers_, "liquid: sinks");
   if (params_.tracker == InterfaceTracker::Flip) return flip_.particleVolume() * double(flip_.removeInside(region));
@@ -185,10 +195,10 @@ double LiquidSolver<D>::drain(const Grid<float, D>& region) {
 template <int D>
 template <typename Edit>
 double LiquidSolver<D>::editLevelSet(const Grid<float, D>& region, Edit&& edit) {
-  const double before = numerics::enclosedVolume(phi_, &solid_);
+  const double before = liquidVolume();
   parallelFor(0, phi_.count(), edit);
   particles_.removeInside(region);
-  const double change = numerics::enclosedVolume(phi_, &solid_) - before;
+  const double change = liquidVolume() - before;
   targetVolume_ = std::max(0.0, targetVolume_ + change);
   return change;
 }
@@ -481,6 +491,7 @@ void LiquidSolver<D>::step(double dt) {
     });
     volume_ = liquidVolume();  // phi is final for this step from here on
     controlDivergence_ = volumeControlDivergence(dt);
+    applyWallInflow();
     if (split_) {
       split_->setFreeSurface(pressurePhi_);
       controlDivergenceField_.fill(static_cast<float>(controlDivergence_));
@@ -492,8 +503,6 @@ void LiquidSolver<D>::step(double dt) {
     } else {
       projection_.setFreeSurface(pressurePhi_);
       projection_.setTargetDivergence(controlDivergence_);
-      if (inflowThisStep_ || inflowApplied_) projection_.setWallFaceVelocity(inflowThisStep_ ? &*wallInflow_ : nullptr);
-      inflowApplied_ = inflowThisStep_;
       lastSolve_ = projection_.project(velocity_, dt, params_.density);
     }
   }

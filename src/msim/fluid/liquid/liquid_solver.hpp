@@ -161,8 +161,8 @@ class LiquidSolver {
 
   // Splits the liquid among processes (null: one process): the solver's grid is this process's
   // block (split->localSpec()). Call it before the obstacles, the liquid and the vortex particles
-  // are added. The particle level set tracker only, without emitters or sinks
-  // (std::invalid_argument); vortex particles are kept whole on every process (VortexLayer).
+  // are added, and call emit and drain on every process alike. The particle level set tracker
+  // only (std::invalid_argument); vortex particles are kept whole on every process (VortexLayer).
   void setDomainSplit(DomainSplit<D>* split);
 
   // Vortex particles in the liquid (null: none); the initial ones are seeded here, so call it
@@ -209,6 +209,8 @@ class LiquidSolver {
   double boundaryOutflow(double dt) const;
   // An emitter against a wall: the wall's faces under it get its velocity (see emit).
   void markWallInflow(const Grid<float, D>& region, const Vec<D>& velocity);
+  // Hands the pressure solve (and a split run's) this step's wall inflow, or clears last step's.
+  void applyWallInflow();
   // Kim et al.'s divergence for the volume just measured after the surface moved (0 when off).
   double volumeControlDivergence(double dt);
   // Volume control starts afresh from the volume phi holds now.

@@ -136,7 +136,6 @@ std::unique_ptr<DomainSplit<D>> liquidSplit(const Scene& scene) {
   } else {
     if (l.at("tracker").get<std::string>() == "flip") refuseSplit(scene, "liquid.tracker", "FLIP");
     if (l.at("turbulence").at("enabled").get<bool>()) refuseSplit(scene, "liquid.turbulence.enabled", "sub-grid turbulence");
-    if (!r.at("sources").empty()) refuseSplit(scene, "sources", "an emitter or sink");
     const fluid::LiquidParams<3> p = liquidParams<3>(scene);
     const int needed = parallel::liquidGhostLayers(p.advection, std::max(1.0, p.cfl), p.bandCells);
     const std::string reads =
@@ -189,7 +188,7 @@ class LiquidPhenomenon final : public Phenomenon {
       coveredOpenCells<D>(scene, *shape, solver_.solid(), key, split_.get());  // InputError when it holds no open cell
       solver_.addLiquid(shape->distanceField(spec), sceneVector<D>(bodies[i].at("velocity")));
     }
-    sources_.emplace(scene, solver_.solid(), volume());
+    sources_.emplace(scene, solver_.solid(), volume(), split_.get());
     solver_.setVortexLayer(vortexLayer<D>(scene, "liquid"));
     if (scene.resolved.at("liquid").at("turbulence").at("enabled").get<bool>())
       turbulence_.emplace(solver_.spec(), liquidTurbulenceParams<D>(scene), solver_.params().advection, solver_.phi(),

@@ -37,19 +37,31 @@ void declareLiquidSources(Schema& root) {
 
 namespace {
 
+// Whether local cell c of a split run's block is the process's own (every cell without a split).
+template <int D>
+bool ownCell(const IVec<D>& c, const DomainSplit<D>* split) {
+  return !split || ((c.array() >= split->ownedLo().array()).all() && (c.array() < split->ownedHi().array()).all());
+}
+
 // Cross-section [m^(D-1)] of the covered cells (indices into `grid`, cell-centred) normal to the
 // unit direction n: their volume over their extent along n (exact for boxes and cylinders aligned
-// with n).
+// with n). Split: over every block's own cells.
 template <int D>
 double crossSection(const std::vector<std::pair<std::size_t, float>>& cells, const Grid<float, D>& grid,
-                    const Vec<D>& n) {
+                    const Vec<D>& n, DomainSplit<D>* split) {
   const GridSpec<D>& spec = grid.spec();
   double lo = std::numeric_limits<double>::infinity(), hi = -lo, volume = 0.0;
   for (const auto& [cell, cover] : cells) {
+    if (!ownCell<D>(grid.coord(cell), split)) continue;
     const double s = grid.position(grid.coord(cell)).dot(n);
     lo = std::min(lo, s);
     hi = std::max(hi, s);
     volume += cover * spec.cellVolume();
+  }
+  if (split) {
+    volume = split->sumOverRanks(volume);
+    hi = split->maxOverRanks(hi);
+    lo = -split->maxOverRanks(-lo);
   }
   return volume / (hi - lo + spec.dx);
 }
@@ -57,7 +69,8 @@ double crossSection(const std::vector<std::pair<std::size_t, float>>& cells, con
 }  // namespace
 
 template <int D>
-LiquidSources<D>::LiquidSources(const Scene& scene, const Grid<float, D>& solid, double initialVolume) {
+LiquidSources<D>::LiquidSources(const Scene& scene, const Grid<float, D>& solid, double initialVolume,
+                                DomainSplit<D>* split) {
   const nlohmann::json& r = scene.resolved;
   const GridSpec<D> spec = solid.spec();
   const double duration = r.at("time").at("duration").get<double>();
@@ -67,14 +80,14 @@ LiquidSources<D>::LiquidSources(const Scene& scene, const Grid<float, D>& solid,
     Region e;
     const std::string key = fmt::format("sources[{}].shape", i);
     e.shape = sceneShape<D>(scene, s.at("shape"), key);
-    const auto cells = coveredOpenCells<D>(scene, *e.shape, solid, key);  // InputError inside a solid
+    const auto cells = coveredOpenCells<D>(scene, *e.shape, solid, key, split);  // InputError inside a solid
     e.velocity = sceneVector<D>(s.at("velocity"));
     e.motion = sceneVector<D>(s.at("motion"));
     e.start = s.at("start").get<double>();
     e.stop = s.at("stop").get<double>();
     const double speed = e.velocity.norm();
     const double on = std::max(0.0, (e.stop > 0.0 ? std::min(e.stop, duration) : duration) - e.start);
-    if (speed > 0.0) emitted += crossSection<D>(cells, solid, Vec<D>(e.velocity / speed)) * speed * on;
+    if (speed > 0.0) emitted += crossSection<D>(cells, solid, Vec<D>(e.velocity / speed), split) * speed * on;
     e.field = e.shape->distanceField(spec);
     emitters_.push_back(std::move(e));
   }
@@ -83,7 +96,7 @@ LiquidSources<D>::LiquidSources(const Scene& scene, const Grid<float, D>& solid,
     Region k;
     const std::string key = fmt::format("sinks[{}].shape", i);
     k.shape = sceneShape<D>(scene, s.at("shape"), key);
-    coveredOpenCells<D>(scene, *k.shape, solid, key);
+    coveredOpenCells<D>(scene, *k.shape, solid, key, split);
     k.start = s.at("start").get<double>();
     k.stop = s.at("stop").get<double>();
     k.field = k.shape->distanceField(spec);
@@ -94,7 +107,9 @@ LiquidSources<D>::LiquidSources(const Scene& scene, const Grid<float, D>& solid,
   for (const auto& axis : openDomainSides<D>(r)) closed = closed && !axis[0] && !axis[1];
   if (closed && !emitters_.empty()) {
     double capacity = 0.0;
-    for (std::size_t c = 0; c < solid.count(); ++c) capacity += solid[c] < 0.5f ? spec.cellVolume() : 0.0;
+    for (std::size_t c = 0; c < solid.count(); ++c)
+      capacity += solid[c] < 0.5f && ownCell<D>(solid.coord(c), split) ? spec.cellVolume() : 0.0;
+    if (split) capacity = split->sumOverRanks(capacity);
     if (initialVolume + emitted > capacity)
       throw InputError(fmt::format(
           "{}: 'sources': the closed domain has {:.4g} m^{} of open space, but the initial liquid ({:.4g}) and what "

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "msim/core/domain_split.hpp"
 #include "msim/core/grid.hpp"
 #include "msim/fluid/liquid/liquid_solver.hpp"
 #include "msim/geometry/shape.hpp"
@@ -26,7 +27,9 @@ class LiquidSources {
  public:
   // InputError naming the key for a shape covering no open cell of `solid`, or for a closed
   // domain (no open side, no sink) that initialVolume [m^3] plus the emitted liquid would overfill.
-  LiquidSources(const Scene& scene, const Grid<float, D>& solid, double initialVolume);
+  // A run split among processes (`split`): `solid` is the block's, the checks are over every
+  // block (collective), and apply must run on every process alike.
+  LiquidSources(const Scene& scene, const Grid<float, D>& solid, double initialVolume, DomainSplit<D>* split = nullptr);
 
   // Applies the emitters and sinks that are on at time t [s] (before the solver's step from t).
   // Returns the volume added less the volume removed [m^3].
