@@ -45,8 +45,8 @@ struct LiquidRun {
 // What a run holds besides the water: a rock it runs against (cut by the blocks' edges), vortex
 // particles spinning the column (every rank keeps them all; those reaching the air are deleted),
 // or an emitter against the z_min wall, across the blocks' cut, letting water in through it and a
-// sink on the floor taking it out.
-enum class Extra { None, Rock, VortexParticles, EmitterAndSink };
+// sink on the floor taking it out; or the water carried by FLIP particles instead.
+enum class Extra { None, Rock, VortexParticles, EmitterAndSink, Flip };
 
 // A column of water against the x_min wall, collapsing, and a ball of water falling beside it.
 Grid<float, 3> water(const GridSpec<3>& spec) {
@@ -61,7 +61,9 @@ Grid<float, 3> water(const GridSpec<3>& spec) {
 }
 
 LiquidRun runDamBreak(const GridSpec<3>& spec, DomainSplit<3>* split, Extra extra) {
-  fluid::LiquidSolver<3> solver(spec, fluid::LiquidParams<3>{});
+  fluid::LiquidParams<3> params;
+  if (extra == Extra::Flip) params.tracker = fluid::InterfaceTracker::Flip;
+  fluid::LiquidSolver<3> solver(spec, params);
   solver.setDomainSplit(split);
   if (extra == Extra::Rock)
     solver.setObstacles(numerics::sampleNodes<3>(spec, [](const Vec<3>& x) { return (x - Vec<3>(0.5, 0.1, 0.37)).norm() - 0.16; }));
@@ -96,7 +98,7 @@ LiquidRun runDamBreak(const GridSpec<3>& spec, DomainSplit<3>* split, Extra extr
       solver.drain(sink);
     }
     solver.step(kDt);
-    const bool reseeded = solver.steps() % solver.params().reseedInterval == 0;
+    const bool reseeded = extra != Extra::Flip && solver.steps() % solver.params().reseedInterval == 0;
     if (s > 0 && !reseeded && extra != Extra::EmitterAndSink)  // they delete the particles in their shapes
       run.particlesLost += long(before) - long(solver.statistics().particles);
   }
@@ -108,6 +110,8 @@ LiquidRun runDamBreak(const GridSpec<3>& spec, DomainSplit<3>* split, Extra extr
   if (split) {
     const auto& mpi = static_cast<const MpiDomainSplit&>(*split);
     for (const Vec<3>& x : solver.levelSetParticles().positions())
+      run.strayParticles += ownerOf<3>(x, mpi.block()) != mpi.block().rank;
+    for (const Vecf<3>& x : solver.flipParticles().positions())
       run.strayParticles += ownerOf<3>(x, mpi.block()) != mpi.block().rank;
     long stray = run.strayParticles;
     MPI_Allreduce(MPI_IN_PLACE, &stray, 1, MPI_LONG, MPI_SUM, mpi.comm());
@@ -167,19 +171,24 @@ TEST_P(DistributedLiquid, DamBreakFollowsTheOneRankRun) {
     const double volumeToOne = split.volume / one->volume - 1.0, volumeToSerial = split.volume / serial->volume - 1.0;
     const double particlesToOne = double(split.particles) / double(one->particles) - 1.0;
     std::printf("liquid dam break%s, %d steps on %d ranks with %d more ghost layers: surface within %.3g cells of the "
-                "one-rank run's (serial solver: %.3g), volume %+.2e (%+.2e), marker particles %zu vs %zu (%+.2e)\n",
+                "one-rank run's (serial solver: %.3g), volume %+.2e (%+.2e), particles %zu vs %zu (%+.2e)\n",
                 extra == Extra::Rock              ? " against a rock"
                 : extra == Extra::VortexParticles ? " with vortex particles"
                 : extra == Extra::EmitterAndSink  ? " with an emitter and a sink"
+                : extra == Extra::Flip            ? ", FLIP"
                                                   : "",
                 kSteps, worldSize(), extraLayers, toOne, toSerial, volumeToOne, volumeToSerial, split.particles,
                 one->particles, particlesToOne);
-    const double surfaceLimit = extraLayers == 0 ? 0.2 : 0.002;
+    // FLIP rebuilds its surface from the particles every step, switching cells between deep inside
+    // and the kernel's value: the fast marching's differences grow (the particles, bit for bit for 30
+    // steps, part at the 1e-7 level by 35 and then 0.002 cells at 10 layers, 0.54 at 6).
+    const bool flip = extra == Extra::Flip;
+    const double surfaceLimit = extraLayers == 0 ? 0.2 : flip ? 0.004 : 0.002;
     EXPECT_LT(toOne, surfaceLimit);
     // hypre and MG-PCG: 3e-4 cells apart on one rank; the vortex particles spin that up to 0.009.
     EXPECT_LT(toSerial, extra == Extra::VortexParticles ? 0.02 : surfaceLimit + 0.001);
-    EXPECT_LT(std::abs(volumeToOne), 1e-5);
-    EXPECT_LT(std::abs(volumeToSerial), 1e-5);
+    EXPECT_LT(std::abs(volumeToOne), flip ? 1e-4 : 1e-5);
+    EXPECT_LT(std::abs(volumeToSerial), flip ? 1e-4 : 1e-5);
     EXPECT_LT(std::abs(particlesToOne), 1e-3);
     if (extra == Extra::EmitterAndSink) {
       std::printf("target volume %.6g m^3 (one rank %.6g, serial %.6g)\n", split.targetVolume, one->targetVolume,
@@ -204,7 +213,7 @@ TEST_P(DistributedLiquid, DamBreakFollowsTheOneRankRun) {
 INSTANTIATE_TEST_SUITE_P(ExtrasAndGhostLayers, DistributedLiquid,
                          ::testing::Values(std::make_tuple(Extra::None, 0), std::make_tuple(Extra::None, 4),
                                            std::make_tuple(Extra::Rock, 0), std::make_tuple(Extra::VortexParticles, 4),
-                                           std::make_tuple(Extra::EmitterAndSink, 8)));
+                                           std::make_tuple(Extra::EmitterAndSink, 8), std::make_tuple(Extra::Flip, 4)));
 
 }  // namespace
 }  // namespace msim::parallel

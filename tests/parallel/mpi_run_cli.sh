@@ -74,7 +74,8 @@ print(f"vortex_local_flow vortex_particles: 1 process {a}, 2 processes {b}")
 assert a > 50 and abs(a - b) <= max(1, 0.02 * a), (a, b)
 PY
 # A liquid (particle level set): a ball of water falling into a pool, into a pool with a rock in it
-# (a static obstacle that both blocks hold part of), and a river fed by an emitter.
+# (a static obstacle that both blocks hold part of), a river fed by an emitter, and a dam break
+# carried by FLIP particles.
 # The one-process run solves the pressure with its own MG-PCG, the split run with hypre, each to
 # its tolerance, and the splash amplifies the difference: the rock's 2.4e-3 in the particle count
 # and 1.1% in the kinetic energy stay the same with 10 or 14 ghost layers (the split itself is
@@ -101,6 +102,9 @@ compare_liquid drop_into_pool rock
 # open x_max side, around five boulders (sub-grid turbulence off: it does not run split).
 extra=(--set domain.resolution=48 --set liquid.turbulence.enabled=false)
 compare_liquid river_rapids river
+# FLIP: the particles carry the water (the 3D dam break).
+extra=()
+compare_liquid dam_break_3d flip
 # The liquid resumed under mpirun (each rank keeps its block and its own saved particles) against
 # the same resume on one process: a liquid's resume restarts the pressure's warm start and the
 # reseeding count, on one process as on two.
@@ -151,7 +155,6 @@ expect_failure 2 "conservative scalar transport" run "$scenes/plume_3d.json" --o
 expect_failure 2 "cannot split" run "$scenes/plume_3d.json" --out "$tmp/bad" --set domain.resolution=4 -q
 expect_failure 2 "mpi.ghost_layers" run "$scenes/plume_3d.json" --out "$tmp/bad" --set mpi.ghost_layers=2 -q
 expect_failure 2 "mpi.blocks" run "$scenes/plume_3d.json" --out "$tmp/bad" --set 'mpi.blocks=[3,1,1]' -q
-expect_failure 2 "liquid.tracker" run "$scenes/dam_break_3d.json" --out "$tmp/bad" -q
 expect_failure 2 "liquid.turbulence.enabled" run "$scenes/river_rapids.json" --out "$tmp/bad" -q
 expect_failure 2 "mpi.ghost_layers" run "$scenes/drop_into_pool.json" --out "$tmp/bad" --set mpi.ghost_layers=4 -q
 [[ ! -e "$tmp/bad" ]] || { echo "bad input left $tmp/bad behind"; exit 1; }

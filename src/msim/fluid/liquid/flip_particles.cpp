@@ -27,16 +27,62 @@ Vecf<D> insideDomain(const GridSpec<D>& spec, Vecf<D> x) {
 
 template <int D>
 FlipParticles<D>::FlipParticles(const GridSpec<D>& spec, int perCell, std::uint64_t seed)
-    : spec_(spec), perCell_(perCell > 0 ? perCell : (1 << D)), seed_(seed), radius_(0.5 * spec.dx) {}
+    : spec_(spec), perCell_(perCell > 0 ? perCell : (1 << D)), seed_(seed), radius_(0.5 * spec.dx), ownedHi_(spec.res) {}
+
+template <int D>
+void FlipParticles<D>::setBlock(const BlockPlacement<D>& placement, const IVec<D>& ownedLo, const IVec<D>& ownedHi) {
+  placement_ = placement;
+  ownedLo_ = ownedLo;
+  ownedHi_ = ownedHi;
+}
+
+template <int D>
+void FlipParticles<D>::appendRows(const std::vector<double>& rows) {
+  for (std::size_t at = 0; at + kRowWidth <= rows.size(); at += kRowWidth) {
+    Vecf<D> x, v;
+    for (int a = 0; a < D; ++a) {
+      x[a] = static_cast<float>(rows[at + a]);
+      v[a] = static_cast<float>(rows[at + D + a]);
+    }
+    positions_.push_back(x);
+    velocities_.push_back(v);
+  }
+}
+
+template <int D>
+void FlipParticles<D>::setNeighbours(const std::vector<double>& rows) {
+  neighbours_ = rows.size() / kRowWidth;
+  withNeighbours_.assign(positions_.begin(), positions_.end());
+  withNeighboursV_.assign(velocities_.begin(), velocities_.end());
+  for (std::size_t at = 0; at + kRowWidth <= rows.size(); at += kRowWidth) {
+    Vecf<D> x, v;
+    for (int a = 0; a < D; ++a) {
+      x[a] = static_cast<float>(rows[at + a]);
+      v[a] = static_cast<float>(rows[at + D + a]);
+    }
+    withNeighbours_.push_back(x);
+    withNeighboursV_.push_back(v);
+  }
+}
+
+template <int D>
+std::span<const Vecf<D>> FlipParticles<D>::readPositions() const {
+  return neighbours_ > 0 ? std::span<const Vecf<D>>(withNeighbours_) : std::span<const Vecf<D>>(positions_);
+}
+
+template <int D>
+std::span<const Vecf<D>> FlipParticles<D>::readVelocities() const {
+  return neighbours_ > 0 ? std::span<const Vecf<D>>(withNeighboursV_) : std::span<const Vecf<D>>(velocities_);
+}
 
 template <int D>
 void FlipParticles<D>::seed(const Grid<float, D>& phi, const Grid<float, D>& solid, const MacGrid<D>& velocity) {
   positions_.clear();
   velocities_.clear();
   for (std::size_t cell = 0; cell < phi.count(); ++cell) {
-    if (!(phi[cell] < 0.5f * spec_.dx) || solid[cell] > 0.5f) continue;  // the surface cells too
     const IVec<D> c = phi.coord(cell);
-    Rng rng = Rng(seed_).split(cell);
+    if (!(phi[cell] < 0.5f * spec_.dx) || solid[cell] > 0.5f || !seeds(c)) continue;  // the surface cells too
+    Rng rng = Rng(seed_).split(placement_.globalIndex(c, cell));
     for (int k = 0; k < perCell_; ++k) {
       Vec<D> x;
       // Stratified when perCell is 2^D: one particle per sub-cell, jittered by up to 0.05 dx about
@@ -135,14 +181,14 @@ std::size_t FlipParticles<D>::emit(const Grid<float, D>& region, const Grid<floa
   parallelFor(0, positions_.size(), [&](std::size_t p) {
     if (sampleLinear<D>(region, positions_[p].template cast<double>()) < 0.0f) velocities_[p] = velocity;
   });
-  bucketByCell();
+  bucketByCell(positions_);
   const std::size_t before = positions_.size();
   for (std::size_t cell = 0; cell < region.count(); ++cell) {
-    if (!(region[cell] < 0.0f) || solid[cell] > 0.5f) continue;
+    const IVec<D> c = region.coord(cell);
+    if (!(region[cell] < 0.0f) || solid[cell] > 0.5f || !seeds(c)) continue;
     const int have = static_cast<int>(cellStart_[cell + 1] - cellStart_[cell]);
     if (2 * have >= perCell_) continue;  // refilled when half empty: fuller cells hold the flux at v A
-    const IVec<D> c = region.coord(cell);
-    Rng rng = Rng(seed_ ^ (round * 0x9E3779B97F4A7C15ull)).split(cell);
+    Rng rng = Rng(seed_ ^ (round * 0x9E3779B97F4A7C15ull)).split(placement_.globalIndex(c, cell));
     for (int k = have; k < perCell_; ++k) {
       Vecf<D> x;
       for (int a = 0; a < D; ++a) x[a] = static_cast<float>(spec_.origin[a] + (c[a] + rng.uniform()) * spec_.dx);
@@ -155,8 +201,7 @@ std::size_t FlipParticles<D>::emit(const Grid<float, D>& region, const Grid<floa
 
 template <int D>
 void FlipParticles<D>::toGrid(MacGrid<D>& velocity) {
-  splatter_.splat(std::span<const Vecf<D>>(positions_), std::span<const Vecf<D>>(velocities_), velocity,
-                  TransferKernel::Linear, SplatMode::Normalized, 0.0f);
+  splatter_.splat(readPositions(), readVelocities(), velocity, TransferKernel::Linear, SplatMode::Normalized, 0.0f);
 }
 
 template <int D>
@@ -172,26 +217,25 @@ void FlipParticles<D>::fromGrid(const MacGrid<D>& updated, const MacGrid<D>& bef
 }
 
 template <int D>
-void FlipParticles<D>::bucketByCell() const {
+void FlipParticles<D>::bucketByCell(std::span<const Vecf<D>> x) const {
   // A counting sort by cell (core's BucketSort keeps a histogram per block and bucket, too large
   // with a bucket per cell).
   const std::size_t cells = spec_.cellCount();
   cellStart_.assign(cells + 1, 0);
-  cellOf_.resize(positions_.size());
-  parallelFor(0, positions_.size(), [&](std::size_t p) {
-    cellOf_[p] = static_cast<std::uint32_t>(spec_.clampedCellIndex(positions_[p]));
-  });
+  cellOf_.resize(x.size());
+  parallelFor(0, x.size(), [&](std::size_t p) { cellOf_[p] = static_cast<std::uint32_t>(spec_.clampedCellIndex(x[p])); });
   for (const std::uint32_t c : cellOf_) ++cellStart_[c + 1];
   for (std::size_t c = 0; c < cells; ++c) cellStart_[c + 1] += cellStart_[c];
-  order_.resize(positions_.size());
+  order_.resize(x.size());
   next_.assign(cellStart_.begin(), cellStart_.end() - 1);
-  for (std::size_t p = 0; p < positions_.size(); ++p) order_[next_[cellOf_[p]]++] = static_cast<std::uint32_t>(p);
+  for (std::size_t p = 0; p < x.size(); ++p) order_[next_[cellOf_[p]]++] = static_cast<std::uint32_t>(p);
 }
 
 template <int D>
 void FlipParticles<D>::surface(Grid<float, D>& phi, double bandCells) const {
   if (!phi.sameLayout(Grid<float, D>(spec_))) throw std::invalid_argument("FLIP surface: phi must be cell-centred");
-  bucketByCell();
+  const std::span<const Vecf<D>> particles = readPositions();
+  bucketByCell(particles);
   const float band = static_cast<float>(bandCells * spec_.dx);
   const double R = 4.0 * radius_;  // kernel radius: 2 dx
   const int reach = 2;             // cells within R of a cell centre
@@ -234,7 +278,7 @@ void FlipParticles<D>::surface(Grid<float, D>& phi, double bandCells) const {
     forBox(lo, hi, [&](const IVec<D>& n) {
       const std::size_t nc = phi.index(n);
       for (std::uint32_t k = cellStart_[nc]; k < cellStart_[nc + 1]; ++k) {
-        const Vec<D> xp = positions_[order_[k]].template cast<double>();
+        const Vec<D> xp = particles[order_[k]].template cast<double>();
         const double s2 = (xp - x).squaredNorm() / (R * R);
         if (s2 >= 1.0) continue;
         const double w = (1.0 - s2) * (1.0 - s2) * (1.0 - s2);

@@ -17,8 +17,10 @@
 //              0.259 R in 2D, so a flat, evenly filled layer gets its surface on its top.
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
 
+#include "msim/core/block_placement.hpp"
 #include "msim/core/grid.hpp"
 #include "msim/core/mac_grid.hpp"
 #include "msim/core/transfer.hpp"
@@ -59,13 +61,39 @@ class FlipParticles {
   // lengths.
   void assign(std::vector<Vecf<D>> positions, std::vector<Vecf<D>> velocities);
 
+  // A block of a grid split among processes (core/domain_split.hpp), as for the particle level set:
+  // the grid is the block with its ghost layers, at `placement`, and the particles are those in
+  // the owned cells [ownedLo, ownedHi); seeding and emitters fill only the owned cells, each with
+  // the random stream of its global index.
+  void setBlock(const BlockPlacement<D>& placement, const IVec<D>& ownedLo, const IVec<D>& ownedHi);
+  // The particles as rows of kRowWidth doubles (position, velocity) for moving them between
+  // processes: taking out those at positions x with select(x), those with select(x) copied, and
+  // appending rows.
+  static constexpr int kRowWidth = 2 * D;
+  template <typename Select>
+  std::vector<double> takeRowsIf(Select&& select);
+  template <typename Select>
+  std::vector<double> rowsIf(Select&& select) const;
+  void appendRows(const std::vector<double>& rows);
+  // The particles of other processes near the block (rows as above): the velocity's splat and
+  // the surface read them with the own ones.
+  void setNeighbours(const std::vector<double>& rows);
+
   std::size_t size() const { return positions_.size(); }
   const std::vector<Vecf<D>>& positions() const { return positions_; }
   const std::vector<Vecf<D>>& velocities() const { return velocities_; }
   double radius() const { return radius_; }
 
  private:
-  void bucketByCell() const;
+  // The own particles' positions and velocities, and the neighbours' after them when there are
+  // any (what toGrid and surface read).
+  std::span<const Vecf<D>> readPositions() const;
+  std::span<const Vecf<D>> readVelocities() const;
+  // Groups the particles `x` by cell (cellStart_, order_).
+  void bucketByCell(std::span<const Vecf<D>> x) const;
+  bool seeds(const IVec<D>& c) const {
+    return (c.array() >= ownedLo_.array()).all() && (c.array() < ownedHi_.array()).all();
+  }
   // Deletes the particles whose flag is set (order kept).
   std::size_t removeFlagged();
 
@@ -74,11 +102,37 @@ class FlipParticles {
   std::uint64_t seed_;
   double radius_;
   std::vector<Vecf<D>> positions_, velocities_;
+  BlockPlacement<D> placement_;
+  IVec<D> ownedLo_ = IVec<D>::Zero(), ownedHi_;
+  std::size_t neighbours_ = 0;                            // neighbours' particles after the own ones in
+  std::vector<Vecf<D>> withNeighbours_, withNeighboursV_;  // these
   std::vector<Vecf<D>> gatheredNew_, gatheredOld_;
   Splatter<D> splatter_;
   mutable std::vector<std::uint32_t> cellStart_, order_;  // particles grouped by cell
   mutable std::vector<std::uint32_t> cellOf_, next_;      // the grouping's work storage
   std::vector<std::uint8_t> flagged_;                     // removeFlagged()'s marks
 };
+
+template <int D>
+template <typename Select>
+std::vector<double> FlipParticles<D>::rowsIf(Select&& select) const {
+  std::vector<double> out;
+  for (std::size_t p = 0; p < positions_.size(); ++p) {
+    if (!select(positions_[p])) continue;
+    for (int a = 0; a < D; ++a) out.push_back(positions_[p][a]);
+    for (int a = 0; a < D; ++a) out.push_back(velocities_[p][a]);
+  }
+  return out;
+}
+
+template <int D>
+template <typename Select>
+std::vector<double> FlipParticles<D>::takeRowsIf(Select&& select) {
+  std::vector<double> out = rowsIf(select);
+  flagged_.assign(positions_.size(), 0);
+  for (std::size_t p = 0; p < positions_.size(); ++p) flagged_[p] = select(positions_[p]);
+  removeFlagged();
+  return out;
+}
 
 }  // namespace msim::fluid

@@ -45,9 +45,8 @@ LiquidSolver<D>::LiquidSolver(const GridSpec<D>& spec, const LiquidParams<D>& pa
 
 template <int D>
 void LiquidSolver<D>::setDomainSplit(DomainSplit<D>* split) {
-  if (split && (params_.tracker != InterfaceTracker::ParticleLevelSet || vortex_ || steps_ > 0 || started_))
-    throw std::invalid_argument("liquid solver: a split run tracks the surface with the particle level set and is "
-                                "split before its vortex particles and its first step");
+  if (split && (vortex_ || steps_ > 0 || started_))
+    throw std::invalid_argument("liquid solver: a split run is split before its vortex particles and its first step");
   split_ = split;
   const BlockPlacement<D> where = split ? split->placement() : BlockPlacement<D>{};
   cellOrigin_ = where.whole() ? IVec<D>::Zero() : where.cellOrigin;
@@ -56,6 +55,7 @@ void LiquidSolver<D>::setDomainSplit(DomainSplit<D>* split) {
   ownedHi_ = split ? split->ownedHi() : spec_.res;
   advector_.setPlacement(where);
   particles_.setBlock(where, ownedLo_, ownedHi_);
+  flip_.setBlock(where, ownedLo_, ownedHi_);
   if (split) controlDivergenceField_ = Grid<float, D>(spec_, 0.0f);
 }
 
@@ -139,7 +139,7 @@ double LiquidSolver<D>::emit(const Grid<float, D>& region, const Vec<D>& velocit
   }
   markWallInflow(region, velocity);
   if (params_.tracker == InterfaceTracker::Flip)  // the particles are the liquid (phi is rebuilt from them)
-    return flip_.particleVolume() * double(flip_.emit(region, solid_, velocity.template cast<float>(), ++emissions_));
+    return flipVolume(flip_.emit(region, solid_, velocity.template cast<float>(), ++emissions_));
   return editLevelSet(region, [&](std::size_t i) {
     if (solid_[i] <= 0.5f) phi_[i] = std::min(phi_[i], region[i]);
   });
@@ -188,7 +188,7 @@ double LiquidSolver<D>::drain(const Grid<float, D>& region) {
   if (!region.sameLayout(phi_)) throw std::invalid_argument("liquid solver: drain needs a cell-centred region");
   if (!started_) start();
   ScopedStage s(timers_, "liquid: sinks");
-  if (params_.tracker == InterfaceTracker::Flip) return flip_.particleVolume() * double(flip_.removeInside(region));
+  if (params_.tracker == InterfaceTracker::Flip) return flipVolume(flip_.removeInside(region));
   return -editLevelSet(region, [&](std::size_t i) { phi_[i] = std::max(phi_[i], -region[i]); });
 }
 
@@ -215,11 +215,16 @@ void LiquidSolver<D>::restore(const Grid<float, D>& phi, const MacGrid<D>& veloc
   steps_ = steps;
   started_ = true;
   const bool saved = particles_.size() > 0;  // the same on every process: each read the whole frame
-  if (split_ && saved) {  // every process was given every saved particle: it keeps its own
-    particles_.takeRowsIf([&](const Vec<D>& x) { return !ownedCell(phi_.coord(spec_.clampedCellIndex(x))); });
+  if (split_) {  // every process was given every saved particle: it keeps its own
+    const auto foreign = [&](const auto& x) { return !ownedCell(phi_.coord(spec_.clampedCellIndex(x))); };
+    particles_.takeRowsIf(foreign);
+    flip_.takeRowsIf(foreign);
   }
   if (params_.tracker == InterfaceTracker::ParticleLevelSet && !saved) particles_.seed(phi_);
-  if (split_) exchangeParticles();
+  if (split_ && params_.tracker == InterfaceTracker::Flip)
+    exchangeFlipParticles();
+  else if (split_)
+    exchangeParticles();
   resetVolumeControl();
 }
 
@@ -256,6 +261,7 @@ void LiquidSolver<D>::start() {
   extendVelocity();
   if (params_.tracker == InterfaceTracker::Flip) {
     flip_.seed(phi_, solid_, velocity_);
+    if (split_) exchangeFlipParticles();
     // Volume control holds the volume the particles' own surface has (it differs from the
     // given shape's by the reconstruction's bias; holding the other would move still water).
     flip_.surface(phi_, params_.bandCells);
@@ -310,7 +316,7 @@ double LiquidSolver<D>::volumeControlDivergence(double dt) {
     // rebuilt surface's volume to theirs when the control first saw them (the reconstruction's
     // bias; holding the particles' own volume instead would move still water). Emitters, sinks
     // and open sides change the count.
-    const double particleVolume = flip_.particleVolume() * double(flip_.size());
+    const double particleVolume = flipVolume(flip_.size());
     if (flipVolumeScale_ == 0.0 && particleVolume > 0.0) flipVolumeScale_ = volume / particleVolume;
     targetVolume_ = particleVolume * flipVolumeScale_;
   }
@@ -390,6 +396,32 @@ void LiquidSolver<D>::exchangeParticles() {
 }
 
 template <int D>
+void LiquidSolver<D>::exchangeFlipParticles() {
+  constexpr int width = FlipParticles<D>::kRowWidth;
+  const auto cellOf = [&](const Vecf<D>& x) { return phi_.coord(spec_.clampedCellIndex(x)); };
+  std::vector<double> moved = flip_.takeRowsIf([&](const Vecf<D>& x) { return !ownedCell(cellOf(x)); });
+  split_->migrate(moved, width);
+  flip_.appendRows(moved);
+  // The surface's kernel reaches 2 cells (the velocity's splat 1): the neighbours need the
+  // particles in the owned cells within 2 cells of a block edge between them.
+  IVec<D> innerLo = ownedLo_, innerHi = ownedHi_;
+  for (int a = 0; a < D; ++a) {
+    if (ownedLo_[a] > 0) innerLo[a] += 2;
+    if (ownedHi_[a] < spec_.res[a]) innerHi[a] -= 2;
+  }
+  flip_.setNeighbours(split_->neighbourRows(flip_.rowsIf([&](const Vecf<D>& x) {
+    const IVec<D> c = cellOf(x);
+    return (c.array() < innerLo.array()).any() || (c.array() >= innerHi.array()).any();
+  }), width, 2));
+}
+
+template <int D>
+double LiquidSolver<D>::flipVolume(std::size_t particles) const {
+  const double own = flip_.particleVolume() * double(particles);
+  return split_ ? split_->sumOverRanks(own) : own;
+}
+
+template <int D>
 void LiquidSolver<D>::moveSplitSurface(double dt) {
   // Enright's step as moveSurface's, with the ghosts refilled before each stencil reads them: the
   // escaped test and the correction read phi around particles in the ghost layers, the radii and
@@ -417,6 +449,7 @@ template <int D>
 void LiquidSolver<D>::moveFlipSurface(double dt) {
   ScopedStage s(timers_, "liquid: surface");
   flip_.advect(velocity_, dt, solidDistance_ ? &*solidDistance_ : nullptr, solid_, params_.sides);
+  if (split_) exchangeFlipParticles();
   flip_.surface(phi_, params_.bandCells);
   reinitialize();
 }

@@ -161,8 +161,9 @@ class LiquidSolver {
 
   // Splits the liquid among processes (null: one process): the solver's grid is this process's
   // block (split->localSpec()). Call it before the obstacles, the liquid and the vortex particles
-  // are added, and call emit and drain on every process alike. The particle level set tracker
-  // only (std::invalid_argument); vortex particles are kept whole on every process (VortexLayer).
+  // are added (std::invalid_argument after), and call emit and drain on every process alike.
+  // Marker and FLIP particles live on the process owning their cell; vortex particles are kept
+  // whole on every process (VortexLayer).
   void setDomainSplit(DomainSplit<D>* split);
 
   // Vortex particles in the liquid (null: none); the initial ones are seeded here, so call it
@@ -227,6 +228,9 @@ class LiquidSolver {
   // A split run: the marker particles that left this block go to their owners, and the
   // neighbours' particles near it are copied for the correction.
   void exchangeParticles();
+  void exchangeFlipParticles();
+  // The liquid volume of `particles` FLIP particles [m^3] (a split run: this process's, summed).
+  double flipVolume(std::size_t particles) const;
   void moveSplitSurface(double dt);
   // A split run: every process stops together when one holds a non-finite value.
   void checkFiniteSplit() const;

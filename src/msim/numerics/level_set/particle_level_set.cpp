@@ -60,15 +60,6 @@ bool ParticleLevelSet<D>::seeds(const IVec<D>& c) const {
 }
 
 template <int D>
-std::uint64_t ParticleLevelSet<D>::streamOf(const IVec<D>& c, std::size_t localIndex) const {
-  if (placement_.whole()) return localIndex;
-  std::uint64_t index = 0;  // the global grid's linear index (x fastest, as Grid's)
-  for (int a = D - 1; a >= 0; --a)
-    index = index * static_cast<std::uint64_t>(placement_.globalRes[a]) + static_cast<std::uint64_t>(c[a] + placement_.cellOrigin[a]);
-  return index;
-}
-
-template <int D>
 void ParticleLevelSet<D>::appendRows(const std::vector<double>& rows) {
   for (std::size_t at = 0; at + kRowWidth <= rows.size(); at += kRowWidth) {
     Vec<D> x;
@@ -122,7 +113,7 @@ void ParticleLevelSet<D>::seed(const Grid<float, D>& phi) {
   const float band = static_cast<float>(settings_.bandCells * spec_.dx);
   for (std::size_t i = 0; i < phi.count(); ++i) {
     const IVec<D> c = phi.coord(i);
-    if (std::abs(phi[i]) < band && seeds(c)) seedCell(phi, c, perCell_, streamOf(c, i));
+    if (std::abs(phi[i]) < band && seeds(c)) seedCell(phi, c, perCell_, placement_.globalIndex(c, i));
   }
 }
 
@@ -220,7 +211,7 @@ void ParticleLevelSet<D>::reseed(const Grid<float, D>& phi) {
   for (const Vec<D>& x : positions_) ++count[spec_.clampedCellIndex(x)];
   for (std::size_t i = 0; i < phi.count(); ++i) {
     const IVec<D> c = phi.coord(i);
-    if (std::abs(phi[i]) < band && count[i] < perCell_ && seeds(c)) seedCell(phi, c, perCell_ - count[i], streamOf(c, i));
+    if (std::abs(phi[i]) < band && count[i] < perCell_ && seeds(c)) seedCell(phi, c, perCell_ - count[i], placement_.globalIndex(c, i));
   }
 }
 

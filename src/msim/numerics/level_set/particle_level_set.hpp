@@ -79,12 +79,9 @@ class ParticleLevelSet {
   // with the random stream of its global index: the particles a whole grid would seed there.
   void setBlock(const BlockPlacement<D>& placement, const IVec<D>& ownedLo, const IVec<D>& ownedHi);
   // The particles as rows of kRowWidth doubles (position, radius, sign), for moving them between
-  // processes: all of them, those at positions x with select(x), and taking out those with
-  // select(x) (the others keep their order); appendRows adds rows.
+  // processes: those at positions x with select(x), and taking out those with select(x) (the
+  // others keep their order); appendRows adds rows.
   static constexpr int kRowWidth = D + 2;
-  std::vector<double> rows() const {
-    return rowsIf([](const Vec<D>&) { return true; });
-  }
   template <typename Select>
   std::vector<double> rowsIf(Select&& select) const {
     std::vector<double> out;
@@ -140,9 +137,8 @@ class ParticleLevelSet {
     out.push_back(radii_[p]);
     out.push_back(signs_[p]);
   }
-  // Whether cell c is seeded here (the owned cells of a block), and its random stream.
+  // Whether cell c is seeded here (the owned cells of a block).
   bool seeds(const IVec<D>& c) const;
-  std::uint64_t streamOf(const IVec<D>& c, std::size_t localIndex) const;
   // Appends up to `count` particles in cell c (random stream `stream`), attracted to phi.
   void seedCell(const Grid<float, D>& phi, const IVec<D>& c, int count, std::uint64_t stream);
 

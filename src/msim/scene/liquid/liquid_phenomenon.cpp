@@ -134,7 +134,6 @@ std::unique_ptr<DomainSplit<D>> liquidSplit(const Scene& scene) {
   if constexpr (D != 3) {
     refuseSplit(scene, "domain.resolution", "a 2D grid");
   } else {
-    if (l.at("tracker").get<std::string>() == "flip") refuseSplit(scene, "liquid.tracker", "FLIP");
     if (l.at("turbulence").at("enabled").get<bool>()) refuseSplit(scene, "liquid.turbulence.enabled", "sub-grid turbulence");
     const fluid::LiquidParams<3> p = liquidParams<3>(scene);
     const int needed = parallel::liquidGhostLayers(p.advection, std::max(1.0, p.cfl), p.bandCells);
@@ -144,8 +143,8 @@ std::unique_ptr<DomainSplit<D>> liquidSplit(const Scene& scene) {
   }
 }
 
-// A split run's frame on rank 0: the fields, the marker particles (rows of position, radius and
-// sign) and the statistics, reduced over the ranks.
+// A split run's frame on rank 0: the fields, the particles (rows: the marker particles' position,
+// radius and sign, or FLIP's position and velocity) and the statistics, reduced over the ranks.
 template <int D>
 struct GatheredLiquid {
   Grid<float, D> phi, solid;
@@ -256,7 +255,7 @@ class LiquidPhenomenon final : public Phenomenon {
     GatheredLiquid<D>& g = gathered_;
     split_->gather(solver_.phi(), g.phi);
     split_->gather(solver_.velocity(), g.velocity);
-    g.particles = split_->gatherRows(solver_.levelSetParticles().rows());
+    g.particles = split_->gatherRows(particleRows());
     // Static solids once, moving ones every frame (decided alike on every rank).
     if (!obstacles_.empty() && (!g.solidGathered || obstacles_.moving())) {
       split_->gather(solver_.solid(), g.solid);
@@ -277,10 +276,8 @@ class LiquidPhenomenon final : public Phenomenon {
     }
     if constexpr (D == 3) writer.addVectorGrid("vel", velocity());
     writeFaceVelocities(writer, velocity());
-    if (solver_.params().tracker == fluid::InterfaceTracker::Flip)
-      writer.addPoints(kFlipParticles, flipCloud(), solver_.spec().dx);
-    else
-      writer.addPoints(kLevelSetParticles, levelSetCloud(), solver_.spec().dx);
+    writer.addPoints(solver_.params().tracker == fluid::InterfaceTracker::Flip ? kFlipParticles : kLevelSetParticles,
+                     particleCloud(), solver_.spec().dx);
     if (!obstacles_.empty())
       writer.addLevelSet("obstacle_distance", (wholeObstacles_ ? *wholeObstacles_ : obstacles_).cellDistance(time_));
     if (solver_.vortexLayer())
@@ -406,35 +403,33 @@ class LiquidPhenomenon final : public Phenomenon {
     if (obstacles_.moving()) solver_.setObstacleVelocity(obstacles_.faceVelocity(t));
   }
 
-  // The marker particles with their radius and sign (a split run: those gathered on rank 0).
-  io::PointCloud levelSetCloud() const {
-    const std::vector<double> rows = split_ ? gathered_.particles : solver_.levelSetParticles().rows();
-    constexpr int width = numerics::ParticleLevelSet<D>::kRowWidth;
+  // This process's particles as rows (FLIP: position and velocity; the particle level set:
+  // position, radius and sign).
+  std::vector<double> particleRows() const {
+    const auto all = [](const auto&) { return true; };
+    return solver_.params().tracker == fluid::InterfaceTracker::Flip ? solver_.flipParticles().rowsIf(all)
+                                                                     : solver_.levelSetParticles().rowsIf(all);
+  }
+
+  // The particles as points (a split run: those gathered on rank 0) with their radius and sign, or
+  // (FLIP) their velocity vx, vy, vz.
+  io::PointCloud particleCloud() const {
+    const bool flip = solver_.params().tracker == fluid::InterfaceTracker::Flip;
+    const std::vector<double> rows = split_ ? gathered_.particles : particleRows();
+    const int width = flip ? fluid::FlipParticles<D>::kRowWidth : numerics::ParticleLevelSet<D>::kRowWidth;
     io::PointCloud cloud;
     cloud.positions.reserve(rows.size() / width);
-    io::PointAttribute radius{"radius", {}}, sign{"sign", {}};
+    std::vector<io::PointAttribute> attributes =
+        flip ? std::vector<io::PointAttribute>{{"vx", {}}, {"vy", {}}, {"vz", {}}}
+             : std::vector<io::PointAttribute>{{"radius", {}}, {"sign", {}}};
     for (std::size_t at = 0; at < rows.size(); at += width) {
       Vecf<3> x = Vecf<3>::Zero();
       for (int a = 0; a < D; ++a) x[a] = static_cast<float>(rows[at + a]);
       cloud.positions.push_back(x);
-      radius.values.push_back(static_cast<float>(rows[at + D]));
-      sign.values.push_back(static_cast<float>(rows[at + D + 1]));
+      for (std::size_t k = 0; k < attributes.size(); ++k)
+        attributes[k].values.push_back(flip && int(k) >= D ? 0.0f : static_cast<float>(rows[at + D + k]));
     }
-    cloud.attributes = {std::move(radius), std::move(sign)};
-    return cloud;
-  }
-
-  io::PointCloud flipCloud() const {
-    const auto& fp = solver_.flipParticles();
-    io::PointCloud cloud;
-    std::vector<io::PointAttribute> v = {{"vx", {}}, {"vy", {}}, {"vz", {}}};
-    for (std::size_t p = 0; p < fp.size(); ++p) {
-      Vecf<3> x = Vecf<3>::Zero();
-      for (int a = 0; a < D; ++a) x[a] = fp.positions()[p][a];
-      cloud.positions.push_back(x);
-      for (int a = 0; a < 3; ++a) v[a].values.push_back(a < D ? fp.velocities()[p][a] : 0.0f);
-    }
-    cloud.attributes = std::move(v);
+    cloud.attributes = std::move(attributes);
     return cloud;
   }
 
