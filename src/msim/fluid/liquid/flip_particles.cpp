@@ -37,16 +37,22 @@ void FlipParticles<D>::setBlock(const BlockPlacement<D>& placement, const IVec<D
 }
 
 template <int D>
-void FlipParticles<D>::appendRows(const std::vector<double>& rows) {
+void FlipParticles<D>::appendRowsTo(const std::vector<double>& rows, std::vector<Vecf<D>>& positions,
+                                    std::vector<Vecf<D>>& velocities) {
   for (std::size_t at = 0; at + kRowWidth <= rows.size(); at += kRowWidth) {
     Vecf<D> x, v;
     for (int a = 0; a < D; ++a) {
       x[a] = static_cast<float>(rows[at + a]);
       v[a] = static_cast<float>(rows[at + D + a]);
     }
-    positions_.push_back(x);
-    velocities_.push_back(v);
+    positions.push_back(x);
+    velocities.push_back(v);
   }
+}
+
+template <int D>
+void FlipParticles<D>::appendRows(const std::vector<double>& rows) {
+  appendRowsTo(rows, positions_, velocities_);
 }
 
 template <int D>
@@ -54,15 +60,7 @@ void FlipParticles<D>::setNeighbours(const std::vector<double>& rows) {
   neighbours_ = rows.size() / kRowWidth;
   withNeighbours_.assign(positions_.begin(), positions_.end());
   withNeighboursV_.assign(velocities_.begin(), velocities_.end());
-  for (std::size_t at = 0; at + kRowWidth <= rows.size(); at += kRowWidth) {
-    Vecf<D> x, v;
-    for (int a = 0; a < D; ++a) {
-      x[a] = static_cast<float>(rows[at + a]);
-      v[a] = static_cast<float>(rows[at + D + a]);
-    }
-    withNeighbours_.push_back(x);
-    withNeighboursV_.push_back(v);
-  }
+  appendRowsTo(rows, withNeighbours_, withNeighboursV_);
 }
 
 template <int D>

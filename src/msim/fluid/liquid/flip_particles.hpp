@@ -89,6 +89,8 @@ class FlipParticles {
   // any (what toGrid and surface read).
   std::span<const Vecf<D>> readPositions() const;
   std::span<const Vecf<D>> readVelocities() const;
+  static void appendRowsTo(const std::vector<double>& rows, std::vector<Vecf<D>>& positions,
+                           std::vector<Vecf<D>>& velocities);
   // Groups the particles `x` by cell (cellStart_, order_).
   void bucketByCell(std::span<const Vecf<D>> x) const;
   bool seeds(const IVec<D>& c) const {

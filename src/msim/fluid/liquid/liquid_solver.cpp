@@ -221,10 +221,7 @@ void LiquidSolver<D>::restore(const Grid<float, D>& phi, const MacGrid<D>& veloc
     flip_.takeRowsIf(foreign);
   }
   if (params_.tracker == InterfaceTracker::ParticleLevelSet && !saved) particles_.seed(phi_);
-  if (split_ && params_.tracker == InterfaceTracker::Flip)
-    exchangeFlipParticles();
-  else if (split_)
-    exchangeParticles();
+  if (split_) exchangeParticles();
   resetVolumeControl();
 }
 
@@ -261,7 +258,7 @@ void LiquidSolver<D>::start() {
   extendVelocity();
   if (params_.tracker == InterfaceTracker::Flip) {
     flip_.seed(phi_, solid_, velocity_);
-    if (split_) exchangeFlipParticles();
+    if (split_) exchangeParticles();
     // Volume control holds the volume the particles' own surface has (it differs from the
     // given shape's by the reconstruction's bias; holding the other would move still water).
     flip_.surface(phi_, params_.bandCells);
@@ -375,44 +372,34 @@ void LiquidSolver<D>::moveSurface(double dt) {
 }
 
 template <int D>
-void LiquidSolver<D>::exchangeParticles() {
-  constexpr int width = numerics::ParticleLevelSet<D>::kRowWidth;
-  const auto cellOf = [&](const Vec<D>& x) { return phi_.coord(spec_.clampedCellIndex(x)); };
-  std::vector<double> moved = particles_.takeRowsIf([&](const Vec<D>& x) { return !ownedCell(cellOf(x)); });
+template <typename Tracked>
+void LiquidSolver<D>::exchangeParticles(Tracked& particles, int reach) {
+  constexpr int width = Tracked::kRowWidth;
+  const auto cellOf = [&](const auto& x) { return phi_.coord(spec_.clampedCellIndex(x)); };
+  std::vector<double> moved = particles.takeRowsIf([&](const auto& x) { return !ownedCell(cellOf(x)); });
   split_->migrate(moved, width);
-  particles_.appendRows(moved);
-  // A particle's correction touches the cell centres around it, in its cell and the next ones: the
-  // neighbours need the particles in the owned cells along a block edge between them (not on the
-  // domain's sides, where this block stores no ghosts).
+  particles.appendRows(moved);
+  // The neighbours need the particles in the owned cells within `reach` of a block edge between
+  // them (not on the domain's sides, where this block stores no ghosts).
   IVec<D> innerLo = ownedLo_, innerHi = ownedHi_;
   for (int a = 0; a < D; ++a) {
-    if (ownedLo_[a] > 0) innerLo[a] += 1;
-    if (ownedHi_[a] < spec_.res[a]) innerHi[a] -= 1;
+    if (ownedLo_[a] > 0) innerLo[a] += reach;
+    if (ownedHi_[a] < spec_.res[a]) innerHi[a] -= reach;
   }
-  particles_.setNeighbours(split_->neighbourRows(particles_.rowsIf([&](const Vec<D>& x) {
+  particles.setNeighbours(split_->neighbourRows(particles.rowsIf([&](const auto& x) {
     const IVec<D> c = cellOf(x);
     return (c.array() < innerLo.array()).any() || (c.array() >= innerHi.array()).any();
-  }), width, 1));
+  }), width, reach));
 }
 
 template <int D>
-void LiquidSolver<D>::exchangeFlipParticles() {
-  constexpr int width = FlipParticles<D>::kRowWidth;
-  const auto cellOf = [&](const Vecf<D>& x) { return phi_.coord(spec_.clampedCellIndex(x)); };
-  std::vector<double> moved = flip_.takeRowsIf([&](const Vecf<D>& x) { return !ownedCell(cellOf(x)); });
-  split_->migrate(moved, width);
-  flip_.appendRows(moved);
-  // The surface's kernel reaches 2 cells (the velocity's splat 1): the neighbours need the
-  // particles in the owned cells within 2 cells of a block edge between them.
-  IVec<D> innerLo = ownedLo_, innerHi = ownedHi_;
-  for (int a = 0; a < D; ++a) {
-    if (ownedLo_[a] > 0) innerLo[a] += 2;
-    if (ownedHi_[a] < spec_.res[a]) innerHi[a] -= 2;
-  }
-  flip_.setNeighbours(split_->neighbourRows(flip_.rowsIf([&](const Vecf<D>& x) {
-    const IVec<D> c = cellOf(x);
-    return (c.array() < innerLo.array()).any() || (c.array() >= innerHi.array()).any();
-  }), width, 2));
+void LiquidSolver<D>::exchangeParticles() {
+  // A marker particle's correction touches the cell centres around it (its cell and the next);
+  // FLIP's surface kernel reaches 2 cells (its splat onto the faces 1).
+  if (params_.tracker == InterfaceTracker::Flip)
+    exchangeParticles(flip_, 2);
+  else
+    exchangeParticles(particles_, 1);
 }
 
 template <int D>
@@ -449,7 +436,7 @@ template <int D>
 void LiquidSolver<D>::moveFlipSurface(double dt) {
   ScopedStage s(timers_, "liquid: surface");
   flip_.advect(velocity_, dt, solidDistance_ ? &*solidDistance_ : nullptr, solid_, params_.sides);
-  if (split_) exchangeFlipParticles();
+  if (split_) exchangeParticles();
   flip_.surface(phi_, params_.bandCells);
   reinitialize();
 }

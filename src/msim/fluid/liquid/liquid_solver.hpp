@@ -228,7 +228,8 @@ class LiquidSolver {
   // A split run: the marker particles that left this block go to their owners, and the
   // neighbours' particles near it are copied for the correction.
   void exchangeParticles();
-  void exchangeFlipParticles();
+  template <typename Tracked>
+  void exchangeParticles(Tracked& particles, int reach);
   // The liquid volume of `particles` FLIP particles [m^3] (a split run: this process's, summed).
   double flipVolume(std::size_t particles) const;
   void moveSplitSurface(double dt);
