@@ -102,24 +102,28 @@ compare_liquid river_rapids river
 # FLIP: the particles carry the water (the 3D dam break).
 extra=()
 compare_liquid dam_break_3d flip
-# The liquid resumed under mpirun (each rank keeps its block and its own saved particles) against
-# the same resume on one process: a liquid's resume restarts the pressure's warm start and the
-# reseeding count, on one process as on two.
+# The liquid resumed under mpirun (each rank keeps its block and its own saved particles: the
+# particle level set's markers, FLIP's particles) against the same resume on one process: a
+# liquid's resume restarts the pressure's warm start and the reseeding count, on one process as on
+# two.
 extra=()
-for runner in one two; do
-  if [[ $runner == one ]]; then run_liquid=("$msim"); else run_liquid=("${two[@]}"); fi
-  "${run_liquid[@]}" run "$scenes/drop_into_pool.json" --out "$tmp/liquid_resumed_$runner" --set domain.resolution=32 --frames 3 -q
-  "${run_liquid[@]}" run "$scenes/drop_into_pool.json" --out "$tmp/liquid_resumed_$runner" "${short[@]}" --resume
-done
-python3 - "$tmp/liquid_resumed_one/run.json" "$tmp/liquid_resumed_two/run.json" <<'PY'
+for scene in drop_into_pool dam_break_3d; do
+  for runner in one two; do
+    if [[ $runner == one ]]; then run_liquid=("$msim"); else run_liquid=("${two[@]}"); fi
+    out="$tmp/${scene}_resumed_$runner"
+    "${run_liquid[@]}" run "$scenes/$scene.json" --out "$out" --set domain.resolution=32 --frames 3 -q
+    "${run_liquid[@]}" run "$scenes/$scene.json" --out "$out" "${short[@]}" --resume
+  done
+  python3 - "$tmp/${scene}_resumed_one/run.json" "$tmp/${scene}_resumed_two/run.json" "$scene" <<'PY'
 import json, sys
 a, b = (json.load(open(p))["frames"] for p in sys.argv[1:3])
 assert len(a) == 6 and len(b) == 6, (len(a), len(b))
 for key, limit in (("volume_m3", 1e-3), ("particles", 5e-3)):
     rel = abs(a[-1][key] - b[-1][key]) / abs(a[-1][key])
-    print(f"resumed liquid {key}: 1 process {a[-1][key]:.6g}, 2 processes {b[-1][key]:.6g}, relative difference {rel:.1e}")
+    print(f"{sys.argv[3]} resumed {key}: 1 process {a[-1][key]:.6g}, 2 processes {b[-1][key]:.6g}, relative difference {rel:.1e}")
     assert rel < limit, key
 PY
+done
 
 # --resume under mpirun: 3 frames, then on to 6 from the third's VDB (full floats, no fog cut-off:
 # the saved frame is the whole state), against the 6 frames run at once.
