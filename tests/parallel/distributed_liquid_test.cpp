@@ -209,7 +209,7 @@ TEST_P(DistributedLiquid, DamBreakFollowsTheOneRankRun) {
 
 // The rock with wider ghost layers measured 0.001 cells (docs/parallel.md), not run here; the
 // vortex particles and the emitter with wider ones, so that their own effect shows (the emitter's
-// box corners, across the cut, feed the fast marching: 0.0056 cells at 10 layers, 3e-6 at 14).
+// box corners, across the cut, feed the fast marching: 0.0056 cells at 10 layers, 1e-5 at 14).
 INSTANTIATE_TEST_SUITE_P(ExtrasAndGhostLayers, DistributedLiquid,
                          ::testing::Values(std::make_tuple(Extra::None, 0), std::make_tuple(Extra::None, 4),
                                            std::make_tuple(Extra::Rock, 0), std::make_tuple(Extra::VortexParticles, 4),

@@ -119,7 +119,7 @@ TEST(ParticleMigration, RowsMigrateAndNeighboursReceiveTheRowsNearTheirCells) {
       IVec<3> c;
       for (int a = 0; a < 3; ++a)
         c[a] = std::clamp(static_cast<int>(std::floor((x[a] - kGlobal.origin[a]) / kGlobal.dx)), 0, kGlobal.res[a] - 1);
-      const bool near = (c.array() >= own.lo.array() - reach).all() && (c.array() < own.hi.array() + reach).all();
+      const bool near = IndexBox<3>{own.lo.array() - reach, own.hi.array() + reach}.contains(c);
       if (near && ownerOf<3>(x, block) != worldRank()) expected.push_back(all[at + 3]);
     }
     for (std::size_t at = 0; at < received.size(); at += kWidth) got.push_back(received[at + 3]);

@@ -10,6 +10,7 @@
 
 #include "msim/core/block_placement.hpp"
 #include "msim/core/grid.hpp"
+#include "msim/core/index_box.hpp"
 #include "msim/core/mac_grid.hpp"
 
 namespace msim {
@@ -27,9 +28,8 @@ class DomainSplit {
   virtual BlockPlacement<D> placement() const = 0;
   // The local grid: the owned cells and the ghost layers, over which the solver's fields lie.
   virtual GridSpec<D> localSpec() const = 0;
-  // The owned cells in the local grid's coordinates: [lo, hi).
-  virtual IVec<D> ownedLo() const = 0;
-  virtual IVec<D> ownedHi() const = 0;
+  // The owned cells in the local grid's coordinates.
+  virtual IndexBox<D> owned() const = 0;
   // Fills the ghost samples of a local cell-centred field, or of every component of a local MAC
   // grid, from their owners. Collective.
   virtual void exchange(Grid<float, D>& cells) = 0;
@@ -51,8 +51,8 @@ class DomainSplit {
   // component a: unit vector a) that are this rank's own: its owned cells, and along a face axis
   // the faces below them, the domain's last face belonging to the last block.
   void ownedSamples(const IVec<D>& extra, IVec<D>& lo, IVec<D>& hi) const {
-    lo = ownedLo();
-    hi = ownedHi();
+    lo = owned().lo;
+    hi = owned().hi;
     const BlockPlacement<D> where = placement();
     for (int a = 0; a < D; ++a)
       if (extra[a] > 0 && hi[a] + where.cellOrigin[a] == where.globalRes[a]) hi[a] += 1;
@@ -81,6 +81,8 @@ class DomainSplit {
   // The divergence [1/s] project() leaves in each local cell (expanding gas; null: none). The
   // field must outlive the calls to project().
   virtual void setCellTargetDivergence(const Grid<float, D>* perCell) = 0;
+  // A divergence [1/s] left in every fluid cell besides (a liquid's volume control).
+  virtual void setTargetDivergence(double perSecond) = 0;
   // A free surface for the pressure solve (liquids): cells with liquidPhi >= 0 are air at
   // pressure 0, as numerics::PressureProjection::setFreeSurface. Collective.
   virtual void setFreeSurface(const Grid<float, D>& liquidPhi) = 0;

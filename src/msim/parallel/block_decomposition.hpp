@@ -7,25 +7,10 @@
 // Ranks are numbered x fastest over the lattice, as the cells of a Grid are.
 #include <string>
 
+#include "msim/core/index_box.hpp"
 #include "msim/core/vec.hpp"
 
 namespace msim::parallel {
-
-// A box of integer indices [lo, hi) (hi exclusive on every axis).
-template <int D>
-struct IndexBox {
-  IVec<D> lo = IVec<D>::Zero();
-  IVec<D> hi = IVec<D>::Zero();
-
-  IVec<D> size() const { return (hi - lo).cwiseMax(0); }
-  bool empty() const { return (hi.array() <= lo.array()).any(); }
-  long long count() const {
-    long long n = 1;
-    for (int a = 0; a < D; ++a) n *= empty() ? 0 : hi[a] - lo[a];
-    return n;
-  }
-  IndexBox intersect(const IndexBox& o) const { return {lo.cwiseMax(o.lo), hi.cwiseMin(o.hi)}; }
-};
 
 template <int D>
 class BlockDecomposition {

@@ -253,7 +253,8 @@ SplitSolveStats DistributedProjection::project(MacGrid<3>& velocity, Grid<float,
   forOwnedCells(block_, [&](const IVec<3>& l, std::size_t k) {
     double outflow = 0.0;
     for (int a = 0; a < 3; ++a) outflow += flux(a, l + IVec<3>::Unit(a)) - flux(a, l);
-    const double target = cellTargetDivergence_ ? block_.global.dx * (*cellTargetDivergence_)(l) : 0.0;
+    const double target =
+        block_.global.dx * (targetDivergence_ + (cellTargetDivergence_ ? double((*cellTargetDivergence_)(l)) : 0.0));
     rhs_[k] = fluid_[k] ? target - outflow : 0.0;
     sum += rhs_[k];
     count += fluid_[k];

@@ -64,6 +64,9 @@ class DistributedProjection {
   // numerics::PressureProjection::setCellTargetDivergence; null: none. Kept by pointer: the field
   // must outlive the calls to project().
   void setCellTargetDivergence(const Grid<float, 3>* perCell) { cellTargetDivergence_ = perCell; }
+  // The divergence [1/s] left in every fluid cell besides (a liquid's volume control), as
+  // numerics::PressureProjection::setTargetDivergence.
+  void setTargetDivergence(double perSecond) { targetDivergence_ = perSecond; }
   // Makes the owned faces of `velocity` (a local MAC grid) divergence free; its ghosts are
   // exchanged first and are stale afterwards. `pressure` [Pa] (local, cell-centred) warm-starts
   // the solve and receives its result on the owned cells, as the serial projection keeps its
@@ -97,6 +100,7 @@ class DistributedProjection {
   std::array<std::array<float, 2>, 3> wallNormalVelocity_{};
   std::optional<MacGrid<3>> wallFaceVelocity_;  // setWallFaceVelocity
   const Grid<float, 3>* cellTargetDivergence_ = nullptr;
+  double targetDivergence_ = 0.0;
   void applyWallVelocities();  // the walls' normal velocities into solidVelocity_
   // The side (0 lower, 1 upper) of the domain wall that local face `face` of `axis` lies on, or -1.
   int wallSide(int axis, const IVec<3>& face) const;

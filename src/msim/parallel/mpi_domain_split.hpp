@@ -19,8 +19,7 @@ class MpiDomainSplit final : public DomainSplit<3> {
 
   BlockPlacement<3> placement() const override { return block_.placement(); }
   GridSpec<3> localSpec() const override { return block_.localSpec(); }
-  IVec<3> ownedLo() const override { return block_.ownedLocal().lo; }
-  IVec<3> ownedHi() const override { return block_.ownedLocal().hi; }
+  IndexBox<3> owned() const override { return block_.ownedLocal(); }
   void exchange(Grid<float, 3>& cells) override { cells_.exchange(cells); }
   void exchange(MacGrid<3>& faces) override { faces_.exchange(faces); }
   void exchange(Grid<float, 3>& faces, int axis) override { faces_.exchange(faces, axis); }
@@ -40,6 +39,7 @@ class MpiDomainSplit final : public DomainSplit<3> {
     projection_.setWallNormalVelocity(axis, side, velocity);
   }
   void setWallFaceVelocity(const MacGrid<3>* velocity) override { projection_.setWallFaceVelocity(velocity); }
+  void setTargetDivergence(double perSecond) override { projection_.setTargetDivergence(perSecond); }
   void setCellTargetDivergence(const Grid<float, 3>* perCell) override { projection_.setCellTargetDivergence(perCell); }
   SplitSolveStats project(MacGrid<3>& velocity, Grid<float, 3>& pressure, double dt, double density) override;
 

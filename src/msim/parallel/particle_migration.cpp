@@ -151,8 +151,7 @@ std::vector<double> neighbourRows(const std::vector<double>& rows, int width, in
   for (std::size_t at = 0; at < rows.size(); at += width) {
     const IVec<D> c = cellOf<D>(rowPosition<D>(&rows[at]), block);
     for (const auto& [r, box] : near) {
-      if ((c.array() >= box.lo.array()).all() && (c.array() < box.hi.array()).all())
-        to[r].insert(to[r].end(), rows.begin() + at, rows.begin() + at + width);
+      if (box.contains(c)) to[r].insert(to[r].end(), rows.begin() + at, rows.begin() + at + width);
     }
   }
   std::vector<int> sendCounts(ranks, 0);

@@ -27,13 +27,13 @@ Vecf<D> insideDomain(const GridSpec<D>& spec, Vecf<D> x) {
 
 template <int D>
 FlipParticles<D>::FlipParticles(const GridSpec<D>& spec, int perCell, std::uint64_t seed)
-    : spec_(spec), perCell_(perCell > 0 ? perCell : (1 << D)), seed_(seed), radius_(0.5 * spec.dx), ownedHi_(spec.res) {}
+    : spec_(spec), perCell_(perCell > 0 ? perCell : (1 << D)), seed_(seed), radius_(0.5 * spec.dx),
+      owned_{IVec<D>::Zero(), spec.res} {}
 
 template <int D>
-void FlipParticles<D>::setBlock(const BlockPlacement<D>& placement, const IVec<D>& ownedLo, const IVec<D>& ownedHi) {
+void FlipParticles<D>::setBlock(const BlockPlacement<D>& placement, const IndexBox<D>& owned) {
   placement_ = placement;
-  ownedLo_ = ownedLo;
-  ownedHi_ = ownedHi;
+  owned_ = owned;
 }
 
 template <int D>
@@ -79,7 +79,7 @@ void FlipParticles<D>::seed(const Grid<float, D>& phi, const Grid<float, D>& sol
   velocities_.clear();
   for (std::size_t cell = 0; cell < phi.count(); ++cell) {
     const IVec<D> c = phi.coord(cell);
-    if (!(phi[cell] < 0.5f * spec_.dx) || solid[cell] > 0.5f || !seeds(c)) continue;  // the surface cells too
+    if (!(phi[cell] < 0.5f * spec_.dx) || solid[cell] > 0.5f || !owned_.contains(c)) continue;  // the surface cells too
     Rng rng = Rng(seed_).split(placement_.globalIndex(c, cell));
     for (int k = 0; k < perCell_; ++k) {
       Vec<D> x;
@@ -183,7 +183,7 @@ std::size_t FlipParticles<D>::emit(const Grid<float, D>& region, const Grid<floa
   const std::size_t before = positions_.size();
   for (std::size_t cell = 0; cell < region.count(); ++cell) {
     const IVec<D> c = region.coord(cell);
-    if (!(region[cell] < 0.0f) || solid[cell] > 0.5f || !seeds(c)) continue;
+    if (!(region[cell] < 0.0f) || solid[cell] > 0.5f || !owned_.contains(c)) continue;
     const int have = static_cast<int>(cellStart_[cell + 1] - cellStart_[cell]);
     if (2 * have >= perCell_) continue;  // refilled when half empty: fuller cells hold the flux at v A
     Rng rng = Rng(seed_ ^ (round * 0x9E3779B97F4A7C15ull)).split(placement_.globalIndex(c, cell));

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "msim/core/block_placement.hpp"
+#include "msim/core/index_box.hpp"
 #include "msim/core/grid.hpp"
 #include "msim/core/mac_grid.hpp"
 #include "msim/core/transfer.hpp"
@@ -63,9 +64,9 @@ class FlipParticles {
 
   // A block of a grid split among processes (core/domain_split.hpp), as for the particle level set:
   // the grid is the block with its ghost layers, at `placement`, and the particles are those in
-  // the owned cells [ownedLo, ownedHi); seeding and emitters fill only the owned cells, each with
+  // the owned cells `owned`; seeding and emitters fill only the owned cells, each with
   // the random stream of its global index.
-  void setBlock(const BlockPlacement<D>& placement, const IVec<D>& ownedLo, const IVec<D>& ownedHi);
+  void setBlock(const BlockPlacement<D>& placement, const IndexBox<D>& owned);
   // The particles as rows of kRowWidth doubles (position, velocity) for moving them between
   // processes: taking out those at positions x with select(x), those with select(x) copied, and
   // appending rows.
@@ -89,13 +90,14 @@ class FlipParticles {
   // any (what toGrid and surface read).
   std::span<const Vecf<D>> readPositions() const;
   std::span<const Vecf<D>> readVelocities() const;
+  void appendRow(std::size_t p, std::vector<double>& out) const {
+    out.insert(out.end(), positions_[p].data(), positions_[p].data() + D);
+    out.insert(out.end(), velocities_[p].data(), velocities_[p].data() + D);
+  }
   static void appendRowsTo(const std::vector<double>& rows, std::vector<Vecf<D>>& positions,
                            std::vector<Vecf<D>>& velocities);
   // Groups the particles `x` by cell (cellStart_, order_).
   void bucketByCell(std::span<const Vecf<D>> x) const;
-  bool seeds(const IVec<D>& c) const {
-    return (c.array() >= ownedLo_.array()).all() && (c.array() < ownedHi_.array()).all();
-  }
   // Deletes the particles whose flag is set (order kept).
   std::size_t removeFlagged();
 
@@ -105,7 +107,7 @@ class FlipParticles {
   double radius_;
   std::vector<Vecf<D>> positions_, velocities_;
   BlockPlacement<D> placement_;
-  IVec<D> ownedLo_ = IVec<D>::Zero(), ownedHi_;
+  IndexBox<D> owned_;  // the seeded cells
   std::size_t neighbours_ = 0;                            // neighbours' particles after the own ones in
   std::vector<Vecf<D>> withNeighbours_, withNeighboursV_;  // these
   std::vector<Vecf<D>> gatheredNew_, gatheredOld_;
@@ -119,20 +121,18 @@ template <int D>
 template <typename Select>
 std::vector<double> FlipParticles<D>::rowsIf(Select&& select) const {
   std::vector<double> out;
-  for (std::size_t p = 0; p < positions_.size(); ++p) {
-    if (!select(positions_[p])) continue;
-    for (int a = 0; a < D; ++a) out.push_back(positions_[p][a]);
-    for (int a = 0; a < D; ++a) out.push_back(velocities_[p][a]);
-  }
+  for (std::size_t p = 0; p < positions_.size(); ++p)
+    if (select(positions_[p])) appendRow(p, out);
   return out;
 }
 
 template <int D>
 template <typename Select>
 std::vector<double> FlipParticles<D>::takeRowsIf(Select&& select) {
-  std::vector<double> out = rowsIf(select);
+  std::vector<double> out;
   flagged_.assign(positions_.size(), 0);
-  for (std::size_t p = 0; p < positions_.size(); ++p) flagged_[p] = select(positions_[p]);
+  for (std::size_t p = 0; p < positions_.size(); ++p)
+    if ((flagged_[p] = select(positions_[p]))) appendRow(p, out);
   removeFlagged();
   return out;
 }

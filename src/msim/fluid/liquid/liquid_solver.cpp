@@ -40,7 +40,7 @@ LiquidSolver<D>::LiquidSolver(const GridSpec<D>& spec, const LiquidParams<D>& pa
     facePhi_[a] = Grid<float, D>(spec, u.size(), u.offset());
     known_[a].assign(u.count(), 0);
   }
-  globalRes_ = ownedHi_ = spec.res;
+  owned_ = {IVec<D>::Zero(), spec.res};
 }
 
 template <int D>
@@ -48,15 +48,11 @@ void LiquidSolver<D>::setDomainSplit(DomainSplit<D>* split) {
   if (split && (vortex_ || steps_ > 0 || started_))
     throw std::invalid_argument("liquid solver: a split run is split before its vortex particles and its first step");
   split_ = split;
-  const BlockPlacement<D> where = split ? split->placement() : BlockPlacement<D>{};
-  cellOrigin_ = where.whole() ? IVec<D>::Zero() : where.cellOrigin;
-  globalRes_ = where.whole() ? spec_.res : where.globalRes;
-  ownedLo_ = split ? split->ownedLo() : IVec<D>::Zero();
-  ownedHi_ = split ? split->ownedHi() : spec_.res;
-  advector_.setPlacement(where);
-  particles_.setBlock(where, ownedLo_, ownedHi_);
-  flip_.setBlock(where, ownedLo_, ownedHi_);
-  if (split) controlDivergenceField_ = Grid<float, D>(spec_, 0.0f);
+  placement_ = split ? split->placement() : BlockPlacement<D>{};
+  owned_ = split ? split->owned() : IndexBox<D>{IVec<D>::Zero(), spec_.res};
+  advector_.setPlacement(placement_);
+  particles_.setBlock(placement_, owned_);
+  flip_.setBlock(placement_, owned_);
 }
 
 template <int D>
@@ -103,10 +99,11 @@ void LiquidSolver<D>::addLiquid(const Grid<float, D>& cellPhi, const Vec<D>& vel
   // each pass reading the last one's values, so cells along an edge or in a corner get it too.
   Grid<float, D> body = cellPhi;
   for (int a = 0; a < D; ++a) {
-    if (globalRes_[a] < 3) continue;  // the inner neighbours must not be side cells themselves
+    const int cells = placement_.whole() ? spec_.res[a] : placement_.globalRes[a];  // along the whole domain
+    if (cells < 3) continue;  // the inner neighbours must not be side cells themselves
     parallelForCells(body, [&](const IVec<D>& c, std::size_t i) {
-      const int g = c[a] + cellOrigin_[a];  // a split run's block: in the global grid
-      if (g != 0 && g != globalRes_[a] - 1) return;
+      const int g = c[a] + placement_.cellOrigin[a];  // a split run's block: in the global grid
+      if (g != 0 && g != cells - 1) return;
       IVec<D> inner = c;
       inner[a] += g == 0 ? 1 : -1;
       if (body[i] < 0.0f) body[i] = std::min(body[i], body(inner));
@@ -158,8 +155,7 @@ void LiquidSolver<D>::markWallInflow(const Grid<float, D>& region, const Vec<D>&
       if (!(inward > 0.0)) continue;
       if (!wallInflow_) wallInflow_.emplace(spec_, 0.0f);
       auto& u = wallInflow_->component(a);
-      const bool domainSide = side == 0 ? cellOrigin_[a] == 0 : cellOrigin_[a] + spec_.res[a] == globalRes_[a];
-      if (!domainSide) continue;  // a split run's block: its edge here lies inside the domain
+      if (!onDomainSide(a, side)) continue;  // a split run's block: its edge here lies inside the domain
       parallelForCells(u, [&](const IVec<D>& f, std::size_t lin) {
         if (f[a] != (side == 0 ? 0 : spec_.res[a])) return;
         IVec<D> cell = f;
@@ -216,7 +212,7 @@ void LiquidSolver<D>::restore(const Grid<float, D>& phi, const MacGrid<D>& veloc
   started_ = true;
   const bool saved = particles_.size() > 0;  // the same on every process: each read the whole frame
   if (split_) {  // every process was given every saved particle: it keeps its own
-    const auto foreign = [&](const auto& x) { return !ownedCell(phi_.coord(spec_.clampedCellIndex(x))); };
+    const auto foreign = [&](const auto& x) { return !owned_.contains(phi_.coord(spec_.clampedCellIndex(x))); };
     particles_.takeRowsIf(foreign);
     flip_.takeRowsIf(foreign);
   }
@@ -228,11 +224,7 @@ void LiquidSolver<D>::restore(const Grid<float, D>& phi, const MacGrid<D>& veloc
 template <int D>
 double LiquidSolver<D>::liquidVolume() const {
   if (!split_) return numerics::enclosedVolume(phi_, &solid_);
-  const double eps = 1.5 * spec_.dx;
-  const double own = spec_.cellVolume() * parallelSum(phi_.count(), [&](std::size_t i) {
-                       return ownedCell(phi_.coord(i)) && solid_[i] <= 0.5f ? numerics::smearedInside(phi_[i], eps) : 0.0;
-                     });
-  return split_->sumOverRanks(own);
+  return split_->sumOverRanks(numerics::enclosedVolume(phi_, &solid_, &owned_));
 }
 
 template <int D>
@@ -282,8 +274,7 @@ double LiquidSolver<D>::boundaryOutflow(double dt) const {
     layerSize[a] = 1;
     const auto& u = velocity_.component(a);
     for (int side = 0; side < 2; ++side) {
-      const bool domainSide = side == 0 ? cellOrigin_[a] == 0 : cellOrigin_[a] + spec_.res[a] == globalRes_[a];
-      if (!domainSide) continue;
+      if (!onDomainSide(a, side)) continue;
       const double outward = side == 0 ? -1.0 : 1.0;
       std::size_t faces = 1;
       for (int b = 0; b < D; ++b) faces *= static_cast<std::size_t>(layerSize[b]);
@@ -295,7 +286,7 @@ double LiquidSolver<D>::boundaryOutflow(double dt) const {
         }
         f[a] = side == 0 ? 0 : spec_.res[a];
         for (int b = 0; b < D; ++b)
-          if (b != a && (f[b] < ownedLo_[b] || f[b] >= ownedHi_[b])) return 0.0;
+          if (b != a && (f[b] < owned_.lo[b] || f[b] >= owned_.hi[b])) return 0.0;
         return faceTouches(a, f, [&](std::size_t cell) { return liquidCell(cell); }) ? outward * u(f) : 0.0;
       });
     }
@@ -376,19 +367,18 @@ template <typename Tracked>
 void LiquidSolver<D>::exchangeParticles(Tracked& particles, int reach) {
   constexpr int width = Tracked::kRowWidth;
   const auto cellOf = [&](const auto& x) { return phi_.coord(spec_.clampedCellIndex(x)); };
-  std::vector<double> moved = particles.takeRowsIf([&](const auto& x) { return !ownedCell(cellOf(x)); });
+  std::vector<double> moved = particles.takeRowsIf([&](const auto& x) { return !owned_.contains(cellOf(x)); });
   split_->migrate(moved, width);
   particles.appendRows(moved);
   // The neighbours need the particles in the owned cells within `reach` of a block edge between
   // them (not on the domain's sides, where this block stores no ghosts).
-  IVec<D> innerLo = ownedLo_, innerHi = ownedHi_;
+  IndexBox<D> inner = owned_;
   for (int a = 0; a < D; ++a) {
-    if (ownedLo_[a] > 0) innerLo[a] += reach;
-    if (ownedHi_[a] < spec_.res[a]) innerHi[a] -= reach;
+    if (!onDomainSide(a, 0)) inner.lo[a] += reach;
+    if (!onDomainSide(a, 1)) inner.hi[a] -= reach;
   }
   particles.setNeighbours(split_->neighbourRows(particles.rowsIf([&](const auto& x) {
-    const IVec<D> c = cellOf(x);
-    return (c.array() < innerLo.array()).any() || (c.array() >= innerHi.array()).any();
+    return !inner.contains(cellOf(x));
   }), width, reach));
 }
 
@@ -415,8 +405,9 @@ void LiquidSolver<D>::moveSplitSurface(double dt) {
   // reseeding around the own particles. An owned cell is corrected by every particle near it (its
   // own and the neighbours' copies, max and min in any order), so the corrections equal the serial
   // ones; the fast marching differs by what lies beyond the ghost layers.
+  // phi's ghosts hold their owners' values from the last step's end (emitters and sinks edit every
+  // cell alike), as its advection needs.
   ScopedStage s(timers_, "liquid: surface");
-  split_->exchange(phi_);
   advector_.advect(phi_, velocity_, dt);
   particles_.advect(velocity_, dt);
   exchangeParticles();
@@ -514,8 +505,7 @@ void LiquidSolver<D>::step(double dt) {
     applyWallInflow();
     if (split_) {
       split_->setFreeSurface(pressurePhi_);
-      controlDivergenceField_.fill(static_cast<float>(controlDivergence_));
-      split_->setCellTargetDivergence(&controlDivergenceField_);
+      split_->setTargetDivergence(controlDivergence_);
       const SplitSolveStats solve = split_->project(velocity_, projection_.pressure(), dt, params_.density);
       lastSolve_.iterations = solve.iterations;
       lastSolve_.relativeResidual = solve.relativeResidual;
@@ -586,7 +576,7 @@ LiquidStatistics LiquidSolver<D>::statistics() const {
                             return wet ? std::abs(u[i]) : 0.0f;
                           }));
   }
-  const auto ownLiquidCell = [&](std::size_t cell) { return liquidCell(cell) && ownedCell(phi_.coord(cell)); };
+  const auto ownLiquidCell = [&](std::size_t cell) { return liquidCell(cell) && owned_.contains(phi_.coord(cell)); };
   s.kineticEnergy = 0.5 * params_.density * spec_.cellVolume() * parallelSum(phi_.count(), [&](std::size_t i) {
                       if (!ownLiquidCell(i)) return 0.0;
                       const IVec<D> c = phi_.coord(i);

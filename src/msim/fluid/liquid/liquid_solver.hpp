@@ -221,9 +221,12 @@ class LiquidSolver {
   template <typename Edit>
   double editLevelSet(const Grid<float, D>& region, Edit&& edit);
   bool liquidCell(std::size_t cell) const { return phi_[cell] < 0.0f && solid_[cell] <= 0.5f; }
-  // Whether local cell c is this process's own (every cell without a split).
-  bool ownedCell(const IVec<D>& c) const {
-    return (c.array() >= ownedLo_.array()).all() && (c.array() < ownedHi_.array()).all();
+  // Whether the grid's side `side` (0 lower, 1 upper) along `axis` is the domain's (every side
+  // without a split; a block's inner edges are not).
+  bool onDomainSide(int axis, int side) const {
+    if (placement_.whole()) return true;
+    return side == 0 ? placement_.cellOrigin[axis] == 0
+                     : placement_.cellOrigin[axis] + spec_.res[axis] == placement_.globalRes[axis];
   }
   // A split run: the marker particles that left this block go to their owners, and the
   // neighbours' particles near it are copied for the correction.
@@ -245,9 +248,8 @@ class LiquidSolver {
   GridSpec<D> spec_;
   LiquidParams<D> params_;
   DomainSplit<D>* split_ = nullptr;
-  IVec<D> cellOrigin_ = IVec<D>::Zero(), globalRes_;  // the block's place in the global grid
-  IVec<D> ownedLo_ = IVec<D>::Zero(), ownedHi_;       // its own cells (local coordinates)
-  Grid<float, D> controlDivergenceField_;             // a split run: volume control's target per cell
+  BlockPlacement<D> placement_;  // the block's place in the global grid (a split run)
+  IndexBox<D> owned_;             // this process's own cells (local coordinates; all without a split)
   Grid<float, D> phi_;
   Grid<float, D> solid_;
   std::optional<Grid<float, D>> solidDistance_;  // the obstacles' nodal signed distance, if any

@@ -454,12 +454,9 @@ double SmokeSolver<D>::measureDivergence() {
   if (!split_) return parallelMax(divergence_.count(), error);
   // A split run: the owned cells (the local face weights are right on all their faces, a block's
   // edge lying a ghost layer away), over every rank.
-  const IVec<D> lo = split_->ownedLo(), hi = split_->ownedHi();
-  const double worst = parallelMax(divergence_.count(), [&](std::size_t i) {
-    const IVec<D> c = divergence_.coord(i);
-    const bool owned = (c.array() >= lo.array()).all() && (c.array() < hi.array()).all();
-    return owned ? error(i) : 0.0;
-  });
+  const IndexBox<D> own = split_->owned();
+  const double worst =
+      parallelMax(divergence_.count(), [&](std::size_t i) { return own.contains(divergence_.coord(i)) ? error(i) : 0.0; });
   return split_->maxOverRanks(worst);
 }
 

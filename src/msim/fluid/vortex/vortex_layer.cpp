@@ -34,9 +34,8 @@ void VortexLayer<D>::seedInitial(const Vorticity<D>* flowVorticity) {
 
 template <int D>
 std::size_t VortexLayer<D>::removeWherePositive(const Grid<float, D>& field) {
-  const auto& x = particles_.positions();
-  if (!split_)
-    return particles_.removeIf([&](std::size_t p) { return sampleLinear<D>(field, Vec<D>(x[p].template cast<double>())) > 0.0f; });
+  if (!split_)  // positive outside: the field taken as minus a signed distance
+    return removeVortexParticlesInSolid<D>(particles_, [&](const Vec<D>& x) { return -double(sampleLinear<D>(field, x)); });
   readAtOwners(field.spec(), 1, [&](const Vec<D>& position, std::size_t, double* out) {
     out[0] = sampleLinear<D>(field, position) > 0.0f ? 1.0 : 0.0;
   });
@@ -60,8 +59,7 @@ void VortexLayer<D>::setDomainSplit(DomainSplit<D>* split) {
   split_ = split;
   if (!split) return;
   placement_ = split->placement();
-  ownedLo_ = split->ownedLo();
-  ownedHi_ = split->ownedHi();
+  owned_ = split->owned();
 }
 
 template <int D>
@@ -75,7 +73,7 @@ bool VortexLayer<D>::owns(const GridSpec<D>& local, const Vec<D>& x) const {
     const int global = std::clamp(static_cast<int>(std::floor((x[a] - local.origin[a]) / local.dx)) + placement_.cellOrigin[a],
                                   0, placement_.globalRes[a] - 1);
     const int cell = global - placement_.cellOrigin[a];
-    if (cell < ownedLo_[a] || cell >= ownedHi_[a]) return false;
+    if (cell < owned_.lo[a] || cell >= owned_.hi[a]) return false;
   }
   return true;
 }

@@ -91,7 +91,7 @@ class VortexLayer {
   std::optional<Vorticity<D>> flowVorticity_;
   DomainSplit<D>* split_ = nullptr;
   BlockPlacement<D> placement_;  // the block's place, and its own cells, in a split run
-  IVec<D> ownedLo_ = IVec<D>::Zero(), ownedHi_ = IVec<D>::Zero();
+  IndexBox<D> owned_;
   std::vector<double> reads_;  // the split run's per-particle reads, summed over the ranks
 };
 

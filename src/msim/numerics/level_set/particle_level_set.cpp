@@ -40,7 +40,7 @@ ParticleLevelSet<D>::ParticleLevelSet(const GridSpec<D>& spec, const ParticleLev
     : spec_(spec),
       settings_(settings),
       perCell_(settings.particlesPerCell > 0 ? settings.particlesPerCell : (D == 2 ? 16 : 32)),
-      ownedHi_(spec.res) {
+      owned_{IVec<D>::Zero(), spec.res} {
   const auto& s = settings_;
   if (!(s.bandCells > 0.0) || !(s.minRadiusCells > 0.0) || !(s.maxRadiusCells >= s.minRadiusCells) ||
       !(s.minSeedCells >= 0.0) || !(s.maxSeedCells > s.minSeedCells) || s.attractionIterations < 1)
@@ -48,15 +48,9 @@ ParticleLevelSet<D>::ParticleLevelSet(const GridSpec<D>& spec, const ParticleLev
 }
 
 template <int D>
-void ParticleLevelSet<D>::setBlock(const BlockPlacement<D>& placement, const IVec<D>& ownedLo, const IVec<D>& ownedHi) {
+void ParticleLevelSet<D>::setBlock(const BlockPlacement<D>& placement, const IndexBox<D>& owned) {
   placement_ = placement;
-  ownedLo_ = ownedLo;
-  ownedHi_ = ownedHi;
-}
-
-template <int D>
-bool ParticleLevelSet<D>::seeds(const IVec<D>& c) const {
-  return (c.array() >= ownedLo_.array()).all() && (c.array() < ownedHi_.array()).all();
+  owned_ = owned;
 }
 
 template <int D>
@@ -113,7 +107,7 @@ void ParticleLevelSet<D>::seed(const Grid<float, D>& phi) {
   const float band = static_cast<float>(settings_.bandCells * spec_.dx);
   for (std::size_t i = 0; i < phi.count(); ++i) {
     const IVec<D> c = phi.coord(i);
-    if (std::abs(phi[i]) < band && seeds(c)) seedCell(phi, c, perCell_, placement_.globalIndex(c, i));
+    if (std::abs(phi[i]) < band && owned_.contains(c)) seedCell(phi, c, perCell_, placement_.globalIndex(c, i));
   }
 }
 
@@ -211,7 +205,7 @@ void ParticleLevelSet<D>::reseed(const Grid<float, D>& phi) {
   for (const Vec<D>& x : positions_) ++count[spec_.clampedCellIndex(x)];
   for (std::size_t i = 0; i < phi.count(); ++i) {
     const IVec<D> c = phi.coord(i);
-    if (std::abs(phi[i]) < band && count[i] < perCell_ && seeds(c)) seedCell(phi, c, perCell_ - count[i], placement_.globalIndex(c, i));
+    if (std::abs(phi[i]) < band && count[i] < perCell_ && owned_.contains(c)) seedCell(phi, c, perCell_ - count[i], placement_.globalIndex(c, i));
   }
 }
 

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "msim/core/block_placement.hpp"
+#include "msim/core/index_box.hpp"
 #include "msim/core/grid.hpp"
 #include "msim/core/mac_grid.hpp"
 
@@ -75,9 +76,9 @@ class ParticleLevelSet {
 
   // A block of a grid split among processes (core/domain_split.hpp): phi's grid is the block with
   // its ghost layers, at `placement` in the global grid, and the particles are those in the owned
-  // cells [ownedLo, ownedHi) (local coordinates). Seeding then fills only the owned cells, each
+  // cells `owned` (local coordinates). Seeding then fills only the owned cells, each
   // with the random stream of its global index: the particles a whole grid would seed there.
-  void setBlock(const BlockPlacement<D>& placement, const IVec<D>& ownedLo, const IVec<D>& ownedHi);
+  void setBlock(const BlockPlacement<D>& placement, const IndexBox<D>& owned);
   // The particles as rows of kRowWidth doubles (position, radius, sign), for moving them between
   // processes: those at positions x with select(x), and taking out those with select(x) (the
   // others keep their order); appendRows adds rows.
@@ -137,8 +138,6 @@ class ParticleLevelSet {
     out.push_back(radii_[p]);
     out.push_back(signs_[p]);
   }
-  // Whether cell c is seeded here (the owned cells of a block).
-  bool seeds(const IVec<D>& c) const;
   // Appends up to `count` particles in cell c (random stream `stream`), attracted to phi.
   void seedCell(const Grid<float, D>& phi, const IVec<D>& c, int count, std::uint64_t stream);
 
@@ -146,7 +145,7 @@ class ParticleLevelSet {
   ParticleLevelSetSettings settings_;
   int perCell_;
   BlockPlacement<D> placement_;
-  IVec<D> ownedLo_ = IVec<D>::Zero(), ownedHi_;  // the seeded cells
+  IndexBox<D> owned_;  // the seeded cells
   std::vector<double> neighbours_;               // other processes' particles (rows)
   std::uint64_t round_ = 0;  // reseeding rounds so far (new random streams each round)
   std::vector<Vec<D>> positions_;

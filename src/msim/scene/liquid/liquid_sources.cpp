@@ -37,12 +37,6 @@ void declareLiquidSources(Schema& root) {
 
 namespace {
 
-// Whether local cell c of a split run's block is the process's own (every cell without a split).
-template <int D>
-bool ownCell(const IVec<D>& c, const DomainSplit<D>* split) {
-  return !split || ((c.array() >= split->ownedLo().array()).all() && (c.array() < split->ownedHi().array()).all());
-}
-
 // Cross-section [m^(D-1)] of the covered cells (indices into `grid`, cell-centred) normal to the
 // unit direction n: their volume over their extent along n (exact for boxes and cylinders aligned
 // with n). Split: over every block's own cells.
@@ -50,9 +44,10 @@ template <int D>
 double crossSection(const std::vector<std::pair<std::size_t, float>>& cells, const Grid<float, D>& grid,
                     const Vec<D>& n, DomainSplit<D>* split) {
   const GridSpec<D>& spec = grid.spec();
+  const IndexBox<D> own = split ? split->owned() : IndexBox<D>{IVec<D>::Zero(), spec.res};
   double lo = std::numeric_limits<double>::infinity(), hi = -lo, volume = 0.0;
   for (const auto& [cell, cover] : cells) {
-    if (!ownCell<D>(grid.coord(cell), split)) continue;
+    if (!own.contains(grid.coord(cell))) continue;
     const double s = grid.position(grid.coord(cell)).dot(n);
     lo = std::min(lo, s);
     hi = std::max(hi, s);
@@ -107,8 +102,9 @@ LiquidSources<D>::LiquidSources(const Scene& scene, const Grid<float, D>& solid,
   for (const auto& axis : openDomainSides<D>(r)) closed = closed && !axis[0] && !axis[1];
   if (closed && !emitters_.empty()) {
     double capacity = 0.0;
+    const IndexBox<D> own = split ? split->owned() : IndexBox<D>{IVec<D>::Zero(), spec.res};
     for (std::size_t c = 0; c < solid.count(); ++c)
-      capacity += solid[c] < 0.5f && ownCell<D>(solid.coord(c), split) ? spec.cellVolume() : 0.0;
+      capacity += solid[c] < 0.5f && own.contains(solid.coord(c)) ? spec.cellVolume() : 0.0;
     if (split) capacity = split->sumOverRanks(capacity);
     if (initialVolume + emitted > capacity)
       throw InputError(fmt::format(
