@@ -156,6 +156,7 @@ void OrcaSolver::computeVelocities(const Agents& agents, const StaticObstacles& 
       4096);
   const Slot* slot = slots_.data();
   const int ny = grid_.cellsY();
+  const std::size_t cellsX = static_cast<std::size_t>(grid_.cellsX());
   const std::size_t maxNeighbours = static_cast<std::size_t>(std::max(0, params.maxNeighbours));
   const float invTau = 1.0f / params.timeHorizon, invTauObst = 1.0f / params.timeHorizonObst, invDt = 1.0f / dt;
   // The grid's cells are at least neighbourDist wide, so a cell's stencil holds the neighbours of
@@ -198,10 +199,14 @@ void OrcaSolver::computeVelocities(const Agents& agents, const StaticObstacles& 
             // The maxNeighbours closest agents within neighbourDist, ties by index (deterministic). Each
             // row of the stencil's distances is computed in one vectorisable pass; the list is only touched
             // by candidates closer than its current last entry (or within range while it is short).
+            // The agent's own row of cells first: it holds the closest candidates, so the list's
+            // threshold falls soonest (the list does not depend on the order).
             s.nearest.clear();
             if (maxNeighbours > 0) {
               float threshold = range2;  // candidates beyond it cannot enter the list
-              for (int q = 0; q < st.count; ++q) {
+              const int ownRow = static_cast<int>(st.cell / cellsX) - st.y0;
+              for (int t = 0; t < st.count; ++t) {
+                const int q = (ownRow + t) % st.count;
                 const std::uint32_t lo = st.lo[q], count = st.hi[q] - lo;
                 s.distances.resize(std::max<std::size_t>(s.distances.size(), count));
                 float* d2 = s.distances.data();
