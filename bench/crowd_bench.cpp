@@ -102,12 +102,14 @@ void BM_CircleScalingRun(benchmark::State& state) {
 
 // Golas Table 3.1's four-way crossing (2000 ORCA agents) while the four groups meet (after 20 s),
 // by method: range 0 plain ORCA (Disc), 1 discrete lookahead (Disc LA), 2 continuum (Cont LA),
-// 3 hybrid (Hyb LA); 8 levels.
+// 3 hybrid (Hyb LA); 8 levels. Ranges 4 and 5 are 1 and 3 with the discrete cascade (the far
+// levels solved apart every second, their answer ORCA's preferred velocity).
 void BM_LookaheadFourWay(benchmark::State& state) {
-  static const char* kMethods[] = {"discrete", "discrete", "continuum", "hybrid"};
+  static const char* kMethods[] = {"discrete", "discrete", "continuum", "hybrid", "discrete", "hybrid"};
   const auto method = static_cast<std::size_t>(state.range(0));
   stepScene(state, scenePath("crowd_lookahead_four_way"),
-            {fmt::format("crowd.lookahead.levels={}", method == 0 ? 0 : 8), std::string("crowd.lookahead.method=") + kMethods[method]},
+            {fmt::format("crowd.lookahead.levels={}", method == 0 ? 0 : 8), std::string("crowd.lookahead.method=") + kMethods[method],
+             std::string("crowd.lookahead.discrete_solve=") + (method >= 4 ? "cascade" : "single")},
             400);
 }
 // Table 3.1's four groups (2000 UIC agents) while they meet (after 30 s): range 0 the continuum
@@ -148,7 +150,7 @@ void BM_StressMerge6800(benchmark::State& state) {
 
 BENCHMARK(BM_StressMerge)->Unit(benchmark::kMillisecond)->Iterations(100);
 BENCHMARK(BM_StressMerge6800)->DenseRange(1, 2)->Unit(benchmark::kMillisecond)->Iterations(20);
-BENCHMARK(BM_LookaheadFourWay)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->Iterations(100);
+BENCHMARK(BM_LookaheadFourWay)->DenseRange(0, 5)->Unit(benchmark::kMillisecond)->Iterations(100);
 BENCHMARK(BM_LookaheadFourGroups)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->Iterations(200);
 BENCHMARK(BM_LookaheadCircle100k)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_Circle10k)->Unit(benchmark::kMillisecond)->Iterations(100);

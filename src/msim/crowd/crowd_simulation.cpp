@@ -246,29 +246,35 @@ void CrowdSimulation::prepareLookahead(double dt) {
   const lookahead::LookaheadSettings& la = settings_.lookahead;
   const std::size_t n = agents_.size();
   const bool orca = stats_.orcaAgents > 0;
-  // The far levels' suggested directions follow the agents (arrivals compact them, new agents
-  // have none until the next refresh).
+  // The far levels' suggestions follow the agents (arrivals compact them, new agents have none
+  // until the next refresh).
   farDirection_.resize(n, Vec2f::Zero());
+  farOrca_.resize(n, Vec2f::Zero());
+  farOrcaSet_.resize(n, 0);
+  const bool discrete = la.enabled() && orca && la.method != LookaheadMethod::Continuum;
+  const bool cascade = discrete && la.discreteSolve == lookahead::DiscreteSolve::Cascade;
+  sinceRefresh_ += dt;
+  const bool refresh = !refreshed_ || sinceRefresh_ >= la.refresh - 1e-9;
   lookahead::AgentLookahead::Needs needs;
-  needs.tree = la.enabled() && orca && la.method != LookaheadMethod::Continuum;
+  needs.tree = discrete && (!cascade || refresh);
   // Level 0 (the crowd now): the hybrid's weights and the continuum's last word for ORCA agents,
   // and the stress model's collision-free velocities (Golas ch. 4.3.3: Chapter 3's continuum).
   const bool stressed = stress_ && stats_.uicAgents > 0;
   needs.densities.now = (la.enabled() && orca && la.method != LookaheadMethod::Discrete) || stressed;
   const bool farWanted = la.enabled() && (stats_.uicAgents > 0 || needs.densities.now);
-  sinceRefresh_ += dt;
-  needs.densities.far = farWanted && (!refreshed_ || sinceRefresh_ >= la.refresh - 1e-9);
+  needs.densities.far = farWanted && refresh;
   stats_.lookahead = {};
   if (!needs.tree && !needs.densities.now && !needs.densities.far) {
-    applyFarDirections();
+    applyFarSuggestions(true);
     return;
   }
   ahead_ = &lookahead_.prepare(agents_, obstacleIndex(), settings_.orca.neighbourDist, maxSpeed(), settings_.lo,
                                settings_.hi, needs);
-  if (needs.densities.far) {
+  if (needs.densities.far || (cascade && refresh)) {
     refreshed_ = true;
     sinceRefresh_ = 0.0;
   }
+  if (cascade && refresh) refreshDiscreteFarLevels();
   continuumVelocity_.resize(n);
   blendWeight_.assign(n, 0.0f);
   skipOrca_.assign(n, 0);
@@ -328,13 +334,35 @@ void CrowdSimulation::prepareLookahead(double dt) {
   }
   st.meanWeight = st.blended > 0 ? weights / double(st.blended) : 0.0;
   stats_.lookahead = st;
+  if (cascade) applyFarSuggestions(false);
 }
 
-// Between refreshes the UIC agents walk towards the far levels' last suggestion.
-void CrowdSimulation::applyFarDirections() {
+// The discrete cascade's far levels (lookahead::farLevelsVelocity) for every ORCA agent that
+// looks ahead, kept per unit of its preferred speed until the next refresh.
+void CrowdSimulation::refreshDiscreteFarLevels() {
+  const float invTau = 1.0f / settings_.orca.timeHorizon;
   parallelFor(0, agents_.size(), [&](std::size_t i) {
-    if (agents_.model[i] != AgentModel::Uic || farDirection_[i].squaredNorm() == 0.0f) return;
-    agents_.preferredVelocity[i] = agents_.preferredVelocity[i].norm() * farDirection_[i];
+    farOrcaSet_[i] = 0;
+    const float wanted = agents_.preferredVelocity[i].norm();
+    if (agents_.model[i] != AgentModel::Orca || lookahead_.depth(i) == 0 || wanted <= 0.0f) return;
+    FarScratch& s = farScratch_.local();
+    const Vec2f v = lookahead::farLevelsVelocity(*ahead_, static_cast<std::uint32_t>(i), agents_.position[i], agents_.velocity[i],
+                                                 agents_.radius[i], invTau, agents_.preferredVelocity[i], agents_.maxSpeed[i],
+                                                 s.planes, s.projected);
+    farOrca_[i] = v / wanted;
+    farOrcaSet_[i] = 1;
+  });
+}
+
+// Between refreshes agents walk towards the far levels' last suggestion: the ORCA agents of the
+// discrete cascade, and with `uic` the UIC agents (which otherwise take theirs in
+// prepareLookahead's pass).
+void CrowdSimulation::applyFarSuggestions(bool uic) {
+  parallelFor(0, agents_.size(), [&](std::size_t i) {
+    Vec2f& preferred = agents_.preferredVelocity[i];
+    if (agents_.model[i] == AgentModel::Orca && farOrcaSet_[i]) preferred = preferred.norm() * farOrca_[i];
+    if (uic && agents_.model[i] == AgentModel::Uic && farDirection_[i].squaredNorm() > 0.0f)
+      preferred = preferred.norm() * farDirection_[i];
   });
 }
 
@@ -344,9 +372,12 @@ void CrowdSimulation::moveOrca(double dt) {
   orcaVelocity_.resize(agents_.size());
   const bool ahead = settings_.lookahead.enabled();
   const LookaheadMethod method = ahead ? settings_.lookahead.method : LookaheadMethod::Discrete;
+  // The single solve puts the far levels into level 0's program; the cascade has already made
+  // their answer each agent's preferred velocity.
+  const bool single = ahead && settings_.lookahead.discreteSolve == lookahead::DiscreteSolve::Single;
   if (method != LookaheadMethod::Continuum)
     orca_.computeVelocities(agents_, obstacleIndex(), settings_.orca, static_cast<float>(dt), orcaVelocity_,
-                            ahead ? ahead_ : nullptr, method == LookaheadMethod::Hybrid ? std::span<const std::uint8_t>(skipOrca_)
+                            single ? ahead_ : nullptr, method == LookaheadMethod::Hybrid ? std::span<const std::uint8_t>(skipOrca_)
                                                                                         : std::span<const std::uint8_t>());
   const float h = static_cast<float>(dt);
   parallelFor(0, agents_.size(), [&](std::size_t i) {
@@ -489,6 +520,8 @@ void CrowdSimulation::arriveAndSpawn(double dt) {
     agents_.removeFlagged(remove_);
     lookahead_.removeFlagged(remove_);
     compactFlagged(farDirection_, remove_);
+    compactFlagged(farOrca_, remove_);
+    compactFlagged(farOrcaSet_, remove_);
   }
   stats_.exited = exited;
 

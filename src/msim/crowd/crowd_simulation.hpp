@@ -163,7 +163,8 @@ class CrowdSimulation {
   // Depths, the agent tree and the future densities; the continuum lookahead's velocities (UIC
   // agents: their preferred velocity) and the hybrid's weights.
   void prepareLookahead(double dt);
-  void applyFarDirections();
+  void refreshDiscreteFarLevels();
+  void applyFarSuggestions(bool uic);
   void moveOrca(double dt);
   void walkingSpeeds();
   // The UIC agents' indices into uicIndex_ and the other agents as discs of the continuum.
@@ -217,6 +218,13 @@ class CrowdSimulation {
   std::optional<stress::StressDynamics> stress_;
   const lookahead::DiscreteLookahead* ahead_ = nullptr;  // this step's, from prepareLookahead()
   std::vector<Vec2f> farDirection_;  // per agent: the continuum lookahead's far levels' direction (0: none)
+  // Per agent: the discrete cascade's far levels' velocity per unit of preferred speed, where set.
+  std::vector<Vec2f> farOrca_;
+  std::vector<std::uint8_t> farOrcaSet_;
+  struct FarScratch {
+    std::vector<HalfPlane> planes, projected;
+  };
+  tbb::enumerable_thread_specific<FarScratch> farScratch_;
   double sinceRefresh_ = 0.0;        // [s] since the far levels were last asked
   bool refreshed_ = false;
   std::vector<Vec2f> stepStartVelocity_;

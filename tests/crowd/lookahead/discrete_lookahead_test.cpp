@@ -28,8 +28,9 @@ Agents orcaAgents(const std::vector<Vec2f>& starts, float radius) {
   return a;
 }
 
-// Steps the agents towards their goals with ORCA, with the lookahead when `ahead` is given;
-// calls observe(step, agents) after each step.
+// Steps the agents towards their goals with ORCA, with the lookahead when `ahead` is given (its
+// settings' discreteSolve: the far levels in ORCA's program, or their answer, asked every step, as
+// ORCA's preferred velocity); calls observe(step, agents) after each step.
 template <typename Observe>
 void walk(Agents& a, const std::vector<Vec2f>& goals, int steps, float dt, lookahead::AgentLookahead* ahead,
           Observe&& observe) {
@@ -46,6 +47,15 @@ void walk(Agents& a, const std::vector<Vec2f>& goals, int steps, float dt, looka
     }
     const lookahead::DiscreteLookahead* la =
         ahead ? &ahead->prepare(a, none, params.neighbourDist, 1.4, msim::Vec2::Zero(), msim::Vec2::Zero(), {.tree = true}) : nullptr;
+    if (la && ahead->settings().discreteSolve == lookahead::DiscreteSolve::Cascade) {
+      std::vector<HalfPlane> planes, scratch;
+      std::vector<Vec2f> far(a.size());
+      for (std::size_t i = 0; i < a.size(); ++i)
+        far[i] = lookahead::farLevelsVelocity(*la, static_cast<std::uint32_t>(i), a.position[i], a.velocity[i], a.radius[i],
+                                              1.0f / params.timeHorizon, a.preferredVelocity[i], a.maxSpeed[i], planes, scratch);
+      a.preferredVelocity = far;
+      la = nullptr;
+    }
     solver.computeVelocities(a, none, params, dt, v, la);
     std::vector<Vec2f> previous = a.velocity;
     for (std::size_t i = 0; i < a.size(); ++i) {
@@ -64,10 +74,17 @@ TEST(DiscreteLookahead, KeepsOrcasLevelZeroGuaranteeInDenseRandomCrowds) {
   // 10 s. The seed expects no two closer than r_i + r_j - 1 mm with and without the lookahead; this
   // ORCA (float positions, the least-penetration program where the half-planes leave no velocity)
   // lets pairs overlap by about 1 cm here (float positions and steps make single runs chaotic:
-  // either may overlap a little more). Neither may overlap by more than a tenth of a radius: the
-  // lookahead's constraints join the same program without loosening level 0.
-  float closest[2] = {1e9f, 1e9f};
-  for (const int levels : {0, 8}) {
+  // either may overlap a little more). None may overlap by more than a tenth of a radius: the
+  // single solve's far constraints join level 0's program without loosening it, the cascade's only
+  // bend its preferred velocity.
+  using lookahead::DiscreteSolve;
+  struct Variant {
+    const char* name;
+    int levels;
+    DiscreteSolve solve;
+  };
+  for (const Variant& variant : {Variant{"plain_orca", 0, DiscreteSolve::Single}, Variant{"single_solve", 8, DiscreteSolve::Single},
+                                 Variant{"cascade", 8, DiscreteSolve::Cascade}}) {
     std::mt19937 random(17);
     const std::size_t kAgents = 80;
     std::uniform_real_distribution<float> u(0.0f, 12.0f);
@@ -80,27 +97,26 @@ TEST(DiscreteLookahead, KeepsOrcasLevelZeroGuaranteeInDenseRandomCrowds) {
     for (std::size_t i = 0; i < starts.size(); ++i) goals.emplace_back(u(random), u(random));
     Agents a = orcaAgents(starts, 0.25f);
     lookahead::LookaheadSettings settings;
-    settings.levels = levels;
+    settings.levels = variant.levels;
     settings.baseStep = 0.05;
+    settings.discreteSolve = variant.solve;
     lookahead::AgentLookahead ahead(settings);
-    float& c = closest[levels > 0 ? 1 : 0];
-    walk(a, goals, 200, 0.05f, levels > 0 ? &ahead : nullptr, [&](int, const Agents& agents) {
+    float closest = 1e9f;
+    walk(a, goals, 200, 0.05f, variant.levels > 0 ? &ahead : nullptr, [&](int, const Agents& agents) {
       for (std::size_t i = 0; i < agents.size(); ++i)
         for (std::size_t j = i + 1; j < agents.size(); ++j)
-          c = std::min(c, (agents.position[i] - agents.position[j]).norm() - agents.radius[i] - agents.radius[j]);
+          closest = std::min(closest, (agents.position[i] - agents.position[j]).norm() - agents.radius[i] - agents.radius[j]);
     });
+    testing::Test::RecordProperty(std::string(variant.name) + "_overlap_m", std::to_string(-closest));
+    EXPECT_GE(closest, -0.025f) << variant.name;
   }
-  testing::Test::RecordProperty("plain_orca_overlap_m", std::to_string(-closest[0]));
-  testing::Test::RecordProperty("lookahead_overlap_m", std::to_string(-closest[1]));
-  EXPECT_GE(closest[0], -0.025f);
-  EXPECT_GE(closest[1], -0.025f);
 }
 
 TEST(DiscreteLookahead, AgentsWalkingAtEachOtherTurnAsideFromFurtherAway) {
   // Two agents 20 m apart walk at each other at 1.4 m/s, 0.1 m off the same line. Plain ORCA (R = 3 m,
   // tau = 2 s) sees the other only within R; with 8 levels of 0.05 s (horizons to 6.4 s, bands to
   // R + 2 v_max 6.4 s) the lookahead sees it from the start and the agents turn aside while still
-  // far apart.
+  // far apart, whether the far levels sit in level 0's program or bend its preferred velocity.
   const auto turnDistance = [](lookahead::AgentLookahead* ahead) {
     Agents a = orcaAgents({Vec2f(0.0f, 0.05f), Vec2f(20.0f, -0.05f)}, 0.25f);
     a.velocity[0] = Vec2f(1.4f, 0.0f);
@@ -113,14 +129,18 @@ TEST(DiscreteLookahead, AgentsWalkingAtEachOtherTurnAsideFromFurtherAway) {
     return distance;
   };
   const float plain = turnDistance(nullptr);
-  lookahead::LookaheadSettings settings;
-  settings.levels = 8;
-  settings.baseStep = 0.05;
-  lookahead::AgentLookahead ahead(settings);
-  const float early = turnDistance(&ahead);
   EXPECT_GT(plain, 0.0f);
   EXPECT_LT(plain, 7.0f) << "plain ORCA reacts within its horizon";
   testing::Test::RecordProperty("plain_turn_distance_m", std::to_string(plain));
-  testing::Test::RecordProperty("lookahead_turn_distance_m", std::to_string(early));
-  EXPECT_GT(early, 1.5f * plain) << "plain " << plain << " m";
+  for (const auto solve : {lookahead::DiscreteSolve::Single, lookahead::DiscreteSolve::Cascade}) {
+    lookahead::LookaheadSettings settings;
+    settings.levels = 8;
+    settings.baseStep = 0.05;
+    settings.discreteSolve = solve;
+    lookahead::AgentLookahead ahead(settings);
+    const float early = turnDistance(&ahead);
+    const std::string name = solve == lookahead::DiscreteSolve::Single ? "single_solve" : "cascade";
+    testing::Test::RecordProperty(name + "_turn_distance_m", std::to_string(early));
+    EXPECT_GT(early, 1.5f * plain) << name << ": plain " << plain << " m";
+  }
 }

@@ -33,6 +33,11 @@ namespace msim::crowd::lookahead {
 // as their preferred velocity (the UIC then decides at level 0).
 enum class LookaheadMethod { Discrete, Continuum, Hybrid };
 
+// How the discrete lookahead's far levels meet level 0: in ORCA's one linear program with the
+// neighbours (the seed's single solve, ch. 3.6), or solved apart as the generic cascade of Fig. 3.4
+// does, their answer level 0's preferred velocity, asked again every `refresh` seconds.
+enum class DiscreteSolve { Single, Cascade };
+
 struct LookaheadSettings {
   int levels = 0;             // i_max; 0: no lookahead
   double baseStep = 0.01;     // dt of the horizons dt_i = 2^(i-1) dt [s] (the seed's step)
@@ -41,10 +46,12 @@ struct LookaheadSettings {
   double metricWindow = 0.4;  // tau_w [s]
   MetricMode metricMode = MetricMode::SqrtEigenvalueSum;
   LookaheadMethod method = LookaheadMethod::Discrete;
+  DiscreteSolve discreteSolve = DiscreteSolve::Single;
   double cell = 1.0;          // h_0: level 0's cell in the future-density pyramid [m]
-  // How often the continuum lookahead's far levels (1..L) are asked again [s]; in between each
-  // agent keeps the direction they suggested (0: every step, as the seed). Their horizons are
-  // seconds, and asking them every step cost as much as the UIC step itself.
+  // How often the far levels (1..L) of the continuum lookahead and of the discrete cascade are
+  // asked again [s]; in between each agent keeps what they suggested (0: every step, as the seed).
+  // The continuum's horizons are seconds, and asking them every step cost as much as the UIC step
+  // itself.
   double refresh = 1.0;
   ContinuumSettings continuum;
   BlendThresholds blend;

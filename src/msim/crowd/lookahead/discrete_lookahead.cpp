@@ -76,4 +76,13 @@ void appendLookaheadPlanes(const DiscreteLookahead& l, std::uint32_t self, const
   }
 }
 
+Vec2f farLevelsVelocity(const DiscreteLookahead& lookahead, std::uint32_t self, const Vec2f& x, const Vec2f& v, float r,
+                        float invTau, const Vec2f& preferred, float maxSpeed, std::vector<HalfPlane>& planes,
+                        std::vector<HalfPlane>& scratch) {
+  planes.clear();
+  appendLookaheadPlanes(lookahead, self, x, v, r, invTau, planes);
+  if (planes.empty()) return preferred;
+  return solveOrcaProgram(planes, 0, preferred, maxSpeed, scratch);
+}
+
 }  // namespace msim::crowd::lookahead

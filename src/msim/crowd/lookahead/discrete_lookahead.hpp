@@ -53,4 +53,13 @@ inline float clusterRadius(const AgentTree::Node& node, float effectiveRadius, f
 void appendLookaheadPlanes(const DiscreteLookahead& lookahead, std::uint32_t self, const Vec2f& x, const Vec2f& v, float r,
                            float invTau, std::vector<HalfPlane>& planes);
 
+// The far levels on their own (the cascade of Fig. 3.4 with levels depth..1 taken in one linear
+// program): the velocity nearest `preferred`, within maxSpeed, that avoids the agents and clusters
+// of agent `self`'s levels 1..depth[self]; level 0, plain ORCA, then takes it as its preferred
+// velocity, so far agents bend an agent's wish instead of binding its choice. Returns `preferred`
+// where there is nothing far to avoid. `planes` and `scratch` are the caller's buffers.
+Vec2f farLevelsVelocity(const DiscreteLookahead& lookahead, std::uint32_t self, const Vec2f& x, const Vec2f& v, float r,
+                        float invTau, const Vec2f& preferred, float maxSpeed, std::vector<HalfPlane>& planes,
+                        std::vector<HalfPlane>& scratch);
+
 }  // namespace msim::crowd::lookahead

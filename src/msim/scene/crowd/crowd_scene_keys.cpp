@@ -128,11 +128,16 @@ Schema crowdKeys() {
                "future densities instead of ORCA, ch. 3.5) or hybrid (the two blended by density and velocity spread, ch. 3.9); "
                "UIC agents always take the continuum lookahead as their preferred velocity")
       .choices({"discrete", "continuum", "hybrid"});
+  ahead.string("discrete_solve", "single",
+               "how the discrete lookahead's far levels meet level 0: single (in ORCA's one linear program with the "
+               "neighbours, ch. 3.6) or cascade (solved apart every `refresh` seconds, their answer level 0's preferred "
+               "velocity, Fig. 3.4)")
+      .choices({"single", "cascade"});
   ahead.number("cell", "m", 1.0, "h_0: the future-density pyramid's finest cell (level i: h_0 c^i)")
       .min(0.0, Bound::Exclusive);
   ahead.number("refresh", "s", 1.0,
-               "the continuum lookahead asks its far levels (1..levels) again this often, each agent keeping their "
-               "suggested direction in between; 0: every step (the seed)")
+               "the continuum lookahead and the discrete cascade ask their far levels (1..levels) again this often, each "
+               "agent keeping their suggestion in between; 0: every step (the seed)")
       .min(0.0);
   ahead.number("plan_horizon", "s", 1.0, "T: how far ahead eq. 3.1 weighs the density change along a direction")
       .min(0.0, Bound::Exclusive);
@@ -355,6 +360,9 @@ struct Builder {
     out.settings.lookahead.method = method == "continuum" ? crowd::lookahead::LookaheadMethod::Continuum
                                     : method == "hybrid"  ? crowd::lookahead::LookaheadMethod::Hybrid
                                                           : crowd::lookahead::LookaheadMethod::Discrete;
+    out.settings.lookahead.discreteSolve = la.at("discrete_solve").get<std::string>() == "cascade"
+                                               ? crowd::lookahead::DiscreteSolve::Cascade
+                                               : crowd::lookahead::DiscreteSolve::Single;
     out.settings.lookahead.cell = la.at("cell").get<double>();
     out.settings.lookahead.refresh = la.at("refresh").get<double>();
     out.settings.lookahead.continuum.planHorizon = la.at("plan_horizon").get<double>();
