@@ -1,7 +1,9 @@
 #include "msim/crowd/orca.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <limits>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -17,6 +19,9 @@ float det(const Vec2f& a, const Vec2f& b) { return a.x() * b.y() - a.y() * b.x()
 
 // Parallel lines (in the 1D program) and vanishing bisector normals (in the 3D one).
 constexpr float kEps = 1e-5f;
+
+// Neighbour candidates are screened against the list's threshold this many at a time.
+constexpr std::uint32_t kBlock = 32;
 
 // Best point on the boundary line of planes[k], v = p + t d, within the disc and planes[0, k).
 // With `maximise`, the point furthest along `objective`; otherwise the one closest to it.
@@ -208,14 +213,24 @@ void OrcaSolver::computeVelocities(const Agents& agents, const StaticObstacles& 
               for (int t = 0; t < st.count; ++t) {
                 const int q = (ownRow + t) % st.count;
                 const std::uint32_t lo = st.lo[q], count = st.hi[q] - lo;
-                s.distances.resize(std::max<std::size_t>(s.distances.size(), count));
+                // Padded to whole blocks of kBlock with distances no candidate has.
+                const std::uint32_t padded = (count + kBlock - 1) / kBlock * kBlock;
+                s.distances.resize(std::max<std::size_t>(s.distances.size(), padded));
                 float* d2 = s.distances.data();
                 const Vec2f* p = pos.data() + lo;
                 for (std::uint32_t m = 0; m < count; ++m) {
                   const float ex = p[m].x() - xi.x(), ey = p[m].y() - xi.y();
                   d2[m] = ex * ex + ey * ey;
                 }
-                for (std::uint32_t m = 0; m < count; ++m) {
+                std::fill(d2 + count, d2 + padded, std::numeric_limits<float>::infinity());
+                // The candidates under the threshold, a block at a time as a bit mask (one vector
+                // compare instead of a hard-to-predict branch per candidate); the threshold may fall
+                // within a block, so each is tested again.
+                for (std::uint32_t block = 0; block < padded; block += kBlock) {
+                  std::uint32_t below = 0;
+                  for (std::uint32_t b = 0; b < kBlock; ++b) below |= static_cast<std::uint32_t>(d2[block + b] <= threshold) << b;
+                  for (; below != 0; below &= below - 1) {
+                  const std::uint32_t m = block + static_cast<std::uint32_t>(std::countr_zero(below));
                   if (d2[m] > threshold) continue;
                   const std::uint32_t j = lo + m;
                   if (d2[m] >= range2 || j == k) continue;
@@ -229,6 +244,7 @@ void OrcaSolver::computeVelocities(const Agents& agents, const StaticObstacles& 
                   for (std::size_t at = s.nearest.size() - 1; at > 0 && closer(s.nearest[at], s.nearest[at - 1]); --at)
                     std::swap(s.nearest[at], s.nearest[at - 1]);
                   if (s.nearest.size() == maxNeighbours) threshold = s.nearest.back().d2;
+                  }
                 }
               }
             }
