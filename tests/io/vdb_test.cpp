@@ -154,6 +154,27 @@ TEST(Vdb, GridsAndPointsShareOneFile) {
   EXPECT_THROW(writer.addFloatGrid("density", randomScalarGrid()), std::invalid_argument);
 }
 
+TEST(Vdb, NumbersRoundTripExactlyBesideTheFrameMetadata) {
+  // A resumed run's state besides the grids (volume control's integrator, counters): doubles
+  // back bit for bit, next to the frame's own metadata; a name asked for that is not there is an
+  // input error naming the file, a repeated one refused when written.
+  const auto dir = scratchDir();
+  VdbWriter writer;
+  writer.addFloatGrid("density", randomScalarGrid());
+  writer.addNumber("target", 0.1 + 0.2);
+  writer.addNumber("integral", -1e-300);
+  EXPECT_THROW(writer.addNumber("target", 1.0), std::invalid_argument);
+  EXPECT_THROW(writer.addNumber("", 1.0), std::invalid_argument);
+  const VdbFrameInfo info{"scene", 3, 0.25};
+  writer.write(dir / "f.vdb", &info);
+  const VdbFile file(dir / "f.vdb", VdbProvenance::MsimRun);
+  EXPECT_EQ(file.number("target"), 0.1 + 0.2);
+  EXPECT_EQ(file.number("integral"), -1e-300);
+  EXPECT_TRUE(file.hasNumber("target"));
+  EXPECT_FALSE(file.hasNumber("frame"));
+  expectInputError([&] { (void)file.number("leak"); }, {"f.vdb", "'leak'"});
+}
+
 TEST(Vdb, ReadErrorsAreInputErrorsNamingTheFile) {
   const auto dir = scratchDir();
   VdbWriter writer;

@@ -139,16 +139,26 @@ std::string readFileBytes(const std::filesystem::path& path) {
 
 // Parses every grid of the file's bytes. The stream throws at the end of the data, so a count
 // read from a damaged file cannot make OpenVDB loop on past it.
-openvdb::GridPtrVec parseGrids(std::string bytes, const std::filesystem::path& path) {
+// The file metadata key of a number added with VdbWriter::addNumber.
+std::string numberKey(const std::string& name) { return "msim_state_" + name; }
+
+// A file's grids and its metadata.
+struct ParsedVdb {
+  openvdb::GridPtrVec grids;
+  openvdb::MetaMap::Ptr metadata;
+};
+
+ParsedVdb parseGrids(std::string bytes, const std::filesystem::path& path) {
   initializeOpenVdb();
   try {
     std::istringstream stream(std::move(bytes));
     stream.exceptions(std::ios::failbit | std::ios::badbit);
     openvdb::io::Stream archive(stream, /*delayLoad=*/false);
-    openvdb::GridPtrVec grids;
+    ParsedVdb parsed;
     for (const auto& grid : *archive.getGrids())
-      if (grid) grids.push_back(grid);
-    return grids;
+      if (grid) parsed.grids.push_back(grid);
+    parsed.metadata = archive.getMetadata();
+    return parsed;
   } catch (const std::exception& e) {  // openvdb::Exception, a stream error or bad_alloc on a corrupt file
     failRead(path, std::string("cannot read VDB file (") + e.what() + ")");
   }
@@ -239,6 +249,7 @@ struct VdbWriter::Impl {
   VdbWriteOptions options;
   openvdb::GridPtrVec grids;
   std::set<std::string> names;
+  openvdb::MetaMap numbers;
 
   void add(const std::string& name, openvdb::GridBase::Ptr grid) {
     if (name.empty()) throw std::invalid_argument("VdbWriter: empty grid name");
@@ -387,11 +398,17 @@ void VdbWriter::addPoints(const std::string& name, const PointCloud& points, dou
   impl_->add(name, grid);
 }
 
+void VdbWriter::addNumber(const std::string& name, double value) {
+  if (name.empty()) throw std::invalid_argument("VdbWriter: empty number name");
+  if (impl_->numbers[numberKey(name)]) throw std::invalid_argument("VdbWriter: duplicate number name '" + name + "'");
+  impl_->numbers.insertMeta(numberKey(name), openvdb::DoubleMetadata(value));
+}
+
 void VdbWriter::write(const std::filesystem::path& path, const VdbFrameInfo* frame) const {
   writeFileAtomically(path, [&](const std::filesystem::path& tmp) {
     try {
       openvdb::io::File file(tmp.string());
-      openvdb::MetaMap fileMetadata;
+      openvdb::MetaMap fileMetadata(impl_->numbers);
       fileMetadata.insertMeta("msim_version", openvdb::StringMetadata(kVersion));
       fileMetadata.insertMeta("msim_units", openvdb::StringMetadata(kUnits));
       if (frame) {
@@ -412,6 +429,7 @@ void VdbWriter::write(const std::filesystem::path& path, const VdbFrameInfo* fra
 struct VdbFile::Impl {
   std::filesystem::path path;
   openvdb::GridPtrVec grids;
+  openvdb::MetaMap::Ptr metadata;
 
   openvdb::GridBase::Ptr grid(const std::string& name) const {
     for (const auto& g : grids)
@@ -438,7 +456,9 @@ VdbFile::VdbFile(const std::filesystem::path& path, VdbProvenance provenance) : 
   // The seal is checked before OpenVDB reads a byte: a damaged frame never reaches its parser.
   if (checkVdbSeal(bytes, path) == VdbSeal::Absent && provenance == VdbProvenance::MsimRun)
     failRead(path, "not a frame written by this version of msim, or damaged: it carries no msim checksum");
-  impl_->grids = parseGrids(std::move(bytes), path);
+  ParsedVdb parsed = parseGrids(std::move(bytes), path);
+  impl_->grids = std::move(parsed.grids);
+  impl_->metadata = std::move(parsed.metadata);
 }
 
 VdbFile::~VdbFile() = default;
@@ -479,6 +499,15 @@ Grid<Vecf<3>, 3> VdbFile::vectorGrid(const std::string& name) const {
   if (const auto vs = openvdb::gridPtrCast<openvdb::Vec3SGrid>(base)) return readVectorGridAs(*vs, impl_->path);
   if (const auto vd = openvdb::gridPtrCast<openvdb::Vec3DGrid>(base)) return readVectorGridAs(*vd, impl_->path);
   failRead(impl_->path, "grid '" + name + "' has type " + base->valueType() + ", expected vec3s or vec3d");
+}
+
+bool VdbFile::hasNumber(const std::string& name) const {
+  return impl_->metadata && impl_->metadata->getMetadata<openvdb::DoubleMetadata>(numberKey(name)) != nullptr;
+}
+
+double VdbFile::number(const std::string& name) const {
+  if (!hasNumber(name)) failRead(impl_->path, "no number named '" + name + "' in its metadata");
+  return impl_->metadata->metaValue<double>(numberKey(name));
 }
 
 PointCloud VdbFile::points(const std::string& name) const {

@@ -78,6 +78,9 @@ class VdbWriter {
   // a power of two, which makes the world <-> voxel-offset conversion exact, so positions read
   // back bit-equal. std::invalid_argument for non-finite positions or mismatched attributes.
   void addPoints(const std::string& name, const PointCloud& points, double voxelSize);
+  // A number stored with the frame as file metadata (msim_state_<name>): state a resumed run needs
+  // besides the grids, such as a controller's. std::invalid_argument for an empty or repeated name.
+  void addNumber(const std::string& name, double value);
 
   // Writes all added grids atomically, with the frame's metadata if given, and seals the file with
   // its checksum (vdb_seal.hpp); std::runtime_error if writing fails.
@@ -120,6 +123,9 @@ class VdbFile {
   // msim. An empty set comes back without attributes (VDB keeps attribute names in the leaves, and
   // an empty grid has none).
   PointCloud points(const std::string& name) const;
+  // A number stored by VdbWriter::addNumber; InputError naming the file if it has none of that name.
+  double number(const std::string& name) const;
+  bool hasNumber(const std::string& name) const;
 
  private:
   struct Impl;

@@ -59,6 +59,11 @@ bool anyRank(bool flag) {
   return any != 0;
 }
 
+long fromRankZero(long value) {
+  if (mpiRunning()) MPI_Bcast(&value, 1, MPI_LONG, 0, MPI_COMM_WORLD);
+  return value;
+}
+
 void agreeOnFailure(std::exception_ptr local, MPI_Comm comm) {
   if (!mpiRunning()) {
     if (local) std::rethrow_exception(local);

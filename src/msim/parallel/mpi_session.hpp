@@ -32,6 +32,8 @@ int worldSize();
 int ranksOnThisNode();
 // Whether `flag` holds on some rank (the flag itself without MPI). Collective.
 bool anyRank(bool flag);
+// Rank 0's `value` on every rank (the value itself without MPI). Collective.
+long fromRankZero(long value);
 
 // Agrees on an error that may have struck some ranks only (a scene's shape that lies outside
 // one rank's block): `local` is this rank's exception or null. If any rank failed, every rank

@@ -32,8 +32,9 @@ class Phenomenon {
   // runner owns the file: its name, storage options and metadata).
   virtual void writeVolume(io::VdbWriter& writer) const = 0;
   virtual io::Image preview() const = 0;
-  // Restores the state saved by writeVolume at simulated time `time` [s] (for --resume).
-  virtual void restore(const std::filesystem::path& vdbFile, double time) = 0;
+  // Restores the state saved by writeVolume at simulated time `time` [s] after `steps` steps (for
+  // --resume; the step count serves what happens every so many steps).
+  virtual void restore(const std::filesystem::path& vdbFile, double time, long steps) = 0;
   // Summary numbers of the current state, one JSON object of named numbers.
   virtual nlohmann::json statistics() const = 0;
   // In a run split among MPI processes (PhenomenonType::splitsAmongProcesses) every rank calls

@@ -235,18 +235,27 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
   if (ranks > 1) record.note("mpi_processes", std::to_string(ranks));
 
   int firstFrame = 1;
+  long resumedSteps = 0;
   if (options.resume) {
     int done = 0;
     while (done < lastFrame && frameComplete(layout, done + 1)) ++done;
     if (done > 0) {
       ScopedStage stage(timers, "resume: read frame");
-      phenomenon->restore(frameFile(layout.vdbDir, layout.name, done, "vdb"), done / scene.fps);
+      // The steps taken so far: the substeps of the frames the run's record holds (rank 0's
+      // reading, so that every rank keeps the same count).
+      record.adoptPreviousFrames(done);
+      for (const json& f : record.frames()) resumedSteps += f.value("substeps", 0L);
+      resumedSteps = parallel::fromRankZero(resumedSteps);
+      if (writesFiles && record.frames().size() != static_cast<std::size_t>(done))
+        logger().warn("{}: run.json does not hold the {} frames written: the step count restarts at {} (what happens "
+                      "every so many steps, such as a liquid's reseeding, shifts)",
+                      layout.root.string(), done, resumedSteps);
+      phenomenon->restore(frameFile(layout.vdbDir, layout.name, done, "vdb"), done / scene.fps, resumedSteps);
       if (layout.vdbOptions.halfFloat || layout.vdbOptions.fogTolerance > 0.0f)
         logger().info("frame {} was stored with outputs.vdb_fog_tolerance = {:g}{}: the resumed run continues from "
                       "those values, close to but not bit-equal with an uninterrupted run (a tolerance of 0 and full "
                       "floats make resuming exact)",
                       done, layout.vdbOptions.fogTolerance, layout.vdbOptions.halfFloat ? " in half floats" : "");
-      record.adoptPreviousFrames(done);
     }
     firstFrame = done + 1;
     logger().info("resuming after frame {} of {}", done, lastFrame);
@@ -256,7 +265,7 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
 
   const double frameDt = 1.0 / scene.fps;
   const int maxSubsteps = scene.resolved.at("time").at("max_substeps").get<int>();
-  long stepIndex = 0;
+  long stepIndex = resumedSteps;
   ProgressBar progress(firstFrame, lastFrame);
   RunStatus status = RunStatus::Complete;
   try {

@@ -235,6 +235,23 @@ void LiquidSolver<D>::resetVolumeControl() {
 }
 
 template <int D>
+typename LiquidSolver<D>::VolumeControlState LiquidSolver<D>::volumeControlState() const {
+  return {targetVolume_, volumeErrorIntegral_, lastVolumeError_, controlDivergence_, leakRate_, flipVolumeScale_,
+          controlStarted_};
+}
+
+template <int D>
+void LiquidSolver<D>::restoreVolumeControl(const VolumeControlState& state) {
+  targetVolume_ = state.target;
+  volumeErrorIntegral_ = state.errorIntegral;
+  lastVolumeError_ = state.lastError;
+  controlDivergence_ = state.divergence;
+  leakRate_ = state.leakRate;
+  flipVolumeScale_ = state.flipScale;
+  controlStarted_ = state.started;
+}
+
+template <int D>
 void LiquidSolver<D>::reinitialize() {
   intoSolids_.extend(phi_);
   // Split: the block marches with its ghost layers filled (Selle ch. 8.1: ceil(band) layers give

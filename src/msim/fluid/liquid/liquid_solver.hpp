@@ -150,6 +150,15 @@ class LiquidSolver {
   // saved particles first (levelSetParticles() / flipParticles()); a particle level set left
   // empty is seeded afresh from phi. Volume control holds the restored volume from then on.
   void restore(const Grid<float, D>& phi, const MacGrid<D>& velocity, long steps);
+  // Volume control's state: its target, the PI controller's integral and last error and output,
+  // the leak estimate, FLIP's volume per particle. A resumed run that restores it after restore()
+  // holds the volume the uninterrupted run holds, not the one its saved surface had.
+  struct VolumeControlState {
+    double target = 0.0, errorIntegral = 0.0, lastError = 0.0, divergence = 0.0, leakRate = 0.0, flipScale = 0.0;
+    bool started = false;
+  };
+  VolumeControlState volumeControlState() const;
+  void restoreVolumeControl(const VolumeControlState& state);
 
   // Largest step with (max speed + sqrt(|g| dx)) dt <= cfl dx: the gravity term keeps a liquid at
   // rest from taking an unbounded first step.

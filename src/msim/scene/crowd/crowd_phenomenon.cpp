@@ -148,7 +148,7 @@ class CrowdPhenomenon final : public Phenomenon {
     writer.addFloatGrid("free_area", sim_->freeArea().fraction());
   }
 
-  void restore(const fs::path& vdbFile, double time) override {
+  void restore(const fs::path& vdbFile, double time, long /*steps*/) override {
     const io::VdbFile saved(vdbFile, io::VdbProvenance::MsimRun);
     const io::PointCloud points = saved.points(kAgentPoints);
     const io::PointCloud state = saved.points(kStatePoints);

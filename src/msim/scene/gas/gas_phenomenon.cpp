@@ -163,7 +163,7 @@ class GasPhenomenon final : public Phenomenon {
 
   // The motion fields are steady and the winds a function of time, so the state is the two grids
   // and the clock.
-  void restore(const std::filesystem::path& vdbFile, double time) override {
+  void restore(const std::filesystem::path& vdbFile, double time, long /*steps*/) override {
     const io::VdbFile saved(vdbFile, io::VdbProvenance::MsimRun);
     solver_.setTime(time);
     restoreGrid(saved, "density", solver_.density(), source_);

@@ -95,7 +95,7 @@ class GranularPhenomenon final : public Phenomenon {
 
   void writeVolume(io::VdbWriter& writer) const override { addGranularFrame(writer, sim_, setup_.bodies); }
 
-  void restore(const fs::path& vdbFile, double time) override {
+  void restore(const fs::path& vdbFile, double time, long /*steps*/) override {
     restoreGranularVdb(vdbFile, sim_, setup_.bodies, source_);
     // Render points are not saved: new ones are sampled inside the restored particles.
     sim_.resampleRenderPoints();

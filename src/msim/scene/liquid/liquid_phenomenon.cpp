@@ -282,6 +282,15 @@ class LiquidPhenomenon final : public Phenomenon {
       writer.addLevelSet("obstacle_distance", (wholeObstacles_ ? *wholeObstacles_ : obstacles_).cellDistance(time_));
     if (solver_.vortexLayer())
       writer.addPoints(kVortexPoints, vortexParticleCloud(solver_.vortexLayer()->particles()), solver_.spec().dx);
+    // Volume control's state, the same on every process (it works on the summed volume).
+    const typename fluid::LiquidSolver<D>::VolumeControlState control = solver_.volumeControlState();
+    writer.addNumber("volume_control_target", control.target);
+    writer.addNumber("volume_control_integral", control.errorIntegral);
+    writer.addNumber("volume_control_last_error", control.lastError);
+    writer.addNumber("volume_control_divergence", control.divergence);
+    writer.addNumber("volume_control_leak_rate", control.leakRate);
+    writer.addNumber("volume_control_flip_scale", control.flipScale);
+    writer.addNumber("volume_control_started", control.started ? 1.0 : 0.0);
   }
 
   // The surface as a triangle mesh (3D): mesh/<name>_NNNN.ply and/or .obj (liquid.mesh_format);
@@ -315,9 +324,10 @@ class LiquidPhenomenon final : public Phenomenon {
     return render::renderDensityPreview(fraction_, preview_, obstacles_.empty() ? nullptr : solid);
   }
 
-  // The resumed run continues from the saved surface, velocity and particles; the pressure's warm
-  // start is not saved, so it is close to but not bit-equal with an uninterrupted run.
-  void restore(const std::filesystem::path& vdbFile, double time) override {
+  // The resumed run continues from the saved surface, velocity and particles, volume control's
+  // state, and the step count (the reseeding keeps its phase); the pressure's warm start is not
+  // saved, so it is close to but not bit-equal with an uninterrupted run.
+  void restore(const std::filesystem::path& vdbFile, double time, long steps) override {
     time_ = time;
     if (obstacles_.moving()) placeObstacles(time);
     const io::VdbFile saved(vdbFile, io::VdbProvenance::MsimRun);
@@ -350,7 +360,12 @@ class LiquidPhenomenon final : public Phenomenon {
       }
       solver_.levelSetParticles().assign(std::move(positions), radius, std::move(signs));
     }
-    solver_.restore(phi, velocity, 0);
+    solver_.restore(phi, velocity, steps);  // the reseeding keeps its phase
+    if (saved.hasNumber("volume_control_target"))
+      solver_.restoreVolumeControl({saved.number("volume_control_target"), saved.number("volume_control_integral"),
+                                    saved.number("volume_control_last_error"), saved.number("volume_control_divergence"),
+                                    saved.number("volume_control_leak_rate"), saved.number("volume_control_flip_scale"),
+                                    saved.number("volume_control_started") != 0.0});
     solver_.setTime(time);
     if (fluid::VortexLayer<D>* layer = solver_.vortexLayer())
       restoreVortexParticles(saved, kVortexPoints, *layer, source_);

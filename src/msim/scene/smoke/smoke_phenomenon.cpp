@@ -248,7 +248,7 @@ class SmokePhenomenon final : public Phenomenon {
     return render::renderDensityPreview(density(), preview_, solid, emission);
   }
 
-  void restore(const std::filesystem::path& vdbFile, double time) override {
+  void restore(const std::filesystem::path& vdbFile, double time, long /*steps*/) override {
     const io::VdbFile saved(vdbFile, io::VdbProvenance::MsimRun);
     // A split run's ranks each read the whole frame and keep their block of it.
     const BlockPlacement<D> block = split_ ? split_->placement() : BlockPlacement<D>{};

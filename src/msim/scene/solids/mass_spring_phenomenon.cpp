@@ -374,7 +374,7 @@ class MassSpringPhenomenon final : public Phenomenon {
     }
   }
 
-  void restore(const fs::path& vdbFile, double time) override {
+  void restore(const fs::path& vdbFile, double time, long /*steps*/) override {
     time_ = time;
     moveBodies(time);
     const io::VdbFile saved(vdbFile, io::VdbProvenance::MsimRun);
