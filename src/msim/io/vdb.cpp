@@ -501,13 +501,10 @@ Grid<Vecf<3>, 3> VdbFile::vectorGrid(const std::string& name) const {
   failRead(impl_->path, "grid '" + name + "' has type " + base->valueType() + ", expected vec3s or vec3d");
 }
 
-bool VdbFile::hasNumber(const std::string& name) const {
-  return impl_->metadata && impl_->metadata->getMetadata<openvdb::DoubleMetadata>(numberKey(name)) != nullptr;
-}
-
 double VdbFile::number(const std::string& name) const {
-  if (!hasNumber(name)) failRead(impl_->path, "no number named '" + name + "' in its metadata");
-  return impl_->metadata->metaValue<double>(numberKey(name));
+  const auto value = impl_->metadata ? impl_->metadata->getMetadata<openvdb::DoubleMetadata>(numberKey(name)) : nullptr;
+  if (!value) failRead(impl_->path, "no number named '" + name + "' in its metadata");
+  return value->value();
 }
 
 PointCloud VdbFile::points(const std::string& name) const {

@@ -125,7 +125,6 @@ class VdbFile {
   PointCloud points(const std::string& name) const;
   // A number stored by VdbWriter::addNumber; InputError naming the file if it has none of that name.
   double number(const std::string& name) const;
-  bool hasNumber(const std::string& name) const;
 
  private:
   struct Impl;

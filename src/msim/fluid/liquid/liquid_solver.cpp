@@ -235,9 +235,9 @@ void LiquidSolver<D>::resetVolumeControl() {
 }
 
 template <int D>
-typename LiquidSolver<D>::VolumeControlState LiquidSolver<D>::volumeControlState() const {
+VolumeControlState LiquidSolver<D>::volumeControlState() const {
   return {targetVolume_, volumeErrorIntegral_, lastVolumeError_, controlDivergence_, leakRate_, flipVolumeScale_,
-          controlStarted_};
+          controlStarted_ ? 1.0 : 0.0};
 }
 
 template <int D>
@@ -248,7 +248,7 @@ void LiquidSolver<D>::restoreVolumeControl(const VolumeControlState& state) {
   controlDivergence_ = state.divergence;
   leakRate_ = state.leakRate;
   flipVolumeScale_ = state.flipScale;
-  controlStarted_ = state.started;
+  controlStarted_ = state.started != 0.0;
 }
 
 template <int D>

@@ -119,6 +119,14 @@ struct LiquidStatistics {
   long step = 0;
 };
 
+// Volume control's state: its target, the PI controller's integral, last error and output, the
+// leak estimate and FLIP's volume per particle (all [m^3], 1, 1/s or ratios), and whether it has
+// measured yet (1 or 0).
+struct VolumeControlState {
+  double target = 0.0, errorIntegral = 0.0, lastError = 0.0, divergence = 0.0, leakRate = 0.0, flipScale = 0.0;
+  double started = 0.0;
+};
+
 template <int D>
 class LiquidSolver {
  public:
@@ -150,13 +158,8 @@ class LiquidSolver {
   // saved particles first (levelSetParticles() / flipParticles()); a particle level set left
   // empty is seeded afresh from phi. Volume control holds the restored volume from then on.
   void restore(const Grid<float, D>& phi, const MacGrid<D>& velocity, long steps);
-  // Volume control's state: its target, the PI controller's integral and last error and output,
-  // the leak estimate, FLIP's volume per particle. A resumed run that restores it after restore()
-  // holds the volume the uninterrupted run holds, not the one its saved surface had.
-  struct VolumeControlState {
-    double target = 0.0, errorIntegral = 0.0, lastError = 0.0, divergence = 0.0, leakRate = 0.0, flipScale = 0.0;
-    bool started = false;
-  };
+  // Volume control's state; a resumed run that restores it after restore() holds the volume the
+  // uninterrupted run holds, not the one its saved surface had.
   VolumeControlState volumeControlState() const;
   void restoreVolumeControl(const VolumeControlState& state);
 

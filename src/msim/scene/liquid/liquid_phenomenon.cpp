@@ -1,9 +1,11 @@
 #include "msim/scene/liquid/liquid_phenomenon.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -40,6 +42,16 @@ constexpr const char* kSimulationPhi = "liquid_sim_phi";  // with turbulence: th
 constexpr const char* kLevelSetParticles = "level_set_particles";
 constexpr const char* kFlipParticles = "flip_particles";
 constexpr const char* kVortexPoints = "vortex_particles";
+// Volume control's state among the frame's numbers (--resume continues it): each one's name.
+constexpr std::array<std::pair<const char*, double fluid::VolumeControlState::*>, 7> kVolumeControlNumbers = {{
+    {"volume_control_target", &fluid::VolumeControlState::target},
+    {"volume_control_integral", &fluid::VolumeControlState::errorIntegral},
+    {"volume_control_last_error", &fluid::VolumeControlState::lastError},
+    {"volume_control_divergence", &fluid::VolumeControlState::divergence},
+    {"volume_control_leak_rate", &fluid::VolumeControlState::leakRate},
+    {"volume_control_flip_scale", &fluid::VolumeControlState::flipScale},
+    {"volume_control_started", &fluid::VolumeControlState::started},
+}};
 
 void declareLiquid(Schema& root) {
   Schema liquid = Schema::object("the liquid and how its surface is tracked (docs/liquid.md)");
@@ -283,14 +295,8 @@ class LiquidPhenomenon final : public Phenomenon {
     if (solver_.vortexLayer())
       writer.addPoints(kVortexPoints, vortexParticleCloud(solver_.vortexLayer()->particles()), solver_.spec().dx);
     // Volume control's state, the same on every process (it works on the summed volume).
-    const typename fluid::LiquidSolver<D>::VolumeControlState control = solver_.volumeControlState();
-    writer.addNumber("volume_control_target", control.target);
-    writer.addNumber("volume_control_integral", control.errorIntegral);
-    writer.addNumber("volume_control_last_error", control.lastError);
-    writer.addNumber("volume_control_divergence", control.divergence);
-    writer.addNumber("volume_control_leak_rate", control.leakRate);
-    writer.addNumber("volume_control_flip_scale", control.flipScale);
-    writer.addNumber("volume_control_started", control.started ? 1.0 : 0.0);
+    const fluid::VolumeControlState control = solver_.volumeControlState();
+    for (const auto& [name, member] : kVolumeControlNumbers) writer.addNumber(name, control.*member);
   }
 
   // The surface as a triangle mesh (3D): mesh/<name>_NNNN.ply and/or .obj (liquid.mesh_format);
@@ -361,11 +367,9 @@ class LiquidPhenomenon final : public Phenomenon {
       solver_.levelSetParticles().assign(std::move(positions), radius, std::move(signs));
     }
     solver_.restore(phi, velocity, steps);  // the reseeding keeps its phase
-    if (saved.hasNumber("volume_control_target"))
-      solver_.restoreVolumeControl({saved.number("volume_control_target"), saved.number("volume_control_integral"),
-                                    saved.number("volume_control_last_error"), saved.number("volume_control_divergence"),
-                                    saved.number("volume_control_leak_rate"), saved.number("volume_control_flip_scale"),
-                                    saved.number("volume_control_started") != 0.0});
+    fluid::VolumeControlState control;
+    for (const auto& [name, member] : kVolumeControlNumbers) control.*member = saved.number(name);
+    solver_.restoreVolumeControl(control);
     solver_.setTime(time);
     if (fluid::VortexLayer<D>* layer = solver_.vortexLayer())
       restoreVortexParticles(saved, kVortexPoints, *layer, source_);
