@@ -137,8 +137,6 @@ std::string readFileBytes(const std::filesystem::path& path) {
   return bytes;
 }
 
-// Parses every grid of the file's bytes. The stream throws at the end of the data, so a count
-// read from a damaged file cannot make OpenVDB loop on past it.
 // The file metadata key of a number added with VdbWriter::addNumber.
 std::string numberKey(const std::string& name) { return "msim_state_" + name; }
 
@@ -148,6 +146,8 @@ struct ParsedVdb {
   openvdb::MetaMap::Ptr metadata;
 };
 
+// Parses every grid of the file's bytes, and the file's metadata. The stream throws at the end of
+// the data, so a count read from a damaged file cannot make OpenVDB loop on past it.
 ParsedVdb parseGrids(std::string bytes, const std::filesystem::path& path) {
   initializeOpenVdb();
   try {

@@ -247,8 +247,8 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
       for (const json& f : record.frames()) resumedSteps += f.value("substeps", 0L);
       resumedSteps = parallel::fromRankZero(resumedSteps);
       if (writesFiles && record.frames().size() != static_cast<std::size_t>(done))
-        logger().warn("{}: run.json does not hold the {} frames written: the step count restarts at {} (what happens "
-                      "every so many steps, such as a liquid's reseeding, shifts)",
+        logger().warn("{}: run.json does not hold the {} frames written: the step count goes on from {}, the steps of "
+                      "those it holds (what happens every so many steps, such as a liquid's reseeding, shifts)",
                       layout.root.string(), done, resumedSteps);
       phenomenon->restore(frameFile(layout.vdbDir, layout.name, done, "vdb"), done / scene.fps, resumedSteps);
       if (layout.vdbOptions.halfFloat || layout.vdbOptions.fogTolerance > 0.0f)
