@@ -201,8 +201,9 @@ int main(int argc, char** argv) {
                   s.frameCount, runOptions.outDir.string());
     const scene::RunStatus status = scene::runScene(s, runOptions);
     if (status == scene::RunStatus::Interrupted) {
-      logger().warn("interrupted; the frames written are complete. Continue with: msim run {} --out {} --resume",
-                    scenePath, runOptions.outDir.string());
+      const int ranks = parallel::worldSize();
+      logger().warn("interrupted; the frames written are complete. Continue with: {}msim run {} --out {} --resume",
+                    ranks > 1 ? fmt::format("mpirun -np {} ", ranks) : "", scenePath, runOptions.outDir.string());
       return kExitInterrupted;
     }
     logger().info("done: {}", runOptions.outDir.string());

@@ -166,46 +166,50 @@ TEST(Cli, ResumeContinuesBitExactly) {
 }
 
 TEST(Cli, InterruptFinishesTheFrameAndStops) {
-  const fs::path dir = scratch("interrupt");
-  writeText(dir / "s.json", tinyScene("", 40));
-  const fs::path out = dir / "out";
-  const std::string scene = (dir / "s.json").string(), outDir = out.string();
-  const pid_t child = fork();
-  ASSERT_GE(child, 0);
-  if (child == 0) {
-    const int devnull = open("/dev/null", O_WRONLY);
-    dup2(devnull, STDOUT_FILENO);
-    dup2(devnull, STDERR_FILENO);
-    execl(MSIM_APP_PATH, MSIM_APP_PATH, "run", scene.c_str(), "--out", outDir.c_str(), "--set", "time.duration=30",
-          static_cast<char*>(nullptr));
-    _exit(127);
+  // Ctrl-C (SIGINT), and SIGUSR1, which mpirun forwards to its processes where Ctrl-C would end the
+  // whole job at once.
+  for (const int signal : {SIGINT, SIGUSR1}) {
+    const fs::path dir = scratch("interrupt_" + std::to_string(signal));
+    writeText(dir / "s.json", tinyScene("", 40));
+    const fs::path out = dir / "out";
+    const std::string scene = (dir / "s.json").string(), outDir = out.string();
+    const pid_t child = fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      const int devnull = open("/dev/null", O_WRONLY);
+      dup2(devnull, STDOUT_FILENO);
+      dup2(devnull, STDERR_FILENO);
+      execl(MSIM_APP_PATH, MSIM_APP_PATH, "run", scene.c_str(), "--out", outDir.c_str(), "--set", "time.duration=30",
+            static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (!fs::exists(out / "vdb" / "tiny_0002.vdb") && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    kill(child, signal);
+    int status = 0;
+    waitpid(child, &status, 0);
+    ASSERT_TRUE(WIFEXITED(status)) << signal;
+    EXPECT_EQ(WEXITSTATUS(status), 130) << signal;
+    // Every frame written is complete (both files), numbered without gaps, and no temporary is left.
+    int frames = 0;
+    while (fs::exists(out / "vdb" / ("tiny_" + std::string(4 - std::to_string(frames + 1).size(), '0') +
+                                     std::to_string(frames + 1) + ".vdb")))
+      ++frames;
+    EXPECT_GE(frames, 2);
+    EXPECT_LT(frames, 240);
+    std::size_t files = 0;
+    for (const auto& e : fs::recursive_directory_iterator(out)) {
+      const std::string name = e.path().filename().string();
+      EXPECT_EQ(name.find(".tmp-"), std::string::npos) << name;
+      if (e.path().extension() == ".vdb" || e.path().extension() == ".png") ++files;
+    }
+    EXPECT_EQ(files, 2u * frames);
+    std::ifstream run(out / "run.json");
+    std::stringstream text;
+    text << run.rdbuf();
+    EXPECT_NE(text.str().find("\"status\": \"interrupted\""), std::string::npos) << signal;
   }
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  while (!fs::exists(out / "vdb" / "tiny_0002.vdb") && std::chrono::steady_clock::now() < deadline)
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  kill(child, SIGINT);
-  int status = 0;
-  waitpid(child, &status, 0);
-  ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 130);
-  // Every frame written is complete (both files), numbered without gaps, and no temporary is left.
-  int frames = 0;
-  while (fs::exists(out / "vdb" / ("tiny_" + std::string(4 - std::to_string(frames + 1).size(), '0') +
-                                   std::to_string(frames + 1) + ".vdb")))
-    ++frames;
-  EXPECT_GE(frames, 2);
-  EXPECT_LT(frames, 240);
-  std::size_t files = 0;
-  for (const auto& e : fs::recursive_directory_iterator(out)) {
-    const std::string name = e.path().filename().string();
-    EXPECT_EQ(name.find(".tmp-"), std::string::npos) << name;
-    if (e.path().extension() == ".vdb" || e.path().extension() == ".png") ++files;
-  }
-  EXPECT_EQ(files, 2u * frames);
-  std::ifstream run(out / "run.json");
-  std::stringstream text;
-  text << run.rdbuf();
-  EXPECT_NE(text.str().find("\"status\": \"interrupted\""), std::string::npos);
 }
 
 TEST(Cli, TurbulentWindResumesBitExactly) {

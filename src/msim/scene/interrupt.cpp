@@ -18,6 +18,9 @@ extern "C" void onSignal(int signal) {
 void installInterruptHandler() {
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
+  // Under mpirun, Ctrl-C ends the whole job at once; mpirun forwards SIGUSR1 to every process, so
+  // it is the way to stop a split run after its frame (kill -USR1 on mpirun's process).
+  std::signal(SIGUSR1, onSignal);
 }
 
 bool interruptRequested() { return gInterrupted.load(); }

@@ -1,6 +1,7 @@
 #pragma once
-// Ctrl-C (SIGINT) and SIGTERM ask the run to stop: the time loop finishes the frame file it is
-// writing, records the run as interrupted and exits; nothing half-written is left behind.
+// Ctrl-C (SIGINT), SIGTERM and SIGUSR1 (which mpirun forwards to its processes) ask the run to
+// stop: the time loop finishes the frame file it is writing, records the run as interrupted and
+// exits; nothing half-written is left behind.
 // A second signal terminates at once (still no half-written frame: files are renamed into place).
 namespace msim::scene {
 
