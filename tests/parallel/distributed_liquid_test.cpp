@@ -25,7 +25,8 @@ namespace {
 
 using testing::fromRoot;
 using testing::sendToRoot;
-using testing::serialReferenceRank;
+using testing::referenceRuns;
+using testing::References;
 using testing::worldRank;
 using testing::worldSize;
 
@@ -157,25 +158,18 @@ TEST_P(DistributedLiquid, DamBreakFollowsTheOneRankRun) {
   const auto [extra, extraLayers] = GetParam();
   // The rock on 8 ranks (blocks touching at corners), the others on 2.
   if (worldSize() != (extra == Extra::Rock ? 8 : 2)) GTEST_SKIP() << "run on 2 ranks (the rock on 8)";
-  MPI_Comm alone;
-  MPI_Comm_split(MPI_COMM_WORLD, worldRank() == 0 ? 0 : MPI_UNDEFINED, 0, &alone);
-  // The one-rank run on rank 0 and, at the same time, the serial solver on the last rank.
-  std::optional<LiquidRun> one, serial;
-  if (worldRank() == 0) {
-    one = runSplit(alone, extra);
-    MPI_Comm_free(&alone);
-  }
-  const int serialRank = serialReferenceRank();
-  if (worldRank() == serialRank) serial = runDamBreak(kGlobal, nullptr, extra);
-  else if (worldRank() == 0) serial = LiquidRun{Grid<float, 3>(kGlobal)};
-  if (serial) {
-    sendToRoot(serial->phi.data(), serialRank);
-    std::vector<double> numbers = {serial->volume, serial->targetVolume, double(serial->vortexParticles)};
-    sendToRoot(numbers, serialRank);
-    serial->volume = numbers[0];
-    serial->targetVolume = numbers[1];
-    serial->vortexParticles = static_cast<std::size_t>(numbers[2]);
-  }
+  const References<LiquidRun> ref = referenceRuns(
+      [&](MPI_Comm alone) { return runSplit(alone, extra); }, [&] { return runDamBreak(kGlobal, nullptr, extra); },
+      LiquidRun{Grid<float, 3>(kGlobal)}, [](LiquidRun& run, int from) {
+        sendToRoot(run.phi.data(), from);
+        std::vector<double> numbers = {run.volume, run.targetVolume, double(run.vortexParticles)};
+        sendToRoot(numbers, from);
+        run.volume = numbers[0];
+        run.targetVolume = numbers[1];
+        run.vortexParticles = static_cast<std::size_t>(numbers[2]);
+      });
+  const auto& one = ref.one;
+  const auto& serial = ref.serial;
   const LiquidRun split = runSplit(MPI_COMM_WORLD, extra, extraLayers);
   EXPECT_EQ(split.strayParticles, 0);
   EXPECT_EQ(split.particlesLost, 0);

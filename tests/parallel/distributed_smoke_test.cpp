@@ -23,7 +23,8 @@ namespace {
 
 using testing::fromRoot;
 using testing::sendToRoot;
-using testing::serialReferenceRank;
+using testing::referenceRuns;
+using testing::References;
 using testing::worldRank;
 using testing::worldSize;
 
@@ -168,19 +169,12 @@ TEST_P(DistributedSmoke, FiftyStepsMatchOneRankWithin1e4Relative) {
   // The implicit viscosity's CG reads a 7-point stencil: face neighbours only, which one cut holds
   // (on 8 oversubscribed ranks its hundreds of exchanges took a fifth of the MPI tests' time).
   if (variant == Variant::Viscous && worldSize() != 2) GTEST_SKIP() << "run on 2 ranks";
-  // The one-rank run on rank 0 alone and, at the same time, the serial solver on the last rank;
-  // then the split run on every rank.
-  MPI_Comm alone;
-  MPI_Comm_split(MPI_COMM_WORLD, worldRank() == 0 ? 0 : MPI_UNDEFINED, 0, &alone);
-  std::optional<Grid<float, 3>> one, serial;
-  if (worldRank() == 0) {
-    one = runSplit(alone, variant);
-    MPI_Comm_free(&alone);
-  }
-  const int serialRank = serialReferenceRank();
-  if (worldRank() == serialRank) serial = runPlume(kGlobal, nullptr, variant);
-  else if (worldRank() == 0) serial = Grid<float, 3>(kGlobal);
-  if (serial) sendToRoot(serial->data(), serialRank);
+  // The one-rank run and the serial solver's, then the split run on every rank.
+  const References<Grid<float, 3>> ref = referenceRuns(
+      [&](MPI_Comm alone) { return runSplit(alone, variant); }, [&] { return runPlume(kGlobal, nullptr, variant); },
+      Grid<float, 3>(kGlobal), [](Grid<float, 3>& g, int from) { sendToRoot(g.data(), from); });
+  const auto& one = ref.one;
+  const auto& serial = ref.serial;
   const Grid<float, 3> split = runSplit(MPI_COMM_WORLD, variant);
   bool ok = true;
   if (worldRank() == 0) {

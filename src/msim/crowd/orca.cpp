@@ -228,22 +228,23 @@ void OrcaSolver::computeVelocities(const Agents& agents, const StaticObstacles& 
                 // within a block, so each is tested again.
                 for (std::uint32_t block = 0; block < padded; block += kBlock) {
                   std::uint32_t below = 0;
-                  for (std::uint32_t b = 0; b < kBlock; ++b) below |= static_cast<std::uint32_t>(d2[block + b] <= threshold) << b;
+                  for (std::uint32_t b = 0; b < kBlock; ++b)
+                    below |= static_cast<std::uint32_t>(d2[block + b] <= threshold) << b;
                   for (; below != 0; below &= below - 1) {
-                  const std::uint32_t m = block + static_cast<std::uint32_t>(std::countr_zero(below));
-                  if (d2[m] > threshold) continue;
-                  const std::uint32_t j = lo + m;
-                  if (d2[m] >= range2 || j == k) continue;
-                  const Neighbour entry{d2[m], order[j], j};
-                  if (s.nearest.size() == maxNeighbours) {
-                    if (!closer(entry, s.nearest.back())) continue;
-                    s.nearest.back() = entry;
-                  } else {
-                    s.nearest.push_back(entry);
-                  }
-                  for (std::size_t at = s.nearest.size() - 1; at > 0 && closer(s.nearest[at], s.nearest[at - 1]); --at)
-                    std::swap(s.nearest[at], s.nearest[at - 1]);
-                  if (s.nearest.size() == maxNeighbours) threshold = s.nearest.back().d2;
+                    const std::uint32_t m = block + static_cast<std::uint32_t>(std::countr_zero(below));
+                    if (d2[m] > threshold) continue;
+                    const std::uint32_t j = lo + m;
+                    if (d2[m] >= range2 || j == k) continue;
+                    const Neighbour entry{d2[m], order[j], j};
+                    if (s.nearest.size() == maxNeighbours) {
+                      if (!closer(entry, s.nearest.back())) continue;
+                      s.nearest.back() = entry;
+                    } else {
+                      s.nearest.push_back(entry);
+                    }
+                    for (std::size_t at = s.nearest.size() - 1; at > 0 && closer(s.nearest[at], s.nearest[at - 1]); --at)
+                      std::swap(s.nearest[at], s.nearest[at - 1]);
+                    if (s.nearest.size() == maxNeighbours) threshold = s.nearest.back().d2;
                   }
                 }
               }

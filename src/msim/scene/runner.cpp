@@ -241,10 +241,12 @@ RunStatus runScene(const Scene& scene, const RunOptions& options) {
     while (done < lastFrame && frameComplete(layout, done + 1)) ++done;
     if (done > 0) {
       ScopedStage stage(timers, "resume: read frame");
-      // The steps taken so far: the substeps of the frames the run's record holds (rank 0's
-      // reading, so that every rank keeps the same count).
-      record.adoptPreviousFrames(done);
-      for (const json& f : record.frames()) resumedSteps += f.value("substeps", 0L);
+      // The steps taken so far: the substeps of the frames the run's record holds (rank 0 keeps
+      // the record and reads it; every rank takes its count).
+      if (writesFiles) {
+        record.adoptPreviousFrames(done);
+        for (const json& f : record.frames()) resumedSteps += f.value("substeps", 0L);
+      }
       resumedSteps = parallel::fromRankZero(resumedSteps);
       if (writesFiles && record.frames().size() != static_cast<std::size_t>(done))
         logger().warn("{}: run.json does not hold the {} frames written: the step count goes on from {}, the steps of "

@@ -195,7 +195,7 @@ double LiquidSolver<D>::editLevelSet(const Grid<float, D>& region, Edit&& edit) 
   parallelFor(0, phi_.count(), edit);
   particles_.removeInside(region);
   const double change = liquidVolume() - before;
-  targetVolume_ = std::max(0.0, targetVolume_ + change);
+  control_.target = std::max(0.0, control_.target + change);
   return change;
 }
 
@@ -229,26 +229,8 @@ double LiquidSolver<D>::liquidVolume() const {
 
 template <int D>
 void LiquidSolver<D>::resetVolumeControl() {
-  targetVolume_ = liquidVolume();
-  volumeErrorIntegral_ = leakRate_ = flipVolumeScale_ = 0.0;
-  controlStarted_ = false;
-}
-
-template <int D>
-VolumeControlState LiquidSolver<D>::volumeControlState() const {
-  return {targetVolume_, volumeErrorIntegral_, lastVolumeError_, controlDivergence_, leakRate_, flipVolumeScale_,
-          controlStarted_ ? 1.0 : 0.0};
-}
-
-template <int D>
-void LiquidSolver<D>::restoreVolumeControl(const VolumeControlState& state) {
-  targetVolume_ = state.target;
-  volumeErrorIntegral_ = state.errorIntegral;
-  lastVolumeError_ = state.lastError;
-  controlDivergence_ = state.divergence;
-  leakRate_ = state.leakRate;
-  flipVolumeScale_ = state.flipScale;
-  controlStarted_ = state.started != 0.0;
+  control_ = VolumeControlState{};
+  control_.target = liquidVolume();
 }
 
 template <int D>
@@ -322,20 +304,20 @@ double LiquidSolver<D>::volumeControlDivergence(double dt) {
     // bias; holding the particles' own volume instead would move still water). Emitters, sinks
     // and open sides change the count.
     const double particleVolume = flipVolume(flip_.size());
-    if (flipVolumeScale_ == 0.0 && particleVolume > 0.0) flipVolumeScale_ = volume / particleVolume;
-    targetVolume_ = particleVolume * flipVolumeScale_;
+    if (control_.flipScale == 0.0 && particleVolume > 0.0) control_.flipScale = volume / particleVolume;
+    control_.target = particleVolume * control_.flipScale;
   }
-  if (!(targetVolume_ > 0.0)) return 0.0;
-  const double x = volume / targetVolume_ - 1.0;
-  volumeErrorIntegral_ += x * dt;
+  if (!(control_.target > 0.0)) return 0.0;
+  const double x = volume / control_.target - 1.0;
+  control_.errorIntegral += x * dt;
   // The rate at which the surface lost volume in this step beyond what the last control asked
   // for (a splash hitting a wall loses several percent in a few steps, faster than the PI gains
   // follow): fed forward so that it is cancelled at once.
   double leak = 0.0;
-  if (controlStarted_) leak = (x - lastVolumeError_) / dt - (lastVolumeError_ + 1.0) * controlDivergence_;
-  leakRate_ += 0.5 * (leak - leakRate_);
-  lastVolumeError_ = x;
-  controlStarted_ = true;
+  if (control_.started) leak = (x - control_.lastError) / dt - (control_.lastError + 1.0) * control_.divergence;
+  control_.leakRate += 0.5 * (leak - control_.leakRate);
+  control_.lastError = x;
+  control_.started = true;
   // Kim et al. (2007) choose the gains so that an error decays, overdamped, within about 25 steps
   // (k_i = (k_p / 4.4)^2); a dam break's splashes need it faster (volumeControlSteps).
   const double kp = 2.3 / (params_.volumeControlSteps * dt), ki = (kp / 4.4) * (kp / 4.4);
@@ -343,7 +325,7 @@ double LiquidSolver<D>::volumeControlDivergence(double dt) {
   // the grid's reach) must not turn into a blast, and a bound that grew as the step shrinks would
   // feed itself (faster flow, shorter steps, a larger divergence allowed).
   const double limit = std::min(0.02 / dt, 3.0);
-  return std::clamp(-(kp * x + ki * volumeErrorIntegral_ + leakRate_) / (x + 1.0), -limit, limit);
+  return std::clamp(-(kp * x + ki * control_.errorIntegral + control_.leakRate) / (x + 1.0), -limit, limit);
 }
 
 template <int D>
@@ -481,7 +463,7 @@ void LiquidSolver<D>::step(double dt) {
   if (!(dt > 0.0) || !std::isfinite(dt)) throw std::invalid_argument(fmt::format("liquid solver: step of {} s", dt));
   if (!started_) start();
   const bool flip = params_.tracker == InterfaceTracker::Flip;
-  if (params_.volumeControl && !flip) targetVolume_ = std::max(0.0, targetVolume_ - boundaryOutflow(dt));
+  if (params_.volumeControl && !flip) control_.target = std::max(0.0, control_.target - boundaryOutflow(dt));
   if (flip) {
     moveFlipSurface(dt);
     {
@@ -518,18 +500,18 @@ void LiquidSolver<D>::step(double dt) {
       pressurePhi_[i] = solid_[i] > 0.5f ? std::max(phi_[i], static_cast<float>(0.5 * spec_.dx)) : phi_[i];
     });
     volume_ = liquidVolume();  // phi is final for this step from here on
-    controlDivergence_ = volumeControlDivergence(dt);
+    control_.divergence = volumeControlDivergence(dt);
     applyWallInflow();
     if (split_) {
       split_->setFreeSurface(pressurePhi_);
-      split_->setTargetDivergence(controlDivergence_);
+      split_->setTargetDivergence(control_.divergence);
       const SplitSolveStats solve = split_->project(velocity_, projection_.pressure(), dt, params_.density);
       lastSolve_.iterations = solve.iterations;
       lastSolve_.relativeResidual = solve.relativeResidual;
       lastSolve_.converged = solve.converged;
     } else {
       projection_.setFreeSurface(pressurePhi_);
-      projection_.setTargetDivergence(controlDivergence_);
+      projection_.setTargetDivergence(control_.divergence);
       lastSolve_ = projection_.project(velocity_, dt, params_.density);
     }
   }
@@ -584,8 +566,8 @@ LiquidStatistics LiquidSolver<D>::statistics() const {
   // A split run sums over the processes' own cells and particles (every process calls this).
   LiquidStatistics s;
   s.volume = liquidVolume();
-  s.targetVolume = targetVolume_;
-  s.controlDivergence = controlDivergence_;
+  s.targetVolume = control_.target;
+  s.controlDivergence = control_.divergence;
   for (int a = 0; a < D; ++a) {
     const auto& u = velocity_.component(a);
     s.maxSpeed = std::max(s.maxSpeed, parallelMax(u.count(), [&](std::size_t i) {

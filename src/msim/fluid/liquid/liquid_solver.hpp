@@ -119,12 +119,13 @@ struct LiquidStatistics {
   long step = 0;
 };
 
-// Volume control's state: its target, the PI controller's integral, last error and output, the
-// leak estimate and FLIP's volume per particle (all [m^3], 1, 1/s or ratios), and whether it has
-// measured yet (1 or 0).
+// Volume control's state: what it holds the volume to [m^3], the PI controller's integral of the
+// relative error [s] and its last error, its last output (a target divergence [1/s]), the leak
+// estimate [1/s], FLIP's rebuilt-surface volume per particle volume (0: not measured yet), and
+// whether it has measured yet.
 struct VolumeControlState {
   double target = 0.0, errorIntegral = 0.0, lastError = 0.0, divergence = 0.0, leakRate = 0.0, flipScale = 0.0;
-  double started = 0.0;
+  bool started = false;
 };
 
 template <int D>
@@ -156,12 +157,13 @@ class LiquidSolver {
 
   // A saved state (--resume): phi, the face velocities and the number of steps taken. Assign the
   // saved particles first (levelSetParticles() / flipParticles()); a particle level set left
-  // empty is seeded afresh from phi. Volume control holds the restored volume from then on.
+  // empty is seeded afresh from phi. Volume control holds the restored volume from then on,
+  // unless its saved state is restored after (restoreVolumeControl).
   void restore(const Grid<float, D>& phi, const MacGrid<D>& velocity, long steps);
   // Volume control's state; a resumed run that restores it after restore() holds the volume the
   // uninterrupted run holds, not the one its saved surface had.
-  VolumeControlState volumeControlState() const;
-  void restoreVolumeControl(const VolumeControlState& state);
+  const VolumeControlState& volumeControl() const { return control_; }
+  void restoreVolumeControl(const VolumeControlState& state) { control_ = state; }
 
   // Largest step with (max speed + sqrt(|g| dx)) dt <= cfl dx: the gravity term keeps a liquid at
   // rest from taking an unbounded first step.
@@ -278,10 +280,7 @@ class LiquidSolver {
   numerics::PcgStats lastSolve_;
   std::size_t lastEscaped_ = 0;
   double volume_ = 0.0;
-  double targetVolume_ = 0.0, volumeErrorIntegral_ = 0.0, controlDivergence_ = 0.0;
-  double lastVolumeError_ = 0.0, leakRate_ = 0.0;
-  double flipVolumeScale_ = 0.0;  // FLIP: rebuilt surface volume per particle volume (0: not yet seen)
-  bool controlStarted_ = false;
+  VolumeControlState control_;
   bool started_ = false;
   long steps_ = 0;
   std::uint64_t emissions_ = 0;  // emit() calls so far (new random streams each)

@@ -42,15 +42,15 @@ constexpr const char* kSimulationPhi = "liquid_sim_phi";  // with turbulence: th
 constexpr const char* kLevelSetParticles = "level_set_particles";
 constexpr const char* kFlipParticles = "flip_particles";
 constexpr const char* kVortexPoints = "vortex_particles";
-// Volume control's state among the frame's numbers (--resume continues it): each one's name.
-constexpr std::array<std::pair<const char*, double fluid::VolumeControlState::*>, 7> kVolumeControlNumbers = {{
+// Volume control's state among the frame's numbers (--resume continues it): each one's name, and
+// "volume_control_started" (1 or 0).
+constexpr std::array<std::pair<const char*, double fluid::VolumeControlState::*>, 6> kVolumeControlNumbers = {{
     {"volume_control_target", &fluid::VolumeControlState::target},
     {"volume_control_integral", &fluid::VolumeControlState::errorIntegral},
     {"volume_control_last_error", &fluid::VolumeControlState::lastError},
     {"volume_control_divergence", &fluid::VolumeControlState::divergence},
     {"volume_control_leak_rate", &fluid::VolumeControlState::leakRate},
     {"volume_control_flip_scale", &fluid::VolumeControlState::flipScale},
-    {"volume_control_started", &fluid::VolumeControlState::started},
 }};
 
 void declareLiquid(Schema& root) {
@@ -295,8 +295,9 @@ class LiquidPhenomenon final : public Phenomenon {
     if (solver_.vortexLayer())
       writer.addPoints(kVortexPoints, vortexParticleCloud(solver_.vortexLayer()->particles()), solver_.spec().dx);
     // Volume control's state, the same on every process (it works on the summed volume).
-    const fluid::VolumeControlState control = solver_.volumeControlState();
+    const fluid::VolumeControlState& control = solver_.volumeControl();
     for (const auto& [name, member] : kVolumeControlNumbers) writer.addNumber(name, control.*member);
+    writer.addNumber("volume_control_started", control.started ? 1.0 : 0.0);
   }
 
   // The surface as a triangle mesh (3D): mesh/<name>_NNNN.ply and/or .obj (liquid.mesh_format);
@@ -331,8 +332,9 @@ class LiquidPhenomenon final : public Phenomenon {
   }
 
   // The resumed run continues from the saved surface, velocity and particles, volume control's
-  // state, and the step count (the reseeding keeps its phase); the pressure's warm start is not
-  // saved, so it is close to but not bit-equal with an uninterrupted run.
+  // state, and the step count (the reseeding keeps its phase). FLIP resumes bit for bit; the
+  // marker particles' positions and radii are saved in single precision (kept in double), so a
+  // particle level set resumes to round-off.
   void restore(const std::filesystem::path& vdbFile, double time, long steps) override {
     time_ = time;
     if (obstacles_.moving()) placeObstacles(time);
@@ -369,6 +371,7 @@ class LiquidPhenomenon final : public Phenomenon {
     solver_.restore(phi, velocity, steps);  // the reseeding keeps its phase
     fluid::VolumeControlState control;
     for (const auto& [name, member] : kVolumeControlNumbers) control.*member = saved.number(name);
+    control.started = saved.number("volume_control_started") != 0.0;
     solver_.restoreVolumeControl(control);
     solver_.setTime(time);
     if (fluid::VortexLayer<D>* layer = solver_.vortexLayer())
