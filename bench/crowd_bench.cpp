@@ -149,7 +149,7 @@ void BM_StressMerge6800(benchmark::State& state) {
 }  // namespace
 
 BENCHMARK(BM_StressMerge)->Unit(benchmark::kMillisecond)->Iterations(100);
-BENCHMARK(BM_StressMerge6800)->DenseRange(1, 2)->Unit(benchmark::kMillisecond)->Iterations(20);
+BENCHMARK(BM_StressMerge6800)->DenseRange(1, 2)->Unit(benchmark::kMillisecond)->Iterations(100);
 BENCHMARK(BM_LookaheadFourWay)->DenseRange(0, 5)->Unit(benchmark::kMillisecond)->Iterations(100);
 BENCHMARK(BM_LookaheadFourGroups)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->Iterations(200);
 BENCHMARK(BM_LookaheadCircle100k)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->Iterations(1);

@@ -128,25 +128,17 @@ class BoundQpSolver {
                       QpFacePreconditioner* preconditioner = nullptr);
 
  private:
-  // lower/upper null: p >= 0.
+  // lower and upper both null: p >= 0.
   BoundQpResult solveBox(const QpOperator& A, const Eigen::VectorXd& b, const Eigen::VectorXd* lower,
                          const Eigen::VectorXd* upper, Eigen::VectorXd& p, const BoundQpSettings& settings,
                          QpFacePreconditioner* preconditioner);
-  void setFace(const Eigen::VectorXd& p, QpFacePreconditioner* preconditioner);
-  double chopped(Eigen::Index i, double pi, double gi) const;
-  void precondition(QpFacePreconditioner* preconditioner);  // z_ from g_ on the current face
-  // z_i without a face preconditioner: Jacobi (or none) on the face, 0 off it. For a diagonal M,
-  // M_FF^{-1} = (M^{-1})_FF, so it needs no refactoring when the face changes.
-  double diagonallyPreconditioned(Eigen::Index i) const {
-    return free_[static_cast<std::size_t>(i)] ? (jacobi_ ? g_[i] * invDiagonal_[i] : g_[i]) : 0.0;
-  }
+  void setFace(const Eigen::VectorXd& p, QpFacePreconditioner& preconditioner);  // free_ from p
   double dot(const Eigen::VectorXd& x, const Eigen::VectorXd& y);  // blocked, deterministic
 
-  bool jacobi_ = false;  // built-in Jacobi (no preconditioner passed, Jacobi requested)
-  const double* lower_ = nullptr;  // bounds of the current solve; null: 0 and +inf
+  bool boxed_ = false;              // the current solve has box bounds (else p >= 0)
+  const double* lower_ = nullptr;  // bounds of the current solve (zeros_, infinities_ for p >= 0)
   const double* upper_ = nullptr;
-  double lo(Eigen::Index i) const { return lower_ ? lower_[i] : 0.0; }
-  double hi(Eigen::Index i) const { return upper_ ? upper_[i] : std::numeric_limits<double>::infinity(); }
+  Eigen::VectorXd zeros_, infinities_;
   std::vector<std::uint8_t> free_;
   Eigen::VectorXd g_, z_, d_, Ad_, invDiagonal_;
   std::vector<double> partial_;  // per-block partial sums of the vector loops

@@ -167,6 +167,50 @@ TEST(CrowdStress, T6AccelerationIsClampedKeepingItsDirection) {
   }
 }
 
+TEST(CrowdStress, DivergenceOfALinearStressIsExactAndItsTransposeIsTheAdjoint) {
+  // 12 x 8 cells of 0.5 m with a covered 2 x 2 block: D of s_d = a x + b y (cell centres),
+  // s_o = c x + e y (corners) is (a + e, c - b) on every open face (central differences are exact
+  // on linear fields) and 0 on the others; and <D s, f> = <s, D^T f> for any s and f, f taken on
+  // the open faces only.
+  const GridSpec<2> spec(Vec2(0.0, 0.0), 0.5, IVec<2>(12, 8));
+  Grid<float, 2> free = allFree(spec);
+  for (int j = 3; j < 5; ++j)
+    for (int i = 5; i < 7; ++i) free(IVec<2>(i, j)) = 0.0f;
+  StressGrid g(spec);
+  g.splat({}, {}, free);
+  const int nx = 12, ny = 8, cells = nx * ny;
+  const double a = 0.7, b = -1.3, c = 2.1, e = 0.4, h = 0.5;
+  Eigen::VectorXd s(cells + (nx + 1) * (ny + 1));
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) s[i + nx * j] = a * (i + 0.5) * h + b * (j + 0.5) * h;
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i) s[cells + i + (nx + 1) * j] = c * i * h + e * j * h;
+  Eigen::VectorXd faces;
+  g.divergence(s, faces);
+  ASSERT_EQ(faces.size(), static_cast<Eigen::Index>(g.faceCount()));
+  const std::size_t xFaces = static_cast<std::size_t>((nx + 1) * ny);
+  int open = 0;
+  for (std::size_t f = 0; f < g.faceCount(); ++f) {
+    const double expected = !g.activeFace(f) ? 0.0 : f < xFaces ? a + e : c - b;
+    EXPECT_NEAR(faces[static_cast<Eigen::Index>(f)], expected, 1e-12) << "face " << f;
+    open += g.activeFace(f) ? 1 : 0;
+  }
+  EXPECT_EQ(open, (nx - 1) * ny + nx * (ny - 1) - 12);  // the block closes 6 x faces and 6 y faces
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 5; ++trial) {
+    for (Eigen::Index k = 0; k < s.size(); ++k) s[k] = u(rng);
+    Eigen::VectorXd f(faces.size()), openF(faces.size()), back;
+    for (Eigen::Index k = 0; k < f.size(); ++k) {
+      f[k] = u(rng);
+      openF[k] = g.activeFace(static_cast<std::size_t>(k)) ? f[k] : 0.0;
+    }
+    g.divergence(s, faces);
+    g.divergenceTranspose(f, back);
+    EXPECT_NEAR(faces.dot(openF), s.dot(back), 1e-12 * (1.0 + std::abs(s.dot(back)))) << trial;
+  }
+}
+
 TEST(CrowdStress, T7T8FrictionStaysInItsBoxAndDissipates) {
   // A crowd just past the critical density (4.3 /m^2 on a 0.48 m lattice, alpha = 0.3) in a
   // 12 x 12 m box with random velocities: the solve converges, every stress lies within its bound,

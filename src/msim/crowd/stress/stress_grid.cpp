@@ -14,8 +14,8 @@ namespace {
 constexpr float kCovered = 1e-6f;
 constexpr double kSmallestFree = 0.05;
 
-// A = scale D^T D + diag(extra), applied without assembling D^T D (rebuilding that product cost
-// more than the solve). The unknowns with an extra diagonal couple to nothing, so its norm is the
+// A = scale D^T D + diag(extra), applied as D then D^T on the grid (StressGrid::divergence and
+// divergenceTranspose). The unknowns with an extra diagonal couple to nothing, so its norm is the
 // larger of the two blocks'. |D^T D| <= 8 / h^2: D's rows on this grid are rows of D on a periodic
 // grid around it, applied to the unknowns extended by zeros, where D's symbol takes (s_d, s_o) to
 // (a s_d + b s_o, a s_o - b s_d) with a, b = 2i sin(theta / 2) / h along x and y, whose square is
@@ -24,28 +24,26 @@ constexpr double kSmallestFree = 0.05;
 // longer).
 class FrictionOperator final : public numerics::QpOperator {
  public:
-  FrictionOperator(const Eigen::SparseMatrix<double>& d, const Eigen::SparseMatrix<double>& dt, double scale,
-                   const Eigen::VectorXd& diagonal, double normBound, Eigen::VectorXd& scratch)
-      : d_(d), dt_(dt), scale_(scale), diagonal_(diagonal), normBound_(normBound), faces_(scratch) {}
-  Eigen::Index size() const override { return d_.cols(); }
+  FrictionOperator(const StressGrid& grid, double scale, const Eigen::VectorXd& diagonal,
+                   const std::vector<std::uint8_t>& decoupled, double normBound, Eigen::VectorXd& scratch)
+      : grid_(grid), scale_(scale), diagonal_(diagonal), decoupled_(decoupled), normBound_(normBound), faces_(scratch) {}
+  Eigen::Index size() const override { return diagonal_.size(); }
   void apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const override {
-    faces_.noalias() = d_ * x;
-    y.noalias() = dt_ * faces_;
-    y *= scale_;
+    grid_.divergence(x, faces_);
+    grid_.divergenceTranspose(faces_, y);
+    // Unknowns no open face sees carry only the diagonal setDecoupledDiagonals gave them: their
+    // zero right-hand side holds them at 0.
     for (Eigen::Index k = 0; k < y.size(); ++k)
-      if (decoupled(k)) y[k] = diagonal_[k] * x[k];
+      y[k] = decoupled_[static_cast<std::size_t>(k)] ? diagonal_[k] * x[k] : scale_ * y[k];
   }
   void diagonal(Eigen::VectorXd& d) const override { d = diagonal_; }
   double normUpperBound() const override { return normBound_; }
 
  private:
-  // Unknowns no open face sees (D's column k empty; D is column-major) carry only the diagonal
-  // setDecoupledDiagonals gave them: their zero right-hand side holds them at 0.
-  bool decoupled(Eigen::Index k) const { return d_.outerIndexPtr()[k + 1] == d_.outerIndexPtr()[k]; }
-  const Eigen::SparseMatrix<double>& d_;
-  const Eigen::SparseMatrix<double>& dt_;
+  const StressGrid& grid_;
   double scale_;
   const Eigen::VectorXd& diagonal_;
+  const std::vector<std::uint8_t>& decoupled_;
   double normBound_;
   Eigen::VectorXd& faces_;
 };
@@ -146,7 +144,7 @@ void StressGrid::splat(std::span<const Vec2f> positions, std::span<const Vec2f> 
       active_[xFaces + static_cast<std::size_t>(i + nx_ * j)] = j > 0 && j < ny_ && open(i, j - 1) && open(i, j);
   // D follows the open faces, which change only where obstacles move.
   if (active_ != builtFor_) {
-    buildDivergence();
+    followOpenFaces();
     builtFor_ = active_;
   }
 }
@@ -170,46 +168,108 @@ void StressGrid::discomfortGradient(const StressLaws& laws, MacGrid<2>& gradient
                               : 0.0f;
 }
 
-void StressGrid::buildDivergence() {
-  const std::size_t cells = static_cast<std::size_t>(nx_ * ny_);
-  const auto sd = [&](int i, int j) { return static_cast<int>(i + nx_ * j); };
-  const auto so = [&](int i, int j) { return static_cast<int>(cells) + i + (nx_ + 1) * j; };
+void StressGrid::divergence(const Eigen::VectorXd& stress, Eigen::VectorXd& faces) const {
+  const int nx = nx_, ny = ny_;
+  if (stress.size() != static_cast<Eigen::Index>(nx * ny + (nx + 1) * (ny + 1)))
+    throw std::invalid_argument("stress grid: one stress per cell and corner expected");
   const double inv = 1.0 / grid_.dx;
-  std::vector<Eigen::Triplet<double>> entries;
-  entries.reserve(4 * active_.size());
+  const double* sd = stress.data();
+  const double* so = sd + static_cast<std::ptrdiff_t>(nx) * ny;
+  faces.resize(static_cast<Eigen::Index>(active_.size()));
+  double* fx = faces.data();
+  double* fy = fx + static_cast<std::ptrdiff_t>(nx + 1) * ny;
+  const std::uint8_t* ax = active_.data();
+  const std::uint8_t* ay = ax + static_cast<std::ptrdiff_t>(nx + 1) * ny;
+  // (div s)_x at the face between cells (i - 1, j) and (i, j), whose ends are corners (i, j), (i, j + 1).
+  for (int j = 0; j < ny; ++j) {
+    const double* d = sd + nx * j;
+    const double* o = so + (nx + 1) * j;
+    double* f = fx + (nx + 1) * j;
+    const std::uint8_t* open = ax + (nx + 1) * j;
+    f[0] = f[nx] = 0.0;
+    for (int i = 1; i < nx; ++i) f[i] = open[i] ? inv * (d[i] - d[i - 1] + o[i + nx + 1] - o[i]) : 0.0;
+  }
+  // (div s)_y at the face between cells (i, j - 1) and (i, j), whose ends are corners (i, j), (i + 1, j).
+  std::fill(fy, fy + nx, 0.0);
+  std::fill(fy + static_cast<std::ptrdiff_t>(nx) * ny, fy + static_cast<std::ptrdiff_t>(nx) * (ny + 1), 0.0);
+  for (int j = 1; j < ny; ++j) {
+    const double* d = sd + nx * j;
+    const double* o = so + (nx + 1) * j;
+    double* f = fy + nx * j;
+    const std::uint8_t* open = ay + nx * j;
+    for (int i = 0; i < nx; ++i) f[i] = open[i] ? inv * (o[i + 1] - o[i] - d[i] + d[i - nx]) : 0.0;
+  }
+}
+
+void StressGrid::divergenceTranspose(const Eigen::VectorXd& faces, Eigen::VectorXd& stress) const {
+  if (faces.size() != static_cast<Eigen::Index>(active_.size()))
+    throw std::invalid_argument("stress grid: one value per face expected");
+  const int nx = nx_, ny = ny_;
+  const double inv = 1.0 / grid_.dx;
+  stress.resize(static_cast<Eigen::Index>(nx * ny + (nx + 1) * (ny + 1)));
+  double* sd = stress.data();
+  double* so = sd + static_cast<std::ptrdiff_t>(nx) * ny;
+  const double* fx = faces.data();
+  const double* fy = fx + static_cast<std::ptrdiff_t>(nx + 1) * ny;
+  const std::uint8_t* ax = active_.data();
+  const std::uint8_t* ay = ax + static_cast<std::ptrdiff_t>(nx + 1) * ny;
+  // D's rows of the faces that carry no momentum are empty: their values do not enter.
+  const auto value = [](const double* f, const std::uint8_t* open, std::ptrdiff_t k) { return open[k] ? f[k] : 0.0; };
+  // D's columns: s_d(i, j) enters x faces (i, j) (+) and (i + 1, j) (-), y faces (i, j) (-) and
+  // (i, j + 1) (+); s_o(i, j) x faces (i, j - 1) (+) and (i, j) (-), y faces (i - 1, j) (+) and
+  // (i, j) (-).
+  for (int j = 0; j < ny; ++j) {
+    const double* x = fx + (nx + 1) * j;
+    const double* y = fy + nx * j;
+    const std::uint8_t* ox = ax + (nx + 1) * j;
+    const std::uint8_t* oy = ay + nx * j;
+    double* d = sd + nx * j;
+    for (int i = 0; i < nx; ++i)
+      d[i] = inv * (value(x, ox, i) - value(x, ox, i + 1) - value(y, oy, i) + value(y, oy, i + nx));
+  }
+  for (int j = 0; j <= ny; ++j) {
+    const double* x = fx + (nx + 1) * j;  // x faces (., j), present for j < ny
+    const double* y = fy + nx * j;        // y faces (., j), present for i < nx
+    const std::uint8_t* ox = ax + (nx + 1) * j;
+    const std::uint8_t* oy = ay + nx * j;
+    double* o = so + (nx + 1) * j;
+    for (int i = 0; i <= nx; ++i) {
+      double sum = 0.0;
+      if (j > 0) sum += value(x, ox, i - (nx + 1));
+      if (j < ny) sum -= value(x, ox, i);
+      if (i > 0) sum += value(y, oy, i - 1);
+      if (i < nx) sum -= value(y, oy, i);
+      o[i] = inv * sum;
+    }
+  }
+}
+
+void StressGrid::followOpenFaces() {
+  // |column k of D|^2 h^2: the open faces each stress unknown enters (divergenceTranspose's list).
+  const std::size_t cells = static_cast<std::size_t>(nx_ * ny_);
+  const std::size_t xFaces = static_cast<std::size_t>((nx_ + 1) * ny_);
+  const auto xOpen = [&](int i, int j) { return active_[static_cast<std::size_t>(i + (nx_ + 1) * j)] != 0 ? 1.0 : 0.0; };
+  const auto yOpen = [&](int i, int j) { return active_[xFaces + static_cast<std::size_t>(i + nx_ * j)] != 0 ? 1.0 : 0.0; };
+  const double inv2 = 1.0 / (grid_.dx * grid_.dx);
+  columnNorms_.resize(static_cast<Eigen::Index>(cells + static_cast<std::size_t>((nx_ + 1) * (ny_ + 1))));
   for (int j = 0; j < ny_; ++j)
-    for (int i = 1; i < nx_; ++i) {
-      const int face = i + (nx_ + 1) * j;
-      if (!active_[static_cast<std::size_t>(face)]) continue;
-      // (div s)_x at the face between cells (i - 1, j) and (i, j), whose ends are corners (i, j), (i, j + 1).
-      entries.emplace_back(face, sd(i, j), inv);
-      entries.emplace_back(face, sd(i - 1, j), -inv);
-      entries.emplace_back(face, so(i, j + 1), inv);
-      entries.emplace_back(face, so(i, j), -inv);
-    }
-  const int xFaces = (nx_ + 1) * ny_;
-  for (int j = 1; j < ny_; ++j)
-    for (int i = 0; i < nx_; ++i) {
-      const int face = xFaces + i + nx_ * j;
-      if (!active_[static_cast<std::size_t>(face)]) continue;
-      // (div s)_y at the face between cells (i, j - 1) and (i, j), whose ends are corners (i, j), (i + 1, j).
-      entries.emplace_back(face, so(i + 1, j), inv);
-      entries.emplace_back(face, so(i, j), -inv);
-      entries.emplace_back(face, sd(i, j), -inv);
-      entries.emplace_back(face, sd(i, j - 1), inv);
-    }
-  divergence_.resize(static_cast<Eigen::Index>(active_.size()), static_cast<Eigen::Index>(cells + (nx_ + 1) * (ny_ + 1)));
-  divergence_.setFromTriplets(entries.begin(), entries.end());
-  divergenceT_ = divergence_.transpose();
-  // D^T D's diagonal: the squared norms of D's columns.
-  columnNorms_ = divergenceT_.cwiseAbs2() * Eigen::VectorXd::Ones(divergence_.rows());
+    for (int i = 0; i < nx_; ++i)
+      columnNorms_[i + nx_ * j] = inv2 * (xOpen(i, j) + xOpen(i + 1, j) + yOpen(i, j) + yOpen(i, j + 1));
+  for (int j = 0; j <= ny_; ++j)
+    for (int i = 0; i <= nx_; ++i)
+      columnNorms_[static_cast<Eigen::Index>(cells) + i + (nx_ + 1) * j] =
+          inv2 * ((j > 0 ? xOpen(i, j - 1) : 0.0) + (j < ny_ ? xOpen(i, j) : 0.0) + (i > 0 ? yOpen(i - 1, j) : 0.0) +
+                  (i < nx_ ? yOpen(i, j) : 0.0));
+  decoupled_.resize(static_cast<std::size_t>(columnNorms_.size()));
+  for (std::size_t k = 0; k < decoupled_.size(); ++k) decoupled_[k] = columnNorms_[static_cast<Eigen::Index>(k)] > 0.0 ? 0 : 1;
 }
 
 FrictionResult StressGrid::friction(const Eigen::VectorXd& momentum, double dt, const StressLaws& laws,
                                     const numerics::BoundQpSettings& settings, Eigen::VectorXd& change) {
-  if (momentum.size() != divergence_.rows()) throw std::invalid_argument("stress grid: one momentum per face expected");
+  if (momentum.size() != static_cast<Eigen::Index>(active_.size()))
+    throw std::invalid_argument("stress grid: one momentum per face expected");
   if (!(dt > 0.0)) throw std::invalid_argument("stress grid: the step must be > 0");
-  const Eigen::Index unknowns = divergence_.cols();
+  const Eigen::Index unknowns = columnNorms_.size();
   // The bounds: each cell's density for s_d, the mean of the open cells around a corner for s_o.
   upper_.resize(unknowns);
   for (int j = 0; j < ny_; ++j)
@@ -235,15 +295,17 @@ FrictionResult StressGrid::friction(const Eigen::VectorXd& momentum, double dt, 
   diagonal_ = scale * columnNorms_;
   const double largest = numerics::setDecoupledDiagonals(
       std::span<double>(diagonal_.data(), static_cast<std::size_t>(diagonal_.size())),
-      [&](std::size_t k) { return !(columnNorms_[static_cast<Eigen::Index>(k)] > 0.0); });
+      [&](std::size_t k) { return decoupled_[k] != 0; });
   const double h = grid_.dx;
-  const FrictionOperator op(divergence_, divergenceT_, scale, diagonal_, std::max(8.0 * scale / (h * h), largest), faces_);
-  rhs_ = -(dt / laws.yield) * (divergenceT_ * momentum);
+  const FrictionOperator op(*this, scale, diagonal_, decoupled_, std::max(8.0 * scale / (h * h), largest), faces_);
+  divergenceTranspose(momentum, rhs_);
+  rhs_ *= -dt / laws.yield;
   if (stress_.size() != unknowns) stress_ = Eigen::VectorXd::Zero(unknowns);
   stress_ = stress_.cwiseMax(lower_).cwiseMin(upper_);
   FrictionResult result;
   result.qp = solver_.solve(op, rhs_, lower_, upper_, stress_, settings);
-  change = dt * (divergence_ * stress_);
+  divergence(stress_, change);
+  change *= dt;
   result.energyBefore = momentum.squaredNorm() / (2.0 * laws.yield);
   result.energyAfter = (momentum + change).squaredNorm() / (2.0 * laws.yield);
   return result;
@@ -251,7 +313,9 @@ FrictionResult StressGrid::friction(const Eigen::VectorXd& momentum, double dt, 
 
 double StressGrid::energy(const Eigen::VectorXd& momentum, const Eigen::VectorXd& stress, double dt,
                           const StressLaws& laws) const {
-  return (momentum + dt * (divergence_ * stress)).squaredNorm() / (2.0 * laws.yield);
+  Eigen::VectorXd change;
+  divergence(stress, change);
+  return (momentum + dt * change).squaredNorm() / (2.0 * laws.yield);
 }
 
 }  // namespace msim::crowd::stress

@@ -15,7 +15,6 @@
 #include <vector>
 
 #include <Eigen/Core>
-#include <Eigen/SparseCore>
 
 #include "msim/core/grid.hpp"
 #include "msim/core/mac_grid.hpp"
@@ -64,9 +63,14 @@ class StressGrid {
   // The last solve's stress: s_d per cell (x fastest), then s_o per corner ((nx + 1) (ny + 1)).
   const Eigen::VectorXd& stress() const { return stress_; }
   const Eigen::VectorXd& bound() const { return upper_; }  // b per stress unknown
+  // faces = D s (faceCount() entries, 0 on faces that carry no momentum) and its transpose,
+  // stress = D^T faces (the values on faces that carry no momentum ignored), both on the grid;
+  // std::invalid_argument for vectors of other sizes.
+  void divergence(const Eigen::VectorXd& stress, Eigen::VectorXd& faces) const;
+  void divergenceTranspose(const Eigen::VectorXd& faces, Eigen::VectorXd& stress) const;
 
  private:
-  void buildDivergence();
+  void followOpenFaces();
 
   GridSpec<2> grid_;
   int nx_ = 0, ny_ = 0;
@@ -75,9 +79,8 @@ class StressGrid {
   std::vector<float> ones_, vx_, vy_, cx_, cy_;
   Splatter<2> splatter_;
   std::vector<std::uint8_t> active_, builtFor_;
-  Eigen::SparseMatrix<double> divergence_;   // D: faces x stress unknowns (rows of inactive faces empty)
-  Eigen::SparseMatrix<double> divergenceT_;  // D^T
-  Eigen::VectorXd columnNorms_;               // |column k of D|^2
+  Eigen::VectorXd columnNorms_;          // |column k of D|^2
+  std::vector<std::uint8_t> decoupled_;  // stress unknowns no open face enters (column k of D empty)
   Eigen::VectorXd stress_, lower_, upper_, rhs_, diagonal_, faces_;
   std::vector<std::uint8_t> known_, nextKnown_;  // splat(): cells whose density is set
   numerics::BoundQpSolver solver_;
