@@ -113,6 +113,7 @@ class DistributedProjection {
   std::vector<double> rhs_, values_, coefficients_;
   std::vector<unsigned char> fluid_;  // owned cells with an unknown (some face open)
   long long pinned_ = -1;             // global index of the pinned cell, -1 when none
+  long long pinnedOrdinal_ = -1;      // its owned-cell ordinal on this rank, -1 when another rank owns it
   HYPRE_StructGrid grid_ = nullptr;
   HYPRE_StructStencil stencil_ = nullptr;
   HYPRE_StructMatrix matrix_ = nullptr;
