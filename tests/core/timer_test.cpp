@@ -1,6 +1,7 @@
 // StageTimers: accumulation of wall time and calls per stage.
 #include <gtest/gtest.h>
 
+#include <stdexcept>
 #include <thread>
 
 #include <tbb/parallel_for.h>
@@ -51,4 +52,24 @@ TEST(StageTimers, ConcurrentStagesLoseNoCalls) {
   ASSERT_EQ(rows.size(), 2u);
   EXPECT_EQ(rows[0].calls + rows[1].calls, 4000u);
   EXPECT_NEAR(timers.totalSeconds(), 4.0, 1e-9);
+}
+
+TEST(StageTimers, MergeAddsAnotherTablesStagesUnderAPrefix) {
+  StageTimers solver, run;
+  solver.add("project", 1.0);
+  solver.add("project", 2.0);
+  solver.add("advect", 0.5);
+  run.add("setup", 4.0);
+  run.add("smoke: project", 1.0);
+  run.merge(solver, "smoke: ");
+  run.merge(solver, "smoke: ");
+  const auto rows = run.table();
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_EQ(rows[1].name, "smoke: project");
+  EXPECT_DOUBLE_EQ(rows[1].seconds, 7.0);
+  EXPECT_EQ(rows[1].calls, 5u);
+  EXPECT_EQ(rows[2].name, "smoke: advect");
+  EXPECT_DOUBLE_EQ(rows[2].seconds, 1.0);
+  EXPECT_EQ(rows[2].calls, 2u);
+  EXPECT_THROW(run.merge(run), std::invalid_argument);
 }

@@ -1,17 +1,33 @@
 #include "msim/core/timer.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
 namespace msim {
 
-void StageTimers::add(std::string_view stage, double seconds) {
-  std::lock_guard lock(mutex_);
+StageTimers::Entry& StageTimers::entry(std::string_view stage) {
   auto it = std::find_if(entries_.begin(), entries_.end(), [&](const Entry& e) { return e.name == stage; });
   if (it == entries_.end()) it = entries_.insert(entries_.end(), Entry{std::string(stage), 0.0, 0});
-  it->seconds += seconds;
-  ++it->calls;
+  return *it;
+}
+
+void StageTimers::add(std::string_view stage, double seconds) {
+  std::lock_guard lock(mutex_);
+  Entry& e = entry(stage);
+  e.seconds += seconds;
+  ++e.calls;
+}
+
+void StageTimers::merge(const StageTimers& other, std::string_view prefix) {
+  if (&other == this) throw std::invalid_argument("StageTimers::merge: a table cannot merge itself");
+  for (const StageTime& t : other.table()) {
+    std::lock_guard lock(mutex_);
+    Entry& e = entry(std::string(prefix) + t.name);
+    e.seconds += t.seconds;
+    e.calls += t.calls;
+  }
 }
 
 double StageTimers::totalSeconds() const {

@@ -23,6 +23,9 @@ struct StageTime {
 class StageTimers {
  public:
   void add(std::string_view stage, double seconds);
+  // Adds every stage of `other` (its seconds and calls) under prefix + its name, e.g. a solver's
+  // own stages into a run's table.
+  void merge(const StageTimers& other, std::string_view prefix = {});
   // One row per stage, in the order the stages were first used.
   std::vector<StageTime> table() const;
   double totalSeconds() const;
@@ -36,6 +39,7 @@ class StageTimers {
     double seconds = 0.0;
     std::uint64_t calls = 0;
   };
+  Entry& entry(std::string_view stage);  // found or appended; the caller holds mutex_
   mutable std::mutex mutex_;
   std::vector<Entry> entries_;  // a handful of stages: a linear search beats hashing
 };

@@ -218,12 +218,15 @@ class LiquidPhenomenon final : public Phenomenon {
 
   void step(double dt) override {
     double exchanged = 0.0;  // by the emitters and sinks
-    {
-      ScopedStage stage(timers_, "liquid: step");
-      exchanged = sources_->apply(solver_, time_);
-      if (obstacles_.moving()) placeObstacles(time_ + 0.5 * dt);
-      solver_.step(dt);
+    exchanged = sources_->apply(solver_, time_);  // timed by the solver: "liquid: sources", "sinks"
+    if (obstacles_.moving()) {
+      ScopedStage stage(timers_, "liquid: move obstacles");
+      placeObstacles(time_ + 0.5 * dt);
     }
+    solver_.step(dt);
+    // The solver's own stages (surface, advection, pressure, ...) in the run's table.
+    timers_.merge(solver_.timers());
+    solver_.resetTimers();
     if (turbulence_) {
       ScopedStage stage(timers_, "liquid: turbulence");
       if (obstacles_.moving()) turbulence_->setSolid(solver_.solid());

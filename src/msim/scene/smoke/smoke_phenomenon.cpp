@@ -148,14 +148,14 @@ class SmokePhenomenon final : public Phenomenon {
       ScopedStage stage(timers_, "smoke: move obstacles");
       placeObstacles(time_ + 0.5 * dt);
     }
-    {
-      ScopedStage stage(timers_, "smoke: step");
-      try {
-        solver_.step(dt);
-      } catch (const SimulationError& e) {
-        throw SimulationError(fmt::format("t = {:.4g} s: {}", time_, e.what()));
-      }
+    try {
+      solver_.step(dt);
+    } catch (const SimulationError& e) {
+      throw SimulationError(fmt::format("t = {:.4g} s: {}", time_, e.what()));
     }
+    // The solver's own stages (advection, forces, projection, ...) in the run's table.
+    timers_.merge(solver_.timers(), "smoke: ");
+    solver_.resetTimers();
     if (turbulence_) {
       // Sub-grid turbulence, and the fine scalars carried by the new velocity plus the eddies
       // (ch. 3.5.2), as the solver carries its own scalars after its projection.
