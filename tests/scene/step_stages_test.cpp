@@ -1,5 +1,5 @@
-// A fluid run's stage table (the end-of-run summary and run.json's timings) breaks each step into
-// the solver's own stages, each step's time counted once.
+// A fluid run's stage table (the end-of-run summary and run.json's timings) breaks each smoke,
+// gas and liquid step into the solver's own stages, each step's time counted once.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -37,6 +37,15 @@ TEST(StepStages, SmokeStepsShowTheSolversStages) {
     EXPECT_EQ(calls.at(stage), 3u) << stage;
   }
   EXPECT_FALSE(calls.count("smoke: step"));  // no stage holding the others: the total counts each once
+}
+
+TEST(StepStages, GasStepsShowTheSolversStages) {
+  const auto calls = stagesAfterSteps("steam.json", 3);
+  for (const char* stage : {"gas: emit", "gas: transport density", "gas: transport temperature", "gas: decay"}) {
+    ASSERT_TRUE(calls.count(stage)) << stage;
+    EXPECT_EQ(calls.at(stage), 3u) << stage;
+  }
+  EXPECT_FALSE(calls.count("gas: emit + transport"));
 }
 
 TEST(StepStages, LiquidStepsShowTheSolversStages) {

@@ -104,22 +104,36 @@ void GasSolver<D>::decay(double dt) {
 
 template <int D>
 void GasSolver<D>::step(double dt) {
-  emit(dt);
-  numerics::TransportSettings densitySettings;
-  densitySettings.form = numerics::TransportForm::Conservative;
-  densitySettings.diffusivity = params_.densityDiffusion;
-  transport_.step(density_, densitySettings, dt);
-
-  numerics::TransportSettings temperatureSettings;
-  temperatureSettings.form = numerics::TransportForm::Advective;
-  temperatureSettings.diffusivity = params_.temperatureDiffusion;
-  temperatureSettings.inflowValue = params_.ambientTemperature;
-  transport_.step(temperature_, temperatureSettings, dt);
-  // Exact integration of the linear loss terms over the step (no stability limit of their own).
-  decay(dt);
+  {
+    ScopedStage s(timers_, "emit");
+    emit(dt);
+  }
+  {
+    ScopedStage s(timers_, "transport density");
+    numerics::TransportSettings densitySettings;
+    densitySettings.form = numerics::TransportForm::Conservative;
+    densitySettings.diffusivity = params_.densityDiffusion;
+    transport_.step(density_, densitySettings, dt);
+  }
+  {
+    ScopedStage s(timers_, "transport temperature");
+    numerics::TransportSettings temperatureSettings;
+    temperatureSettings.form = numerics::TransportForm::Advective;
+    temperatureSettings.diffusivity = params_.temperatureDiffusion;
+    temperatureSettings.inflowValue = params_.ambientTemperature;
+    transport_.step(temperature_, temperatureSettings, dt);
+  }
+  {
+    // Exact integration of the linear loss terms over the step (no stability limit of their own).
+    ScopedStage s(timers_, "decay");
+    decay(dt);
+  }
   time_ += dt;
-  // The next step's flow, so that stableTimestep() sees it.
-  if (!winds_.empty()) refreshVelocity();
+  if (!winds_.empty()) {
+    // The next step's flow, so that stableTimestep() sees it.
+    ScopedStage s(timers_, "winds");
+    refreshVelocity();
+  }
 }
 
 template <int D>

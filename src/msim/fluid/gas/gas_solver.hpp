@@ -13,6 +13,7 @@
 
 #include "msim/core/grid.hpp"
 #include "msim/core/mac_grid.hpp"
+#include "msim/core/timer.hpp"
 #include "msim/fluid/gas/motion_field.hpp"
 #include "msim/numerics/flux_transport.hpp"
 #include "msim/turbulence/turbulent_wind.hpp"
@@ -67,6 +68,9 @@ class GasSolver {
   void step(double dt);
 
   GasStatistics statistics() const;
+  // Wall time per stage of step() (emit, transport, decay, winds), for the run's stage table.
+  const StageTimers& timers() const { return timers_; }
+  void resetTimers() { timers_.reset(); }
 
   Grid<float, D>& density() { return density_; }
   const Grid<float, D>& density() const { return density_; }
@@ -92,6 +96,7 @@ class GasSolver {
   MacGrid<D> windyVelocity_;   // steady field + winds at the current time (scratch)
   std::vector<turbulence::TurbulentWind<D>> winds_;
   double time_ = 0.0;
+  StageTimers timers_;
 };
 
 }  // namespace msim::fluid

@@ -142,8 +142,10 @@ class GasPhenomenon final : public Phenomenon {
   double stableTimestep() const override { return solver_.stableTimestep(); }
 
   void step(double dt) override {
-    ScopedStage stage(timers_, "gas: emit + transport");
     solver_.step(dt);
+    // The solver's stages (emit, transport, decay, winds) in the run's table.
+    timers_.merge(solver_.timers(), "gas: ");
+    solver_.resetTimers();
   }
 
   void checkFinite(long stepIndex, double time) const override {
