@@ -134,7 +134,7 @@ BoundQpResult BoundQpSolver::solveBox(const QpOperator& A, const Eigen::VectorXd
     throw std::invalid_argument("BoundQpSolver: operator has size " + std::to_string(n) + ", b " +
                                 std::to_string(b.size()) + ", p " + std::to_string(p.size()));
   boxed_ = lower != nullptr;
-  if (!boxed_) {
+  if (!boxed_ && zeros_.size() != n) {
     zeros_.setZero(n);
     infinities_.setConstant(n, std::numeric_limits<double>::infinity());
   }
@@ -172,8 +172,6 @@ BoundQpResult BoundQpSolver::solveBox(const QpOperator& A, const Eigen::VectorXd
     if (invDiagonal_.size() != n || !(invDiagonal_.minCoeff() > 0.0))
       throw std::invalid_argument("BoundQpSolver: Jacobi preconditioning needs a positive diagonal of size n");
     invDiagonal_ = invDiagonal_.cwiseInverse();
-  } else {
-    invDiagonal_.setOnes(n);  // no preconditioning: z = g on the face
   }
   // The loops below go through raw pointers: the vectors do not move during the solve, and the
   // compiler then keeps the addresses in registers instead of reloading them for every entry.
@@ -186,11 +184,11 @@ BoundQpResult BoundQpSolver::solveBox(const QpOperator& A, const Eigen::VectorXd
   const double* const L = lower_;
   const double* const U = upper_;
   std::uint8_t* const F = free_.data();
-  const double* const J = invDiagonal_.data();
+  const double* const J = jacobi ? invDiagonal_.data() : nullptr;
   const double invAlphaBar = 1.0 / alphaBar;
   // z_i without a face preconditioner: Jacobi (or none) on the face, 0 off it (for a diagonal M,
   // M_FF^{-1} = (M^{-1})_FF, so it needs no refactoring when the face changes).
-  const auto diagonallyPreconditioned = [&](Eigen::Index i) { return F[i] ? G[i] * J[i] : 0.0; };
+  const auto diagonallyPreconditioned = [&](Eigen::Index i) { return F[i] ? (J ? G[i] * J[i] : G[i]) : 0.0; };
   // The step along -d at which entry i reaches the bound d moves it towards (none when d_i = 0).
   constexpr double inf = std::numeric_limits<double>::infinity();
   const auto reach = [&](Eigen::Index i) {

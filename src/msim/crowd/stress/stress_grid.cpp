@@ -25,8 +25,13 @@ constexpr double kSmallestFree = 0.05;
 class FrictionOperator final : public numerics::QpOperator {
  public:
   FrictionOperator(const StressGrid& grid, double scale, const Eigen::VectorXd& diagonal,
-                   const std::vector<std::uint8_t>& decoupled, double normBound, Eigen::VectorXd& scratch)
-      : grid_(grid), scale_(scale), diagonal_(diagonal), decoupled_(decoupled), normBound_(normBound), faces_(scratch) {}
+                   const Eigen::VectorXd& columnNorms, double normBound, Eigen::VectorXd& scratch)
+      : grid_(grid),
+        scale_(scale),
+        diagonal_(diagonal),
+        columnNorms_(columnNorms),
+        normBound_(normBound),
+        faces_(scratch) {}
   Eigen::Index size() const override { return diagonal_.size(); }
   void apply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const override {
     grid_.divergence(x, faces_);
@@ -34,7 +39,7 @@ class FrictionOperator final : public numerics::QpOperator {
     // Unknowns no open face sees carry only the diagonal setDecoupledDiagonals gave them: their
     // zero right-hand side holds them at 0.
     for (Eigen::Index k = 0; k < y.size(); ++k)
-      y[k] = decoupled_[static_cast<std::size_t>(k)] ? diagonal_[k] * x[k] : scale_ * y[k];
+      y[k] = columnNorms_[k] > 0.0 ? scale_ * y[k] : diagonal_[k] * x[k];
   }
   void diagonal(Eigen::VectorXd& d) const override { d = diagonal_; }
   double normUpperBound() const override { return normBound_; }
@@ -43,7 +48,7 @@ class FrictionOperator final : public numerics::QpOperator {
   const StressGrid& grid_;
   double scale_;
   const Eigen::VectorXd& diagonal_;
-  const std::vector<std::uint8_t>& decoupled_;
+  const Eigen::VectorXd& columnNorms_;  // |column k of D|^2: 0 for the decoupled unknowns
   double normBound_;
   Eigen::VectorXd& faces_;
 };
@@ -260,8 +265,6 @@ void StressGrid::followOpenFaces() {
       columnNorms_[static_cast<Eigen::Index>(cells) + i + (nx_ + 1) * j] =
           inv2 * ((j > 0 ? xOpen(i, j - 1) : 0.0) + (j < ny_ ? xOpen(i, j) : 0.0) + (i > 0 ? yOpen(i - 1, j) : 0.0) +
                   (i < nx_ ? yOpen(i, j) : 0.0));
-  decoupled_.resize(static_cast<std::size_t>(columnNorms_.size()));
-  for (std::size_t k = 0; k < decoupled_.size(); ++k) decoupled_[k] = columnNorms_[static_cast<Eigen::Index>(k)] > 0.0 ? 0 : 1;
 }
 
 FrictionResult StressGrid::friction(const Eigen::VectorXd& momentum, double dt, const StressLaws& laws,
@@ -295,9 +298,9 @@ FrictionResult StressGrid::friction(const Eigen::VectorXd& momentum, double dt, 
   diagonal_ = scale * columnNorms_;
   const double largest = numerics::setDecoupledDiagonals(
       std::span<double>(diagonal_.data(), static_cast<std::size_t>(diagonal_.size())),
-      [&](std::size_t k) { return decoupled_[k] != 0; });
+      [&](std::size_t k) { return !(columnNorms_[static_cast<Eigen::Index>(k)] > 0.0); });
   const double h = grid_.dx;
-  const FrictionOperator op(*this, scale, diagonal_, decoupled_, std::max(8.0 * scale / (h * h), largest), faces_);
+  const FrictionOperator op(*this, scale, diagonal_, columnNorms_, std::max(8.0 * scale / (h * h), largest), faces_);
   divergenceTranspose(momentum, rhs_);
   rhs_ *= -dt / laws.yield;
   if (stress_.size() != unknowns) stress_ = Eigen::VectorXd::Zero(unknowns);

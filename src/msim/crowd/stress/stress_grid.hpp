@@ -80,7 +80,6 @@ class StressGrid {
   Splatter<2> splatter_;
   std::vector<std::uint8_t> active_, builtFor_;
   Eigen::VectorXd columnNorms_;          // |column k of D|^2
-  std::vector<std::uint8_t> decoupled_;  // stress unknowns no open face enters (column k of D empty)
   Eigen::VectorXd stress_, lower_, upper_, rhs_, diagonal_, faces_;
   std::vector<std::uint8_t> known_, nextKnown_;  // splat(): cells whose density is set
   numerics::BoundQpSolver solver_;
