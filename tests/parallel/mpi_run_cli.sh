@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `mpirun -np 2 msim run` on a 3D smoke scene: the statistics of the one-process run (within what
-# the two pressure solvers' tolerances leave), each frame written once by rank 0; bad input
-# reported by rank 0 alone with exit code 2 and nothing written; a failure on one rank stops all.
+# the two pressure solvers' tolerances leave), each frame written once by rank 0; likewise liquids,
+# and a cloth on 4 processes without self-intersections; bad input reported by rank 0 alone with
+# exit code 2 and nothing written; a failure on one rank stops all.
 # Usage: mpi_run_cli.sh MSIM SCENES_DIR TMP_DIR
 set -euo pipefail
 msim=$1
@@ -9,6 +10,7 @@ scenes=$2
 tmp=$3
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 two=(timeout 300 mpirun -np 2 --oversubscribe --bind-to none "$msim")
+four=(timeout 300 mpirun -np 4 --oversubscribe --bind-to none "$msim")
 rm -rf "$tmp"
 mkdir -p "$tmp"
 short=(--set domain.resolution=32 --frames 6 -q)
@@ -141,11 +143,30 @@ for key in ("smoke_mass_kg", "kinetic_energy_J", "enstrophy"):
     assert x[key] == y[key], key  # bit for bit, as a one-process resume
 PY
 
+# A cloth split among 4 processes (Selle ch. 8.2: the recursive median's parts, the solves' rows
+# split, the repulsions in two phases): the twisted cloth, coarser and turned twice as fast so that
+# it lies on itself within 30 frames, never passes through itself.
+cloth=(--frames 30 --set 'cloth.patch.quads=[24,24]' --set 'cloth.pins[1].angular_velocity=[0,8,0]'
+       --set render.enabled=false --set outputs.mp4=false -q)
+"${four[@]}" run "$scenes/cloth_twist.json" --out "$tmp/cloth_four" "${cloth[@]}"
+python3 - "$tmp/cloth_four/run.json" <<'PY'
+import json, sys
+run = json.load(open(sys.argv[1]))
+assert run["status"] == "complete" and run.get("mpi_processes") == "4", (run["status"], run.get("mpi_processes"))
+frames = run["frames"]
+worst = max(f["self_intersections"] for f in frames)
+steps = frames[-1]["intersecting_steps"]
+print(f"cloth_twist on 4 processes: {len(frames)} frames, {frames[-1]['repulsions']} repulsions in the last, "
+      f"most intersecting triangle pairs {worst}, intersecting steps {steps}")
+assert worst == 0 and steps == 0 and frames[-1]["repulsions"] > 0
+PY
+
+launch=("${two[@]}")
 expect_failure() {  # expect_failure CODE PATTERN ARGS...: exit CODE, PATTERN in one message
   local code=$1 pattern=$2
   shift 2
   set +e
-  out=$("${two[@]}" "$@" 2>&1)
+  out=$("${launch[@]}" "$@" 2>&1)
   rc=$?
   set -e
   [[ $rc -eq $code ]] || { echo "msim $*: exit $rc, expected $code"; echo "$out"; exit 1; }
@@ -158,6 +179,11 @@ expect_failure 2 "mpi.ghost_layers" run "$scenes/plume_3d.json" --out "$tmp/bad"
 expect_failure 2 "mpi.blocks" run "$scenes/plume_3d.json" --out "$tmp/bad" --set 'mpi.blocks=[3,1,1]' -q
 expect_failure 2 "liquid.turbulence.enabled" run "$scenes/river_rapids.json" --out "$tmp/bad" -q
 expect_failure 2 "mpi.ghost_layers" run "$scenes/drop_into_pool.json" --out "$tmp/bad" --set mpi.ghost_layers=4 -q
+expect_failure 2 "cloth.preconditioner" run "$scenes/cloth_twist.json" --out "$tmp/bad" --set cloth.preconditioner=multigrid -q
+expect_failure 2 "runs on one process" run "$scenes/solid_torus.json" --out "$tmp/bad" -q
+launch=(timeout 300 mpirun -np 3 --oversubscribe --bind-to none "$msim")
+expect_failure 2 "power of two" run "$scenes/cloth_twist.json" --out "$tmp/bad" -q
+launch=("${two[@]}")
 [[ ! -e "$tmp/bad" ]] || { echo "bad input left $tmp/bad behind"; exit 1; }
 # A given lattice and wider ghost layers give the same run.
 "${two[@]}" run "$scenes/plume_3d.json" --out "$tmp/given" "${short[@]}" --set 'mpi.blocks=[1,1,2]' --set mpi.ghost_layers=5

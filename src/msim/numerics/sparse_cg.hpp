@@ -30,29 +30,37 @@ struct SparseCgWorkspace {
   Eigen::VectorXd z, search, product;
 };
 
+// A dot product over all of the unknowns is the one computed here.
+struct WholeDot {
+  double operator()(double local) const { return local; }
+};
+
 // Solves A x = b from x and its residual r = b - A x (both updated); stops once |r|^2 <= target2
-// or after maxIterations.
-template <typename Product, typename Preconditioner>
+// or after maxIterations. A solve whose rows are split among processes (solids/newmark.cpp) keeps
+// the other processes' rows of r, and so of z and of the search direction, at 0 and passes
+// `reduce`, which turns the dot products over its own rows into the whole ones.
+template <typename Product, typename Preconditioner, typename Reduce = WholeDot>
 SparseCgStats preconditionedCg(const Product& multiply, const Preconditioner& preconditioner, Eigen::VectorXd& x,
-                               Eigen::VectorXd& r, double target2, int maxIterations, SparseCgWorkspace& w) {
+                               Eigen::VectorXd& r, double target2, int maxIterations, SparseCgWorkspace& w,
+                               const Reduce& reduce = {}) {
   SparseCgStats stats;
-  stats.residualNorm2 = stats.initialResidualNorm2 = parallelDot(r, r);
+  stats.residualNorm2 = stats.initialResidualNorm2 = reduce(parallelDot(r, r));
   if (stats.residualNorm2 <= target2) {
     stats.converged = true;
     return stats;
   }
   preconditioner.apply(r, w.z);
   w.search = w.z;
-  double rz = parallelDot(r, w.z);
+  double rz = reduce(parallelDot(r, w.z));
   while (stats.iterations < maxIterations) {
     multiply(w.search, w.product);
-    const double curvature = parallelDot(w.search, w.product);
+    const double curvature = reduce(parallelDot(w.search, w.product));
     if (!(curvature > 0.0)) break;
     ++stats.iterations;
-    stats.residualNorm2 = parallelStep(rz / curvature, w.search, w.product, x, r);
+    stats.residualNorm2 = reduce(parallelStep(rz / curvature, w.search, w.product, x, r));
     if (stats.residualNorm2 <= target2) break;
     preconditioner.apply(r, w.z);
-    const double rzNext = parallelDot(r, w.z);
+    const double rzNext = reduce(parallelDot(r, w.z));
     parallelDirection(w.z, rzNext / rz, w.search);
     rz = rzNext;
   }

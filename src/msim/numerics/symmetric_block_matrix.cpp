@@ -72,45 +72,51 @@ void SymmetricBlockMatrix::multiply(const Eigen::VectorXd& u, Eigen::VectorXd& y
   multiply(u.data(), y.data());
 }
 
-void SymmetricBlockMatrix::multiply(const double* in, double* out) const {
-  parallelFor(0, rows(), [&](std::size_t r) {
-    const SymmetricBlock<double>& d = diagonal_[r];
-    const double* own = in + 3 * r;
-    double x = d.xx * own[0] + d.xy * own[1] + d.xz * own[2];
-    double y = d.xy * own[0] + d.yy * own[1] + d.yz * own[2];
-    double z = d.xz * own[0] + d.yz * own[1] + d.zz * own[2];
+void SymmetricBlockMatrix::multiplyRow(std::size_t r, const double* in, double* out) const {
+  const SymmetricBlock<double>& d = diagonal_[r];
+  const double* own = in + 3 * r;
+  double x = d.xx * own[0] + d.xy * own[1] + d.xz * own[2];
+  double y = d.xy * own[0] + d.yy * own[1] + d.yz * own[2];
+  double z = d.xz * own[0] + d.yz * own[1] + d.zz * own[2];
 #if defined(__AVX2__) && defined(__FMA__)
-    // Each block's three columns in four-wide registers: one load of its six floats (and two of the
-    // next block's, or of the padding after the last), two permutes and three conversions give
-    // (xx, xy, xz), (xy, yy, yz) and (xz, yz, zz); the product is then three multiply-adds, a third of
-    // the scalar path's arithmetic (the scalar path below serves the portable build).
-    const __m256i firstColumns = _mm256_setr_epi32(0, 3, 4, 4, 3, 1, 5, 5);  // (xx xy xz), (xy yy yz)
-    const __m256i thirdColumn = _mm256_setr_epi32(4, 5, 2, 2, 4, 5, 2, 2);   // (xz yz zz)
-    const auto blockProduct = [&](int e) {
-      const __m256 packed = _mm256_loadu_ps(&blocks_[static_cast<std::size_t>(e)].xx);
-      const __m256 columns01 = _mm256_permutevar8x32_ps(packed, firstColumns);
-      const __m256d column0 = _mm256_cvtps_pd(_mm256_castps256_ps128(columns01));
-      const __m256d column1 = _mm256_cvtps_pd(_mm256_extractf128_ps(columns01, 1));
-      const __m256d column2 = _mm256_cvtps_pd(_mm256_castps256_ps128(_mm256_permutevar8x32_ps(packed, thirdColumn)));
-      const double* v = in + 3 * static_cast<std::size_t>(columns_[static_cast<std::size_t>(e)]);
-      return _mm256_fmadd_pd(column2, _mm256_broadcast_sd(v + 2),
-                             _mm256_fmadd_pd(column1, _mm256_broadcast_sd(v + 1), _mm256_mul_pd(column0, _mm256_broadcast_sd(v))));
-    };
-    __m256d sum = _mm256_setr_pd(x, y, z, 0.0);
-    for (int e = rowStart_[r]; e < rowStart_[r + 1]; ++e) sum = _mm256_add_pd(sum, blockProduct(e));
-    _mm_storeu_pd(out + 3 * r, _mm256_castpd256_pd128(sum));
-    _mm_store_sd(out + 3 * r + 2, _mm256_extractf128_pd(sum, 1));
+  // Each block's three columns in four-wide registers: one load of its six floats (and two of the
+  // next block's, or of the padding after the last), two permutes and three conversions give
+  // (xx, xy, xz), (xy, yy, yz) and (xz, yz, zz); the product is then three multiply-adds, a third of
+  // the scalar path's arithmetic (the scalar path below serves the portable build).
+  const __m256i firstColumns = _mm256_setr_epi32(0, 3, 4, 4, 3, 1, 5, 5);  // (xx xy xz), (xy yy yz)
+  const __m256i thirdColumn = _mm256_setr_epi32(4, 5, 2, 2, 4, 5, 2, 2);   // (xz yz zz)
+  const auto blockProduct = [&](int e) {
+    const __m256 packed = _mm256_loadu_ps(&blocks_[static_cast<std::size_t>(e)].xx);
+    const __m256 columns01 = _mm256_permutevar8x32_ps(packed, firstColumns);
+    const __m256d column0 = _mm256_cvtps_pd(_mm256_castps256_ps128(columns01));
+    const __m256d column1 = _mm256_cvtps_pd(_mm256_extractf128_ps(columns01, 1));
+    const __m256d column2 = _mm256_cvtps_pd(_mm256_castps256_ps128(_mm256_permutevar8x32_ps(packed, thirdColumn)));
+    const double* v = in + 3 * static_cast<std::size_t>(columns_[static_cast<std::size_t>(e)]);
+    return _mm256_fmadd_pd(column2, _mm256_broadcast_sd(v + 2),
+                           _mm256_fmadd_pd(column1, _mm256_broadcast_sd(v + 1), _mm256_mul_pd(column0, _mm256_broadcast_sd(v))));
+  };
+  __m256d sum = _mm256_setr_pd(x, y, z, 0.0);
+  for (int e = rowStart_[r]; e < rowStart_[r + 1]; ++e) sum = _mm256_add_pd(sum, blockProduct(e));
+  _mm_storeu_pd(out + 3 * r, _mm256_castpd256_pd128(sum));
+  _mm_store_sd(out + 3 * r + 2, _mm256_extractf128_pd(sum, 1));
 #else
-    for (int e = rowStart_[r]; e < rowStart_[r + 1]; ++e) {
-      const SymmetricBlock<float>& b = blocks_[static_cast<std::size_t>(e)];
-      const double* v = in + 3 * static_cast<std::size_t>(columns_[static_cast<std::size_t>(e)]);
-      x += b.xx * v[0] + b.xy * v[1] + b.xz * v[2];
-      y += b.xy * v[0] + b.yy * v[1] + b.yz * v[2];
-      z += b.xz * v[0] + b.yz * v[1] + b.zz * v[2];
-    }
-    out[3 * r] = x, out[3 * r + 1] = y, out[3 * r + 2] = z;
+  for (int e = rowStart_[r]; e < rowStart_[r + 1]; ++e) {
+    const SymmetricBlock<float>& b = blocks_[static_cast<std::size_t>(e)];
+    const double* v = in + 3 * static_cast<std::size_t>(columns_[static_cast<std::size_t>(e)]);
+    x += b.xx * v[0] + b.xy * v[1] + b.xz * v[2];
+    y += b.xy * v[0] + b.yy * v[1] + b.yz * v[2];
+    z += b.xz * v[0] + b.yz * v[1] + b.zz * v[2];
+  }
+  out[3 * r] = x, out[3 * r + 1] = y, out[3 * r + 2] = z;
 #endif
-  }, kRowGrain);
+}
+
+void SymmetricBlockMatrix::multiply(const double* in, double* out) const {
+  parallelFor(0, rows(), [&](std::size_t r) { multiplyRow(r, in, out); }, kRowGrain);
+}
+
+void SymmetricBlockMatrix::multiplyRows(const double* in, double* out, std::span<const int> which) const {
+  parallelFor(0, which.size(), [&](std::size_t k) { multiplyRow(static_cast<std::size_t>(which[k]), in, out); }, kRowGrain);
 }
 
 SparseRowMatrix SymmetricBlockMatrix::expanded() const {

@@ -49,10 +49,14 @@ class SymmetricBlockMatrix {
   // y = A u; u and y hold 3 values per block row and must differ (y resized).
   void multiply(const Eigen::VectorXd& u, Eigen::VectorXd& y) const;
   void multiply(const double* u, double* y) const;  // 3 rows() values each
+  // Rows `which` of y = A u only (a solve split among processes computes its own rows).
+  void multiplyRows(const double* u, double* y, std::span<const int> which) const;
   // The same matrix in scalar CSR, 3 x 3 entries per block (for multigrid setups).
   SparseRowMatrix expanded() const;
 
  private:
+  void multiplyRow(std::size_t r, const double* u, double* y) const;
+
   std::vector<int> rowStart_, columns_;
   std::vector<SymmetricBlock<double>> diagonal_;
   std::vector<SymmetricBlock<float>> blocks_;  // the pattern's, and one of padding (multiply's wide loads)

@@ -179,6 +179,13 @@ NewmarkStats NewmarkStepper::solveHalfStep(const MassSpringSystem& system, const
   return stats;
 }
 
+void NewmarkStepper::setSplit(const ParticleSplit* split) {
+  if (split && settings_.preconditioner != SolvePreconditioner::Jacobi)
+    throw std::invalid_argument("Newmark step: a solve split among processes needs the block-Jacobi preconditioner");
+  split_ = split;
+  owned_.clear();
+}
+
 // Solves A out = rhs from the residual rhs - A out already in residual_.
 NewmarkStats NewmarkStepper::conjugateGradients(const MassSpringSystem& system, double h, double rhsNorm2,
                                                  std::vector<Vec3>& out) {
@@ -190,7 +197,26 @@ NewmarkStats NewmarkStepper::conjugateGradients(const MassSpringSystem& system, 
   numerics::SparseCgStats solve;
   const numerics::SymmetricBlockMatrix& A = matrix_.matrix();
   const auto product = [&A](const Eigen::VectorXd& u, Eigen::VectorXd& y) { A.multiply(u, y); };
-  if (settings_.preconditioner == SolvePreconditioner::Multigrid) {
+  if (split_) {
+    // Selle ch. 8.2: this process's rows of r, z and the search direction (the others' stay 0:
+    // block-Jacobi keeps rows apart), the search direction's rows shared before each product, the
+    // dot products summed over the processes; x's other rows stay put and come from their owners.
+    if (owned_.size() != system.size()) {
+      owned_.assign(system.size(), 0);
+      for (const int p : split_->owned()) owned_[static_cast<std::size_t>(p)] = 1;
+    }
+    for (std::size_t p = 0; p < system.size(); ++p)
+      if (!owned_[p]) residualVector_.segment<3>(static_cast<Eigen::Index>(3 * p)).setZero();
+    const auto splitProduct = [&](const Eigen::VectorXd& u, Eigen::VectorXd& y) {
+      sharedSearch_ = u;
+      split_->shareOwned(sharedSearch_.data());
+      y.setZero(unknowns);
+      A.multiplyRows(sharedSearch_.data(), y.data(), split_->owned());
+    };
+    solve = numerics::preconditionedCg(splitProduct, jacobi_, unknowns_, residualVector_, target2, settings_.cgMaxIterations,
+                                       workspace_, [this](double local) { return split_->sum(local); });
+    split_->shareOwned(unknowns_.data());
+  } else if (settings_.preconditioner == SolvePreconditioner::Multigrid) {
     const bool setup = stale_ || multigridParticles_ != system.size() || std::abs(h - multigridH_) > 0.25 * multigridH_;
     if (setup) {
       // The coarse levels carry each aggregate's rigid motions: translations, and rotations, which

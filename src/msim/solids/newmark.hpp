@@ -31,6 +31,7 @@
 #include "msim/solids/body_contact.hpp"
 #include "msim/solids/mass_spring.hpp"
 #include "msim/solids/newmark_matrix.hpp"
+#include "msim/solids/particle_split.hpp"
 #include "msim/solids/self_repulsion.hpp"
 
 namespace msim::solids {
@@ -70,6 +71,12 @@ class NewmarkStepper {
   NewmarkStats step(MassSpringSystem& system, double dt, const BodyContact* bodies = nullptr,
                     SelfRepulsion* repulsion = nullptr);
   const NewmarkSettings& settings() const { return settings_; }
+  // Splits the solves' rows among processes (particle_split.hpp; null: this process alone): each
+  // computes its own particles' rows of every product and the dot products over them, summed over
+  // the processes, and the answer's rows are shared after each solve. The forces and the matrix
+  // are evaluated whole on every process. Block-Jacobi only (std::invalid_argument with multigrid,
+  // whose V-cycle mixes the rows).
+  void setSplit(const ParticleSplit* split);
 
  private:
   // Backward Euler over h from velocity `from`, the elasticity taken where the positions `base`
@@ -116,6 +123,9 @@ class NewmarkStepper {
   double multigridRate_ = 0.0;  // its log10 residual reduction per iteration when new (0: not yet measured)
   std::size_t multigridParticles_ = 0;
   Eigen::VectorXd unknowns_, residualVector_;
+  const ParticleSplit* split_ = nullptr;
+  std::vector<char> owned_;     // per particle, with a split: whether this process computes its rows
+  Eigen::VectorXd sharedSearch_;  // with a split: the search direction with every process's rows
   numerics::SparseCgWorkspace workspace_;
 };
 

@@ -174,34 +174,43 @@ void SelfRepulsion::gatherContacts(const std::vector<Vec3>& x) {
 }
 
 int SelfRepulsion::respond(Pass pass, std::vector<Vec3>& v, const std::vector<double>& inverseMass, double dt) const {
-  const double h = settings_.thickness;
-  for (const Contact& c : contacts_) {
-    const double im = c.stencil.inverseMass(inverseMass);
-    if (!(im > 0.0)) continue;
-    const Vec3 rel = c.stencil.relative(v);
-    const double vN = rel.dot(c.normal);
-    switch (pass) {
-      case Pass::Inelastic:
-        if (vN < 0.0) c.stencil.changeRelative(-vN * c.normal, inverseMass, v);
-        break;
-      case Pass::Elastic: {
-        const double d = h - c.gap;                     // eq. 6.2's overlap
-        const double cap = 0.1 * d / dt - vN;           // eq. 6.1's bound, as a velocity change
-        if (cap > 0.0) c.stencil.changeRelative(std::min(dt * settings_.stiffness * d * im, cap) * c.normal, inverseMass, v);
-        break;
-      }
-      case Pass::EndOfStep: {
-        if (!(vN < 0.0)) break;
-        const Vec3 tangential = rel - vN * c.normal;
-        const double speed = tangential.norm();
-        Vec3 change = -vN * c.normal;
-        if (speed > 0.0) change -= std::min(settings_.friction * -vN / speed, 1.0) * tangential;
-        c.stencil.changeRelative(change, inverseMass, v);
-        break;
-      }
-    }
+  if (split_) {
+    contactParticles_.resize(contacts_.size());
+    for (std::size_t i = 0; i < contacts_.size(); ++i) contactParticles_[i] = contacts_[i].stencil.node;
+    split_->gaussSeidel(contactParticles_, v, [&](std::size_t i) { respond(pass, contacts_[i], v, inverseMass, dt); });
+  } else {
+    for (const Contact& c : contacts_) respond(pass, c, v, inverseMass, dt);
   }
   return static_cast<int>(contacts_.size());
+}
+
+void SelfRepulsion::respond(Pass pass, const Contact& c, std::vector<Vec3>& v, const std::vector<double>& inverseMass,
+                            double dt) const {
+  const double h = settings_.thickness;
+  const double im = c.stencil.inverseMass(inverseMass);
+  if (!(im > 0.0)) return;
+  const Vec3 rel = c.stencil.relative(v);
+  const double vN = rel.dot(c.normal);
+  switch (pass) {
+    case Pass::Inelastic:
+      if (vN < 0.0) c.stencil.changeRelative(-vN * c.normal, inverseMass, v);
+      break;
+    case Pass::Elastic: {
+      const double d = h - c.gap;                     // eq. 6.2's overlap
+      const double cap = 0.1 * d / dt - vN;           // eq. 6.1's bound, as a velocity change
+      if (cap > 0.0) c.stencil.changeRelative(std::min(dt * settings_.stiffness * d * im, cap) * c.normal, inverseMass, v);
+      break;
+    }
+    case Pass::EndOfStep: {
+      if (!(vN < 0.0)) break;
+      const Vec3 tangential = rel - vN * c.normal;
+      const double speed = tangential.norm();
+      Vec3 change = -vN * c.normal;
+      if (speed > 0.0) change -= std::min(settings_.friction * -vN / speed, 1.0) * tangential;
+      c.stencil.changeRelative(change, inverseMass, v);
+      break;
+    }
+  }
 }
 
 }  // namespace msim::solids

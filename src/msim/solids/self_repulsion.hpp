@@ -21,6 +21,7 @@
 #include "msim/core/vec.hpp"
 #include "msim/solids/collision_pairs.hpp"
 #include "msim/solids/contact_stencil.hpp"
+#include "msim/solids/particle_split.hpp"
 
 namespace msim::solids {
 
@@ -53,6 +54,12 @@ class SelfRepulsion {
                             double dt);
   int repelEndVelocity(const std::vector<Vec3>& x, std::vector<Vec3>& v, const std::vector<double>& inverseMass);
 
+  // Runs the Gauss-Seidel passes in the two phases of a split among processes (particle_split.hpp;
+  // null: this process alone). Every process holds every position, so each gathers the same
+  // contacts; the passes' order is then the phases' (the contacts that span processes, in connected
+  // groups, before each process's own) instead of the pairs'.
+  void setSplit(const ParticleSplit* split) { split_ = split; }
+
   RepulsionStats stats() const { return {static_cast<int>(pointTriangle_.size()), static_cast<int>(edgeEdge_.size())}; }
 
  private:
@@ -71,6 +78,8 @@ class SelfRepulsion {
   void gatherContacts(const std::vector<Vec3>& x);
   // One Gauss-Seidel pass over the gathered contacts; returns their count.
   int respond(Pass pass, std::vector<Vec3>& v, const std::vector<double>& inverseMass, double dt) const;
+  // Contact c's impulse of the pass.
+  void respond(Pass pass, const Contact& c, std::vector<Vec3>& v, const std::vector<double>& inverseMass, double dt) const;
 
   struct PointTriangleHistory {
     PointTrianglePair pair;
@@ -107,6 +116,8 @@ class SelfRepulsion {
   std::vector<Vec3> gatheredAt_;
   std::vector<char> moved_;
   bool gatheredValid_ = false;
+  const ParticleSplit* split_ = nullptr;
+  mutable std::vector<std::array<int, 4>> contactParticles_;  // with a split: each contact's stencil's particles
 };
 
 }  // namespace msim::solids

@@ -16,6 +16,8 @@
 #include "msim/io/obj.hpp"
 #include "msim/io/ply.hpp"
 #include "msim/io/vdb.hpp"
+#include "msim/parallel/mpi_session.hpp"
+#include "msim/parallel/split_cloth.hpp"
 #include "msim/render/camera.hpp"
 #include "msim/render/density_preview.hpp"
 #include "msim/render/frame_renderer.hpp"
@@ -232,6 +234,7 @@ class MassSpringPhenomenon final : public Phenomenon {
     stepper_ = solids::NewmarkStepper(settings);
     strainLimit_ = c.at("strain_limit").get<double>();
     if (collisionLoop) buildCollisionLoop(c, settings);
+    if (parallel::worldSize() > 1) splitAmongProcesses(settings);
     implicitSprings_ = settings.implicitSprings;
     springMass_.resize(system_.springs.size());
     for (std::size_t i = 0; i < system_.springs.size(); ++i) {
@@ -578,6 +581,25 @@ class MassSpringPhenomenon final : public Phenomenon {
     loop_ = std::make_unique<solids::ClothCollisionLoop>(mesh_.triangles, system_.size(), newmark, settings);
   }
 
+  // Under mpirun (Selle ch. 8.2): the particles cut by the recursive median at their starting
+  // places, every process holding the whole cloth; the inner steps' solves and repulsions split
+  // (solids/particle_split.hpp), everything else run alike on every process, so that all keep the
+  // same state and rank 0 writes it.
+  void splitAmongProcesses(const solids::NewmarkSettings& settings) {
+    const int ranks = parallel::worldSize();
+    if ((ranks & (ranks - 1)) != 0)
+      throw InputError(fmt::format("{}: a {} splits among a power of two processes (the recursive median cuts of Selle "
+                                   "ch. 8.2), not {}: run it with mpirun -np 2, 4, 8, ...",
+                                   source_, kind_, ranks));
+    if (settings.preconditioner != solids::SolvePreconditioner::Jacobi)
+      throw InputError(fmt::format("{}: '{}.preconditioner' multigrid does not split among processes (its V-cycle mixes "
+                                   "the processes' rows); use \"jacobi\" under mpirun",
+                                   source_, kind_));
+    split_ = std::make_unique<parallel::SplitCloth>(system_.x, MPI_COMM_WORLD);
+    stepper_.setSplit(split_.get());
+    if (loop_) loop_->setSplit(split_.get());
+  }
+
   // The largest stretch of any spring (compression, of bending springs across a fold above all, is
   // not a failure).
   double maxStrain() const {
@@ -668,6 +690,7 @@ class MassSpringPhenomenon final : public Phenomenon {
   solids::NewmarkStepper stepper_;
   std::vector<Script> scripts_;
   std::unique_ptr<solids::ClothCollisionLoop> loop_;  // cloth with self-collisions
+  std::unique_ptr<parallel::SplitCloth> split_;         // under mpirun
   solids::ClothCollisionStats last_;                  // of the last outer step
   long unresolvedSteps_ = 0;
   bool implicitSprings_ = true;
@@ -696,7 +719,7 @@ std::unique_ptr<Phenomenon> createSolid(const Scene& scene, StageTimers& timers)
 
 PhenomenonType clothPhenomenonType() {
   return {"cloth", "a mass-spring cloth on bodies with friction (Selle ch. 5-6)", &declareCloth, &massSpringBytesPerCell,
-          &createCloth};
+          &createCloth, true};
 }
 
 PhenomenonType solidPhenomenonType() {
