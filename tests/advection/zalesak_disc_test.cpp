@@ -32,7 +32,7 @@ using namespace msim::numerics;
 namespace {
 
 constexpr double kOmega = std::numbers::pi / 314.0;
-constexpr double kFinalTime = 2.0 * std::numbers::pi / kOmega;  // one turn, t = 628
+constexpr double kOneTurn = 2.0 * std::numbers::pi / kOmega;  // one turn, t = 628
 // Nodes outside [0,100]^2 on each side. A BFECC step reads at most 3 building blocks x 2 nodes
 // outwards (the foot moves < 2 dx even at CFL 1.75), so the values the clamped outer edge spoils
 // within a step never reach [0,100]^2 (results are identical with 16).
@@ -86,8 +86,8 @@ std::vector<double> nodeErrors(int nodes, BuildingBlock block, AdvectionScheme s
   }
   const double dt = cfl * dx / (kOmega * 100.0);  // max(|u| + |v|) = 100 omega at the corners
   double t = 0.0;
-  while (t < kFinalTime - 1e-9) {
-    const double step = std::min(dt, kFinalTime - t);
+  while (t < kOneTurn - 1e-9) {
+    const double step = std::min(dt, kOneTurn - t);
     advector.advect(phi, velocity, step);
     t += step;
     for (std::size_t i : ghosts) phi[i] = exact(phi.position(phi.coord(i)), t);
@@ -133,7 +133,7 @@ struct Entry {
 constexpr Entry ok(double v) { return {v, true}; }
 constexpr Entry no(double v) { return {v, false}; }
 
-struct Column {
+struct FigureColumn {
   const char* name;
   AdvectionScheme scheme;
   int ctestNodes;            // finest grid the ctest run goes to (the DISABLED_ tests go to 401^2)
@@ -143,8 +143,8 @@ struct Column {
 
 // Runs each column on grids 101^2, 201^2, ... up to its ctestNodes (or `finest`, if given) and
 // checks the checked entries: errors within 15 %, orders within 0.1.
-void reproduce(BuildingBlock block, double cfl, const std::vector<Column>& table, int finest = 0) {
-  for (const Column& col : table) {
+void reproduceFigure(BuildingBlock block, double cfl, const std::vector<FigureColumn>& table, int finest = 0) {
+  for (const FigureColumn& col : table) {
     std::vector<double> previous;
     // The sanitizer build stops at 201^2: the same errors and the first order, minutes sooner.
     const int top = finest ? finest : test::fullOrSanitized(col.ctestNodes, std::min(col.ctestNodes, 201));
@@ -175,20 +175,20 @@ void reproduce(BuildingBlock block, double cfl, const std::vector<Column>& table
 // 16-30 %, MacCormack by 12-13 % at 201^2 and 21-23 % at 401^2) and their orders higher (2.1-2.3
 // against his 1.6-1.95); those entries are printed, not checked (docs/advection.md).
 
-const std::vector<Column> kFigure2_6 = {
+const std::vector<FigureColumn> kFigure2_6 = {
     {"upwind", AdvectionScheme::FirstOrder, 401, {ok(1.8), ok(9.6e-1), ok(5.2e-1)}, {ok(1.05), ok(1.04)}},
     {"BFECC (upwind)", AdvectionScheme::BFECC, 201, {ok(8.9e-2), no(3.9e-2), no(1.8e-2)}, {no(1.79), no(1.77)}},
     {"MacCormack (upwind)", AdvectionScheme::MacCormack, 201,
      {ok(1.6e-1), ok(6.3e-2), no(3.2e-2)}, {no(1.93), no(1.59)}},
 };
-const std::vector<Column> kFigure2_7 = {
+const std::vector<FigureColumn> kFigure2_7 = {
     {"semi-Lagrangian", AdvectionScheme::FirstOrder, 401, {ok(1.8), ok(1.0), ok(5.4e-1)}, {ok(1.04), ok(1.03)}},
     {"BFECC (semi-Lagrangian)", AdvectionScheme::BFECC, 201,
      {ok(9.9e-2), no(4.1e-2), no(2.0e-2)}, {no(1.73), no(1.67)}},
     {"MacCormack (semi-Lagrangian)", AdvectionScheme::MacCormack, 201,
      {ok(1.7e-1), ok(6.7e-2), no(3.3e-2)}, {no(1.95), no(1.60)}},
 };
-const std::vector<Column> kFigure2_8 = {
+const std::vector<FigureColumn> kFigure2_8 = {
     {"semi-Lagrangian", AdvectionScheme::FirstOrder, 401, {ok(2.0), ok(1.1), ok(5.6e-1)}, {ok(1.02), ok(1.02)}},
     {"BFECC (semi-Lagrangian)", AdvectionScheme::BFECC, 201,
      {ok(5.4e-2), no(2.4e-2), no(1.0e-2)}, {no(1.81), no(1.84)}},
@@ -198,17 +198,17 @@ const std::vector<Column> kFigure2_8 = {
 
 }  // namespace
 
-TEST(ZalesakDisc, Figure2_6_UpwindBuildingBlocksCfl075) { reproduce(BuildingBlock::Upwind, 0.75, kFigure2_6); }
+TEST(ZalesakDisc, Figure2_6_UpwindBuildingBlocksCfl075) { reproduceFigure(BuildingBlock::Upwind, 0.75, kFigure2_6); }
 
 TEST(ZalesakDisc, Figure2_7_SemiLagrangianBuildingBlocksCfl075) {
-  reproduce(BuildingBlock::SemiLagrangian, 0.75, kFigure2_7);
+  reproduceFigure(BuildingBlock::SemiLagrangian, 0.75, kFigure2_7);
 }
 
 TEST(ZalesakDisc, Figure2_8_SemiLagrangianBuildingBlocksCfl175) {
-  reproduce(BuildingBlock::SemiLagrangian, 1.75, kFigure2_8);
+  reproduceFigure(BuildingBlock::SemiLagrangian, 1.75, kFigure2_8);
 }
 
 // Every column to 401^2, for docs/advection.md (minutes; --gtest_also_run_disabled_tests).
-TEST(ZalesakDisc, DISABLED_Figure2_6_To401) { reproduce(BuildingBlock::Upwind, 0.75, kFigure2_6, 401); }
-TEST(ZalesakDisc, DISABLED_Figure2_7_To401) { reproduce(BuildingBlock::SemiLagrangian, 0.75, kFigure2_7, 401); }
-TEST(ZalesakDisc, DISABLED_Figure2_8_To401) { reproduce(BuildingBlock::SemiLagrangian, 1.75, kFigure2_8, 401); }
+TEST(ZalesakDisc, DISABLED_Figure2_6_To401) { reproduceFigure(BuildingBlock::Upwind, 0.75, kFigure2_6, 401); }
+TEST(ZalesakDisc, DISABLED_Figure2_7_To401) { reproduceFigure(BuildingBlock::SemiLagrangian, 0.75, kFigure2_7, 401); }
+TEST(ZalesakDisc, DISABLED_Figure2_8_To401) { reproduceFigure(BuildingBlock::SemiLagrangian, 1.75, kFigure2_8, 401); }

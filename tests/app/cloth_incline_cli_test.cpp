@@ -23,14 +23,14 @@ const double kTheta = std::acos(-1.0) / 5.0;
 const double kGravity = 9.8;
 const Vec3 kDownhill(std::cos(kTheta), -std::sin(kTheta), 0.0);
 const Vec3 kNormal(std::sin(kTheta), std::cos(kTheta), 0.0);  // the slope's, as in the scene file
-const std::string kScene = std::string(MSIM_SOURCE_DIR) + "/scenes/cloth_incline.json";
+const std::string kInclineScene = std::string(MSIM_SOURCE_DIR) + "/scenes/cloth_incline.json";
 const std::string kQuiet = " --set render.enabled=false --set outputs.vdb=false --set outputs.png=false --set outputs.mp4=false";
 
 std::string vec(const Vec3& v) { return fmt::format("[{:.9g},{:.9g},{:.9g}]", v.x(), v.y(), v.z()); }
 
-fs::path run(const std::string& name, const std::string& sets) {
+fs::path runIncline(const std::string& name, const std::string& sets) {
   const fs::path dir = scratch(name);
-  const Result r = runMsim("run " + kScene + " -q --out " + (dir / "out").string() + kQuiet + sets);
+  const Result r = runMsim("run " + kInclineScene + " -q --out " + (dir / "out").string() + kQuiet + sets);
   EXPECT_EQ(r.exitCode, 0) << r.output;
   return dir / "out";
 }
@@ -59,13 +59,13 @@ TEST(ClothIncline, FlatClothSlidesAtTheCoulombRateAndFrictionAboveTanThetaHoldsI
   // differences of frames 2-24 (16 inner steps of the collision loop each), is the particle's
   // g (sin theta - mu cos theta) = 1.7969 m/s^2; a tolerance of the solve that grew with the
   // cloth's speed lost 5% of it by 2.6 m/s. mu = 0.9: static friction holds the cloth.
-  const fs::path sliding = run("cloth_incline_slide", flatOnTheSlope(0.5));
+  const fs::path sliding = runIncline("cloth_incline_slide", flatOnTheSlope(0.5));
   const double dt = 1.0 / 24.0, expected = kGravity * (std::sin(kTheta) - 0.5 * std::cos(kTheta));
   std::vector<double> s;
   for (int f = 2; f <= 24; ++f) s.push_back(downhill(frame(sliding, f)));
   for (std::size_t k = 1; k + 1 < s.size(); ++k)
     EXPECT_NEAR((s[k + 1] - 2.0 * s[k] + s[k - 1]) / (dt * dt), expected, 0.005 * expected) << "frame " << k + 2;
-  const fs::path held = run("cloth_incline_hold", flatOnTheSlope(0.9));
+  const fs::path held = runIncline("cloth_incline_hold", flatOnTheSlope(0.9));
   EXPECT_LT(std::abs(downhill(frame(held, 24)) - downhill(frame(held, 1))), 1e-4);
   EXPECT_LT(readJson(held / "run.json").at("frames").back().at("kinetic_energy_J").get<double>(), 1e-9);
 }
@@ -75,7 +75,7 @@ TEST(ClothIncline, ThrownClothRollsOverTheEdgeItLandsOnAndComesToRest) {
   // at it; its lower edge (vertices i = 24 of each row) lands first, and the upper edge (i = 0)
   // comes over it to lie further down the slope. mu = 0.9 > tan theta: it ends at rest, with no
   // vertex in the slope and no intersecting triangle pair in any frame.
-  const fs::path out = run("cloth_incline_roll", " --set 'cloth.patch.quads=[24,15]'");
+  const fs::path out = runIncline("cloth_incline_roll", " --set 'cloth.patch.quads=[24,15]'");
   const std::vector<Vec3> last = frame(out, 36);
   double upper = 0.0, lower = 0.0;
   for (int j = 0; j <= 15; ++j) {

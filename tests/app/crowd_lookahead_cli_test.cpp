@@ -18,9 +18,9 @@ namespace {
 
 using nlohmann::json;
 
-const std::string kScene = std::string(MSIM_SOURCE_DIR) + "/scenes/crowd_lookahead_swap.json";
+const std::string kSwapScene = std::string(MSIM_SOURCE_DIR) + "/scenes/crowd_lookahead_swap.json";
 
-json run(const std::string& name, const std::string& sets, const std::string& scene = kScene) {
+json runLookahead(const std::string& name, const std::string& sets, const std::string& scene = kSwapScene) {
   const fs::path dir = scratch(name);
   const Result r = runMsim("run " + scene + " -q --out " + (dir / "out").string() +
                            " --set outputs.png=false --set outputs.mp4=false --set outputs.vdb=false" + sets);
@@ -52,8 +52,8 @@ TEST(CrowdLookahead, CurtailingBeatsConstantLookaheadOnTheSwap) {
   double constant = 0.0, curtailed = 0.0, constant90 = 0.0, curtailed90 = 0.0;
   for (int seed = 1; seed <= kLayouts; ++seed) {
     const std::string layout = " --set crowd.seed=" + std::to_string(seed);
-    const json c = run("lookahead_constant_" + std::to_string(seed), layout + " --set crowd.lookahead.sigma_max=0");
-    const json l = run("lookahead_curtailed_" + std::to_string(seed), layout);
+    const json c = runLookahead("lookahead_constant_" + std::to_string(seed), layout + " --set crowd.lookahead.sigma_max=0");
+    const json l = runLookahead("lookahead_curtailed_" + std::to_string(seed), layout);
     ASSERT_FALSE(c.empty());
     ASSERT_FALSE(l.empty());
     for (const json* r : {&c, &l}) EXPECT_EQ(r->at("frames").back().at("agents").get<int>(), 0);
@@ -77,8 +77,8 @@ TEST(CrowdLookahead, ContinuumLookaheadShortensTheFourGroups) {
   double plain = 0.0, ahead = 0.0;
   for (int seed = 1; seed <= 2; ++seed) {
     const std::string layout = " --set crowd.seed=" + std::to_string(seed);
-    const json p = run("four_groups_plain_" + std::to_string(seed), layout + " --set crowd.lookahead.levels=0", scene);
-    const json a = run("four_groups_ahead_" + std::to_string(seed), layout, scene);
+    const json p = runLookahead("four_groups_plain_" + std::to_string(seed), layout + " --set crowd.lookahead.levels=0", scene);
+    const json a = runLookahead("four_groups_ahead_" + std::to_string(seed), layout, scene);
     ASSERT_FALSE(p.empty());
     ASSERT_FALSE(a.empty());
     plain += completion(p);
@@ -98,7 +98,7 @@ TEST(CrowdLookahead, HybridBlendsDiscreteAndContinuumAnswers) {
   // no two come closer than 0.4 of a diameter (measured 0.55; plain ORCA itself comes to 0.75 of
   // one here).
   const std::string scene = std::string(MSIM_SOURCE_DIR) + "/scenes/crowd_lookahead_four_way.json";
-  const json r = run("four_way_hybrid", " --set time.duration=45", scene);
+  const json r = runLookahead("four_way_hybrid", " --set time.duration=45", scene);
   ASSERT_FALSE(r.empty());
   double largest = 0.0;
   for (const json& f : r.at("frames")) {
@@ -119,7 +119,7 @@ TEST(CrowdLookahead, BadSettingsNameTheirKey) {
   // thresholds in the wrong order: exit 2 naming the key, no frames.
   std::string scene;
   {
-    std::ifstream in(kScene);
+    std::ifstream in(kSwapScene);
     scene.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
   const std::string lookahead = R"("lookahead": {"levels": 8, "sigma_max": 1.0})";

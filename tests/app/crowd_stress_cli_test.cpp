@@ -15,7 +15,7 @@ namespace {
 
 using nlohmann::json;
 
-const std::string kScene = std::string(MSIM_SOURCE_DIR) + "/scenes/crowd_stress_merge.json";
+const std::string kMergeScene = std::string(MSIM_SOURCE_DIR) + "/scenes/crowd_stress_merge.json";
 const std::string kLoveParade = std::string(MSIM_SOURCE_DIR) + "/scenes/crowd_love_parade.json";
 
 // run.json of `scene` run for `seconds` without pictures into dir/out (an empty object on failure).
@@ -30,7 +30,7 @@ json runScene(const std::string& scene, const fs::path& dir, int seconds) {
 
 TEST(CrowdStressCli, MergePacksPastTheCriticalDensityAndEverySolveConverges) {
   const fs::path dir = scratch("stress_merge");
-  const json run = runScene(kScene, dir, 40);
+  const json run = runScene(kMergeScene, dir, 40);
   ASSERT_FALSE(run.empty());
   const json& stress = run.at("results").at("stress");
   EXPECT_GT(stress.at("friction_solves").get<long>(), 0);
@@ -86,7 +86,7 @@ TEST(CrowdStressCli, BadSettingsNameTheirKey) {
   // Densities in the wrong order, friction outside [0, 1]: exit 2 naming the key, no frames.
   std::string scene;
   {
-    std::ifstream in(kScene);
+    std::ifstream in(kMergeScene);
     scene.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
   const std::string turbulence = R"("turbulence": {"enabled": true})";

@@ -15,7 +15,7 @@ namespace {
 using nlohmann::json;
 
 // 12 x 10 x 12 cells of 5 cm: a slab of sand with a ball dropped on it. `extra` adds keys.
-std::string tinyScene(const std::string& extra = "") {
+std::string tinyGranularScene(const std::string& extra = "") {
   return R"({
   "name": "tiny", "phenomenon": "granular",
   "domain": {"min": [0, 0, 0], "max": [0.6, 0.5, 0.6], "resolution": 12},
@@ -35,7 +35,7 @@ std::string tinyScene(const std::string& extra = "") {
 
 TEST(GranularCli, TinySceneWritesParticlesBodiesVdbAndPng) {
   const fs::path dir = scratch("granular_tiny");
-  writeText(dir / "s.json", replaced(tinyScene(), R"("outputs": {"mp4": false},)",
+  writeText(dir / "s.json", replaced(tinyGranularScene(), R"("outputs": {"mp4": false},)",
                                      R"("outputs": {"mp4": false}, "granular": {"render_points_per_particle": 2},)"));
   const Result r = runMsim("run " + (dir / "s.json").string() + " -q --out " + (dir / "out").string());
   ASSERT_EQ(r.exitCode, 0) << r.output;
@@ -81,7 +81,7 @@ TEST(GranularCli, TinySceneWritesParticlesBodiesVdbAndPng) {
 
 TEST(GranularCli, ResumeContinuesFromTheLastFrame) {
   const fs::path dir = scratch("granular_resume");
-  writeText(dir / "s.json", replaced(tinyScene(), R"("duration": 0.1)", R"("duration": 0.15)"));
+  writeText(dir / "s.json", replaced(tinyGranularScene(), R"("duration": 0.1)", R"("duration": 0.15)"));
   const std::string run = "run " + (dir / "s.json").string() + " -q --out " + (dir / "out").string();
   ASSERT_EQ(runMsim(run + " --frames 2").exitCode, 0);
   const Result resumed = runMsim(run + " --resume");
@@ -95,7 +95,7 @@ TEST(GranularCli, ResumeContinuesFromTheLastFrame) {
 
 TEST(GranularCli, ResumeWithRenderPointsSamplesThemAgain) {
   const fs::path dir = scratch("granular_resume_points");
-  writeText(dir / "s.json", replaced(tinyScene(), R"("outputs": {"mp4": false},)",
+  writeText(dir / "s.json", replaced(tinyGranularScene(), R"("outputs": {"mp4": false},)",
                                      R"("outputs": {"mp4": false}, "granular": {"render_points_per_particle": 2},)"));
   const std::string run = "run " + (dir / "s.json").string() + " -q --out " + (dir / "out").string();
   ASSERT_EQ(runMsim(run + " --frames 1").exitCode, 0);
@@ -111,7 +111,7 @@ TEST(GranularCli, ResumeWithRenderPointsSamplesThemAgain) {
 }
 
 TEST(GranularCli, BadInputNamesTheKey) {
-  const std::string scene = tinyScene();
+  const std::string scene = tinyGranularScene();
   expectInputError("granular_zero_density", replaced(scene, R"("density": 2600)", R"("density": 0)"),
                    {"materials[1].density"});
   expectInputError("granular_negative_density", replaced(scene, R"("density": 2600)", R"("density": -5)"),

@@ -80,7 +80,7 @@ void expectSplatConservesMass(int base, std::size_t n) {
 }
 
 template <int D>
-double linearField(const Vec<D>& x) {
+double linearTransferField(const Vec<D>& x) {
   double f = 0.25;
   for (int a = 0; a < D; ++a) f += (0.6 - 0.35 * a) * x[a];
   return f;
@@ -106,12 +106,12 @@ void expectGatherExactOnLinearFields() {
   std::vector<Grid<float, D>> grids{Grid<float, D>(spec)};
   for (int a = 0; a < D; ++a) grids.push_back(mac.component(a));
   for (Grid<float, D>& g : grids) {
-    for (std::size_t i = 0; i < g.count(); ++i) g[i] = float(linearField<D>(g.position(g.coord(i))));
+    for (std::size_t i = 0; i < g.count(); ++i) g[i] = float(linearTransferField<D>(g.position(g.coord(i))));
     const auto positions = interiorPositions(g, 3000, rng);
     for (TransferKernel kernel : kKernels) {
       const std::vector<float> got = gather<D>(g, positions, kernel);
       for (std::size_t p = 0; p < positions.size(); ++p)
-        ASSERT_NEAR(got[p], linearField<D>(positions[p].template cast<double>()), 1e-6);
+        ASSERT_NEAR(got[p], linearTransferField<D>(positions[p].template cast<double>()), 1e-6);
     }
   }
 }

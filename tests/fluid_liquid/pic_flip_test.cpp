@@ -13,12 +13,12 @@ using namespace msim::fluid;
 
 namespace {
 
-struct Outcome {
+struct DamBreakOutcome {
   double maxHeight = 0.0;     // highest liquid cell centre plus its part of a cell [m]
   double kineticEnergy = 0.0; // [J per m of depth]
 };
 
-Outcome damBreakAt048(double flipRatio) {
+DamBreakOutcome damBreakAt048(double flipRatio) {
   const GridSpec<2> spec(Vec2::Zero(), 1.0 / 80.0, IVec2(80, 80));  // 1 m x 1 m, closed
   LiquidParams<2> params;
   params.tracker = InterfaceTracker::Flip;
@@ -31,7 +31,7 @@ Outcome damBreakAt048(double flipRatio) {
     solver.step(dt);
     t += dt;
   }
-  Outcome o;
+  DamBreakOutcome o;
   const Grid<float, 2>& phi = solver.phi();
   for (std::size_t i = 0; i < phi.count(); ++i)
     if (phi[i] < 0.0f) o.maxHeight = std::max(o.maxHeight, phi.position(phi.coord(i))[1] - double(phi[i]));
@@ -42,7 +42,7 @@ Outcome damBreakAt048(double flipRatio) {
 }  // namespace
 
 TEST(LiquidPicFlip, FlipKeepsAHigherRunUpAndMoreEnergyThanPic) {
-  const Outcome flip = damBreakAt048(0.95), pic = damBreakAt048(0.0);
+  const DamBreakOutcome flip = damBreakAt048(0.95), pic = damBreakAt048(0.0);
   RecordProperty("max_height_flip", std::to_string(flip.maxHeight));
   RecordProperty("max_height_pic", std::to_string(pic.maxHeight));
   RecordProperty("kinetic_energy_flip", std::to_string(flip.kineticEnergy));

@@ -13,7 +13,7 @@ using namespace msim::fluid;
 
 namespace {
 
-const GridSpec<3> kDomain(Vec3::Zero(), 0.1, IVec3(10, 20, 10));
+const GridSpec<3> kSeedingDomain(Vec3::Zero(), 0.1, IVec3(10, 20, 10));
 
 VortexSeedSettings<3> boxSettings() {
   VortexSeedSettings<3> s;
@@ -40,7 +40,7 @@ TEST(VortexSeeding, RandomSeedingFillsTheBoxWithIsotropicDirections) {
   VortexParticles<3> particles;
   Rng rng(42);
   const std::size_t n = 4000;
-  EXPECT_EQ(seedVortexParticles<3>(particles, boxSettings(), kDomain, n, rng), n);
+  EXPECT_EQ(seedVortexParticles<3>(particles, boxSettings(), kSeedingDomain, n, rng), n);
   ASSERT_EQ(particles.size(), n);
   Eigen::Vector3d meanDirection = Eigen::Vector3d::Zero();
   Vec3 meanPosition = Vec3::Zero();
@@ -68,7 +68,7 @@ TEST(VortexSeeding, AzimuthalVorticityIsTangentToTheVerticalCylinder) {
   s.vorticity = SeedVorticity::Azimuthal;
   VortexParticles<3> particles;
   Rng rng(4);
-  seedVortexParticles<3>(particles, s, kDomain, 500, rng);
+  seedVortexParticles<3>(particles, s, kSeedingDomain, 500, rng);
   const Vec3 centre(0.4, 0.3, 0.5);
   for (std::size_t p = 0; p < particles.size(); ++p) {
     const Eigen::Vector3d w = particles.vorticities()[p] / 2e-3;
@@ -85,7 +85,7 @@ TEST(VortexSeeding, VerticalVorticityPointsUpOrDownInEqualShares) {
   s.vorticity = SeedVorticity::Vertical;
   VortexParticles<3> particles;
   Rng rng(5);
-  seedVortexParticles<3>(particles, s, kDomain, 1000, rng);
+  seedVortexParticles<3>(particles, s, kSeedingDomain, 1000, rng);
   int up = 0;
   for (std::size_t p = 0; p < particles.size(); ++p) {
     const Eigen::Vector3d w = particles.vorticities()[p];
@@ -98,7 +98,7 @@ TEST(VortexSeeding, VerticalVorticityPointsUpOrDownInEqualShares) {
 }
 
 TEST(VortexSeeding, LocalFlowTakesTheGridVorticityAndSkipsCalmRegions) {
-  Vorticity<3> flow(kDomain);
+  Vorticity<3> flow(kSeedingDomain);
   for (std::size_t i = 0; i < flow.count(); ++i)
     flow[i] = flow.position(flow.coord(i)).x() < 0.45 ? Eigen::Vector3f(0, 0, 3.0f) : Eigen::Vector3f::Zero();
   auto s = boxSettings();
@@ -108,17 +108,17 @@ TEST(VortexSeeding, LocalFlowTakesTheGridVorticityAndSkipsCalmRegions) {
   s.minimumFlowVorticity = 0.1;
   VortexParticles<3> particles;
   Rng rng(8);
-  EXPECT_EQ(seedVortexParticles<3>(particles, s, kDomain, 100, rng, &flow), 100u);
+  EXPECT_EQ(seedVortexParticles<3>(particles, s, kSeedingDomain, 100, rng, &flow), 100u);
   for (const auto& w : particles.vorticities()) ASSERT_LT((w - Eigen::Vector3d(0, 0, 3)).norm(), 1e-6);
 
   s.regionMin.x() = 0.6;
   s.regionMax.x() = 0.9;  // calm
-  EXPECT_EQ(seedVortexParticles<3>(particles, s, kDomain, 100, rng, &flow), 0u);
-  EXPECT_THROW(seedVortexParticles<3>(particles, s, kDomain, 1, rng), std::invalid_argument);  // no grid given
+  EXPECT_EQ(seedVortexParticles<3>(particles, s, kSeedingDomain, 100, rng, &flow), 0u);
+  EXPECT_THROW(seedVortexParticles<3>(particles, s, kSeedingDomain, 1, rng), std::invalid_argument);  // no grid given
 }
 
 TEST(VortexSeeding, EmitterKeepsItsRateOverUnevenSteps) {
-  VortexEmitter<3> emitter(boxSettings(), kDomain, 1200.0, 99);
+  VortexEmitter<3> emitter(boxSettings(), kSeedingDomain, 1200.0, 99);
   VortexParticles<3> particles;
   double t = 0.0;
   for (int step = 0; step < 37; ++step) {
@@ -129,7 +129,7 @@ TEST(VortexSeeding, EmitterKeepsItsRateOverUnevenSteps) {
   }
   std::printf("  %zu particles after %.4f s at 1200/s (%.1f expected)\n", particles.size(), t, 1200.0 * t);
   // The same seed and steps give the same particles.
-  VortexEmitter<3> again(boxSettings(), kDomain, 1200.0, 99);
+  VortexEmitter<3> again(boxSettings(), kSeedingDomain, 1200.0, 99);
   VortexParticles<3> copy;
   for (int step = 0; step < 37; ++step) again.emit(copy, 0.004 + 0.0003 * (step % 5));
   EXPECT_EQ(copy.positions(), particles.positions());
@@ -138,7 +138,7 @@ TEST(VortexSeeding, EmitterKeepsItsRateOverUnevenSteps) {
 TEST(VortexSeeding, BadInputIsRejectedNamingTheField) {
   auto outside = boxSettings();
   outside.regionMax.x() = 1.5;  // the domain ends at x = 1
-  EXPECT_NE(messageOf([&] { outside.validate(kDomain, "smoke.vortex_particles.seed"); })
+  EXPECT_NE(messageOf([&] { outside.validate(kSeedingDomain, "smoke.vortex_particles.seed"); })
                 .find("smoke.vortex_particles.seed.region"),
             std::string::npos);
   // A box drawn to the domain's bounds as written passes, however dx rounds (4.8 / 96 * 32 < 1.6).
@@ -149,14 +149,14 @@ TEST(VortexSeeding, BadInputIsRejectedNamingTheField) {
   EXPECT_NO_THROW(toTheWall.validate(river));
   auto inverted = boxSettings();
   inverted.regionMin.y() = 0.8;
-  EXPECT_NE(messageOf([&] { inverted.validate(kDomain); }).find("exceeds"), std::string::npos);
+  EXPECT_NE(messageOf([&] { inverted.validate(kSeedingDomain); }).find("exceeds"), std::string::npos);
   auto radius = boxSettings();
   radius.radius = -0.1;
-  EXPECT_NE(messageOf([&] { radius.validate(kDomain, "s"); }).find("s.radius"), std::string::npos);
+  EXPECT_NE(messageOf([&] { radius.validate(kSeedingDomain, "s"); }).find("s.radius"), std::string::npos);
   auto strength = boxSettings();
   strength.strength = -1.0;
-  EXPECT_NE(messageOf([&] { strength.validate(kDomain, "s"); }).find("s.strength"), std::string::npos);
-  EXPECT_THROW(VortexEmitter<3>(boxSettings(), kDomain, -5.0, 1), std::invalid_argument);
+  EXPECT_NE(messageOf([&] { strength.validate(kSeedingDomain, "s"); }).find("s.strength"), std::string::npos);
+  EXPECT_THROW(VortexEmitter<3>(boxSettings(), kSeedingDomain, -5.0, 1), std::invalid_argument);
 
   VortexParticles<3> particles;
   EXPECT_THROW(particles.add(Vec3::Zero(), Eigen::Vector3d::UnitX(), -0.1, 1.0), std::invalid_argument);

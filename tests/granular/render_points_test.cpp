@@ -12,7 +12,7 @@
 namespace msim::granular {
 namespace {
 
-constexpr double kDx = 0.1;
+constexpr double kPointsDx = 0.1;
 
 double worstDistance(const RenderPoints& points, const GranularParticles& p) {
   double worst = 0.0;
@@ -45,7 +45,7 @@ TEST(GranularRenderPoints, SamplesAreUniformInTheEllipsoid) {
 }
 
 TEST(GranularRenderPoints, FollowTheFlowInsideTheirParticlesThroughSplits) {
-  const GridSpec<3> grid(Vec3::Zero(), kDx, IVec3::Constant(24));
+  const GridSpec<3> grid(Vec3::Zero(), kPointsDx, IVec3::Constant(24));
   const Vec3 centre = Vec3::Constant(1.2);
   Eigen::Matrix3d g;
   g << 0.9, 0.3, 0.0, -0.1, 0.6, 0.1, 0.0, 0.1, 0.4;
@@ -78,7 +78,7 @@ TEST(GranularRenderPoints, FollowTheFlowInsideTheirParticlesThroughSplits) {
   }
   const double worstAfterAdvection = worstDistance(points, p);
   // Then with split/merge every step: points follow a child of their particle.
-  SplitMerge splitMerge(particleRadius(kDx));
+  SplitMerge splitMerge(particleRadius(kPointsDx));
   std::size_t splits = 0, resampled = 0;
   for (int step = 0; step < 20; ++step) {
     advectParticles(p, velocity, dt, {}, &motion);
@@ -103,7 +103,7 @@ TEST(GranularRenderPoints, FollowTheFlowInsideTheirParticlesThroughSplits) {
 
 TEST(GranularRenderPoints, MergedParticleTakesBothSetsOfPoints) {
   Eigen::Matrix3d thin = Vec3(0.3, 1.0, 1.0).asDiagonal();
-  const double r = particleRadius(kDx);
+  const double r = particleRadius(kPointsDx);
   thin *= r * r;
   GranularParticles p;
   p.append(Vecf<3>(1, 1, 1), Vecf<3>::Zero(), 1.0f, toShape(thin), 0);

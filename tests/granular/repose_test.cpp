@@ -21,24 +21,24 @@ using namespace msim::granular;
 
 namespace {
 
-constexpr double kDx = 0.025, kWidth = 0.1;
+constexpr double kReposeDx = 0.025, kReposeWidth = 0.1;
 
 double predictedRepose(double alpha) {
   return std::min(std::atan(alpha / (1.0 - alpha)) * 180.0 / std::numbers::pi, 45.0);
 }
 
-// A block kWidth wide against the left wall, then a slope at `degrees` down to the floor; runs one
+// A block kReposeWidth wide against the left wall, then a slope at `degrees` down to the floor; runs one
 // second and returns the final slope angle (a line fitted to the surface heights between 20% and
 // 80% of the top, z-averaged).
 double slopeAfterOneSecond(double alpha, double degrees, double height) {
   GranularSettings s;
-  s.grid = GridSpec<3>(Vec3::Zero(), kDx, IVec3(48, 20, 4));
+  s.grid = GridSpec<3>(Vec3::Zero(), kReposeDx, IVec3(48, 20, 4));
   s.stress.tolerance = 1e-3;
   s.stress.slipWalls = 1u << 2;  // quasi-2D: the z walls hold nothing
   GranularSimulation sim(s, {GranularMaterial{1600.0, alpha}});
   const double t = std::tan(degrees * std::numbers::pi / 180.0);
   sim.seed(Vec3::Zero(), Vec3(1.2, height, 0.1),
-           [&](const Vec3& x) { return x.x() < kWidth || x.y() < height - (x.x() - kWidth) * t; }, {});
+           [&](const Vec3& x) { return x.x() < kReposeWidth || x.y() < height - (x.x() - kReposeWidth) * t; }, {});
   while (sim.time() < 1.0) sim.step(sim.stableTimestep(1.0 / 60.0));
   sim.step(1e-5);  // the grid fields of the final state
   const GranularGridState& st = sim.gridState();
@@ -54,7 +54,7 @@ double slopeAfterOneSecond(double alpha, double degrees, double height) {
     for (int j = r[1] - 1; j >= 0; --j)
       if (phi(i, j) >= 0.5) {  // the half-full level, interpolated towards the cell above
         const double above = j + 1 < r[1] ? phi(i, j + 1) : 0.0;
-        h[static_cast<std::size_t>(i)] = (j + 0.5 + (phi(i, j) - 0.5) / std::max(phi(i, j) - above, 1e-9)) * kDx;
+        h[static_cast<std::size_t>(i)] = (j + 0.5 + (phi(i, j) - 0.5) / std::max(phi(i, j) - above, 1e-9)) * kReposeDx;
         break;
       }
     top = std::max(top, h[static_cast<std::size_t>(i)]);
@@ -62,7 +62,7 @@ double slopeAfterOneSecond(double alpha, double degrees, double height) {
   double sx = 0, sy = 0, sxx = 0, sxy = 0;
   int n = 0;
   for (int i = 0; i < r[0]; ++i) {
-    const double x = (i + 0.5) * kDx, y = h[static_cast<std::size_t>(i)];
+    const double x = (i + 0.5) * kReposeDx, y = h[static_cast<std::size_t>(i)];
     if (y <= 0.2 * top || y >= 0.8 * top) continue;
     sx += x;
     sy += y;
@@ -92,7 +92,7 @@ TEST(GranularRepose, StaticAngleOfReposeLiesWithinFiveDegreesOfThePrediction) {
     ASSERT_TRUE(stands(below)) << "alpha " << alpha << ": a slope at " << below << " deg did not stand";
     ASSERT_LT(flowed, above - 3.0) << "alpha " << alpha << ": a slope at " << above << " deg did not flow";
     // To 10 / 32 deg; the sanitizer build stops at 10 / 4 deg, which still separates the alphas.
-    for (int halving = 0; halving < test::fullOrSanitized(5, 2); ++halving) {
+    for (int halving = 0; halving < msim::test::fullOrSanitized(5, 2); ++halving) {
       const double mid = 0.5 * (below + above);
       (stands(mid) ? below : above) = mid;
     }

@@ -161,7 +161,7 @@ TEST(GranularSimulation, WallsHoldMaterialBackButDoNotHoldItOn) {
   {
     GranularSimulation sim(settingsFor(IVec3(8, 16, 8), dx), {GranularMaterial{kDensity, 0.6}});
     sim.seed(Vec3(0, height - 0.2, 0), Vec3(0.4, height, 0.4), [](const Vec3&) { return true; }, loose);
-    const double y0 = test::totals(sim.particles()).centreOfMass().y();
+    const double y0 = granular::test::totals(sim.particles()).centreOfMass().y();
     double maxDt = 0.0, before = 0.0;
     runUntil(sim, t, 1.0 / 60.0, [&] {
       maxDt = std::max(maxDt, sim.time() - before);
@@ -171,7 +171,7 @@ TEST(GranularSimulation, WallsHoldMaterialBackButDoNotHoldItOn) {
     // so the drop exceeds g t^2 / 2 by at most g t dt / 2.
     const double g = 9.81, freeFall = 0.5 * g * t * t;
     EXPECT_NEAR(sim.totalMomentum().y() / sim.totalMass(), -g * t, 1e-3 * g * t);
-    const double drop = y0 - test::totals(sim.particles()).centreOfMass().y();
+    const double drop = y0 - granular::test::totals(sim.particles()).centreOfMass().y();
     EXPECT_GE(drop, freeFall * (1.0 - 1e-6));
     EXPECT_LE(drop, freeFall + 0.5 * g * t * maxDt);
     float top = 0.0f;
@@ -185,9 +185,9 @@ TEST(GranularSimulation, WallsHoldMaterialBackButDoNotHoldItOn) {
     GranularSimulation sim(s, {GranularMaterial{kDensity, 0.6}});
     sim.seed(Vec3(0, 0, 0), Vec3(0.4, 0.2, 0.4), [](const Vec3&) { return true; }, loose);
     for (auto& v : sim.particles().velocity) v = Vecf<3>(0.0f, 1.0f, 0.0f);
-    const double y0 = test::totals(sim.particles()).centreOfMass().y();
+    const double y0 = granular::test::totals(sim.particles()).centreOfMass().y();
     runUntil(sim, t, 1.0 / 60.0, [] {});
-    EXPECT_NEAR(test::totals(sim.particles()).centreOfMass().y() - y0, 1.0 * t, 0.03 * t);
+    EXPECT_NEAR(granular::test::totals(sim.particles()).centreOfMass().y() - y0, 1.0 * t, 0.03 * t);
     float bottom = height;
     for (const auto& x : sim.particles().position) bottom = std::min(bottom, x.y());
     EXPECT_GT(bottom, 0.5 * t) << "grains left behind on the floor";

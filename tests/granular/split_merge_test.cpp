@@ -15,8 +15,8 @@
 namespace msim::granular {
 namespace {
 
-constexpr double kDx = 0.1;
-const double kR = particleRadius(kDx);
+constexpr double kSplitDx = 0.1;
+const double kR = particleRadius(kSplitDx);
 
 // Semi-axes relative to r, ascending.
 Vec3 semiAxesOverR(const ParticleShape& s) {
@@ -98,7 +98,7 @@ TEST(GranularSplitMerge, IsotropicGrowthSplitsIntoEightValidChildren) {
 
 TEST(GranularSplitMerge, DivergingCloudIsSplitStaysValidAndConserves) {
   // A seeded block in v = G (x - c) with G symmetric positive definite: every ellipsoid grows.
-  const GridSpec<3> grid(Vec3::Zero(), kDx, IVec3::Constant(24));
+  const GridSpec<3> grid(Vec3::Zero(), kSplitDx, IVec3::Constant(24));
   const Vec3 centre = Vec3::Constant(1.2);
   Eigen::Matrix3d g;
   g << 0.9, 0.2, 0.0, 0.2, 0.6, 0.1, 0.0, 0.1, 0.4;
@@ -156,7 +156,7 @@ TEST(GranularSplitMerge, NoSplitBelowTheMinimumChildMass) {
 TEST(GranularSplitMerge, CompressedCloudMergesValidlyAndConserves) {
   // Uniaxial compression v = (-k (x - c), 0, 0): ellipsoids flatten along x and merge with their
   // (now close) neighbours along x.
-  const GridSpec<3> grid(Vec3::Zero(), kDx, IVec3::Constant(24));
+  const GridSpec<3> grid(Vec3::Zero(), kSplitDx, IVec3::Constant(24));
   const Vec3 centre = Vec3::Constant(1.2);
   Eigen::Matrix3d g = Eigen::Matrix3d::Zero();
   g(0, 0) = -1.0;
@@ -305,7 +305,7 @@ TEST(GranularSplitMerge, NoMergeAboveTheMaximumMass) {
 }
 
 TEST(GranularSplitMerge, DeterministicAcrossRuns) {
-  const GridSpec<3> grid(Vec3::Zero(), kDx, IVec3::Constant(12));
+  const GridSpec<3> grid(Vec3::Zero(), kSplitDx, IVec3::Constant(12));
   const std::vector<GranularMaterial> materials{{1600.0, 0.5}};
   GranularParticles a;
   seedBox(a, grid, Vec3::Constant(0.3), Vec3::Constant(0.9), materials);

@@ -16,7 +16,7 @@ using namespace msim::granular;
 
 namespace {
 
-constexpr double kDx = 0.05;
+constexpr double kLatticeDx = 0.05;
 const IVec3 kCells(5, 4, 6);
 
 std::vector<StressComponent> allComponents() {
@@ -53,9 +53,9 @@ TEST(GranularStressLattice, DivergenceAndItsTransposeAreAdjoint) {
     randomFaces(rng, u, mask);
     const std::vector<double> s = randomSamples(rng, c);
     FaceField ds(kCells);
-    addDivergence(c, s, 1.0, kDx, mask, ds);
+    addDivergence(c, s, 1.0, kLatticeDx, mask, ds);
     std::vector<double> dtu;
-    divergenceTranspose(c, u, kDx, mask, dtu);
+    divergenceTranspose(c, u, kLatticeDx, mask, dtu);
     ASSERT_EQ(dtu.size(), s.size());
     double faces = 0.0, samples = 0.0, scale = 0.0;
     for (int a = 0; a < 3; ++a)
@@ -84,17 +84,17 @@ TEST(GranularStressLattice, PoissonStencilIsTheTransposeTimesWeightsTimesTheDive
     constexpr double kIsolated = 3.0;
     std::array<std::vector<double>, 3> lower;
     std::vector<double> diagonal;
-    poissonStencil(c, weight, kDx, mask, kIsolated, lower, diagonal);
+    poissonStencil(c, weight, kLatticeDx, mask, kIsolated, lower, diagonal);
     const numerics::GridPoissonQpOperator<3> A(lattice, lower, diagonal);
 
     // D^T W D x, built from the two other passes.
     const std::vector<double> x = randomSamples(rng, c);
     FaceField dx(kCells);
-    addDivergence(c, x, 1.0, kDx, mask, dx);
+    addDivergence(c, x, 1.0, kLatticeDx, mask, dx);
     for (int a = 0; a < 3; ++a)
       for (std::size_t i = 0; i < dx.values[a].size(); ++i) dx.values[a][i] *= weight.values[a][i];
     std::vector<double> expected;
-    divergenceTranspose(c, dx, kDx, mask, expected);
+    divergenceTranspose(c, dx, kLatticeDx, mask, expected);
 
     Eigen::VectorXd ax(static_cast<Eigen::Index>(x.size()));
     A.apply(Eigen::Map<const Eigen::VectorXd>(x.data(), static_cast<Eigen::Index>(x.size())), ax);
@@ -133,8 +133,8 @@ TEST(GranularStressLattice, BoxedPassesMatchTheWholeOnes) {
             if (!inside) s[(static_cast<std::size_t>(z) * lattice[1] + y) * lattice[0] + x] = 0.0;
           }
       FaceField whole = u, boxed = u;  // start from nonzero values: both add onto them
-      addDivergence(c, s, 1.3, kDx, mask, whole);
-      addDivergence(c, s, 1.3, kDx, mask, boxed, box);
+      addDivergence(c, s, 1.3, kLatticeDx, mask, whole);
+      addDivergence(c, s, 1.3, kLatticeDx, mask, boxed, box);
       for (int a = 0; a < 3; ++a) {
         EXPECT_EQ(whole.values[a], boxed.values[a]) << "axis " << a;
         // Every face the whole pass changed lies in facesReading.
@@ -148,8 +148,8 @@ TEST(GranularStressLattice, BoxedPassesMatchTheWholeOnes) {
         }
       }
       std::vector<double> full, part(s.size(), 7.0);
-      divergenceTranspose(c, u, kDx, mask, full);
-      divergenceTranspose(c, u, kDx, mask, part, box);
+      divergenceTranspose(c, u, kLatticeDx, mask, full);
+      divergenceTranspose(c, u, kLatticeDx, mask, part, box);
       for (int z = 0; z < lattice[2]; ++z)
         for (int y = 0; y < lattice[1]; ++y)
           for (int x = 0; x < lattice[0]; ++x) {

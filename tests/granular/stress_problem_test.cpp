@@ -16,11 +16,11 @@ using namespace msim::granular;
 
 namespace {
 
-constexpr double kDx = 0.1, kDt = 0.01;
+constexpr double kProblemDx = 0.1, kProblemDt = 0.01;
 
 GranularGridState packedBox(const IVec3& res) {
   GranularGridState st;
-  st.spec = GridSpec<3>(Vec3::Zero(), kDx, res);
+  st.spec = GridSpec<3>(Vec3::Zero(), kProblemDx, res);
   st.phi.assign(st.spec.cellCount(), 1.0);
   st.alpha.assign(st.spec.cellCount(), 0.5);
   st.phiFace = FaceField(res, 1.0);
@@ -72,7 +72,7 @@ double solveAndCheck(double freeShare, unsigned seed) {
   FaceField weight(res, 1.0 / 1500.0);
   std::vector<std::vector<BodyFace>> faces(1);
   collectBodyFaces(st, body, faces[0]);
-  pr.build(st, weight, kDt, {&body}, faces);
+  pr.build(st, weight, kProblemDt, {&body}, faces);
   const Eigen::Index n = static_cast<Eigen::Index>(pr.lattice.prod());
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0), pick(0.0, 1.0);
@@ -99,7 +99,7 @@ double solveAndCheck(double freeShare, unsigned seed) {
   CoupledOperator whole;
   whole.grid().assign(pr.lattice, pr.lower, pr.diagonal);
   whole.bodies() = pr.bodies;
-  whole.setBodyWeight(kDt * kDt * st.spec.cellVolume());
+  whole.setBodyWeight(kProblemDt * kProblemDt * st.spec.cellVolume());
   return kktViolation(pr, whole);
 }
 

@@ -14,14 +14,14 @@ using namespace msim::granular;
 
 namespace {
 
-constexpr double kRho = 1500.0, kG = 9.81, kDx = 0.1, kDt = 0.01;
+constexpr double kSolverRho = 1500.0, kSolverG = 9.81, kSolverDx = 0.1, kSolverDt = 0.01;
 
 // A closed box of res cells, material (phi = 1, rho) in the cells of [lo, hi). A face beside
 // material counts as full (phi = 1): with the mean of the two cells, phi v would carry half the
 // flux out of a packed cell's leading face, and uniform motion would appear to compress it.
 GranularGridState block(const IVec3& res, const IVec3& lo, const IVec3& hi, double alpha) {
   GranularGridState st;
-  st.spec = GridSpec<3>(Vec3::Zero(), kDx, res);
+  st.spec = GridSpec<3>(Vec3::Zero(), kSolverDx, res);
   const std::size_t n = st.spec.cellCount();
   st.phi.assign(n, 0.0);
   st.alpha.assign(n, alpha);
@@ -48,7 +48,7 @@ GranularGridState block(const IVec3& res, const IVec3& lo, const IVec3& hi, doub
           if (f[a] == 0 || f[a] == res[a]) st.open.values[a][idx] = 0.0;  // domain walls
           const double phi = std::max(cellPhi(f), cellPhi(below));
           st.phiFace.values[a][idx] = phi;
-          st.rhoFace.values[a][idx] = phi > 0.0 ? kRho : 0.0;
+          st.rhoFace.values[a][idx] = phi > 0.0 ? kSolverRho : 0.0;
         }
   }
   return st;
@@ -64,7 +64,7 @@ FaceField predicted(const GranularGridState& st, double vx) {
   for (int a = 0; a < 3; ++a)
     for (std::size_t i = 0; i < v.values[a].size(); ++i)
       if (st.open.values[a][i] != 0.0 && st.rhoFace.values[a][i] > 0.0)
-        v.values[a][i] = a == 1 ? -kG * kDt : (a == 0 ? vx : 0.0);
+        v.values[a][i] = a == 1 ? -kSolverG * kSolverDt : (a == 0 ? vx : 0.0);
   return v;
 }
 
@@ -82,16 +82,16 @@ TEST(GranularStress, RestingColumnIsHydrostatic) {
   GranularGridState st = column(res, height, 0.0);
   StressSolver solver(StressSolverSettings{.staggeredIterations = 2, .friction = false});
   FaceField v = predicted(st, 0.0);
-  solver.solve(st, kDt, v, {});
+  solver.solve(st, kSolverDt, v, {});
   // Gravity is held: the material does not move into the floor or compress.
-  for (int a = 0; a < 3; ++a) EXPECT_LT(maxAbs(v.values[a]), 1e-3 * kG * kDt) << "axis " << a;
+  for (int a = 0; a < 3; ++a) EXPECT_LT(maxAbs(v.values[a]), 1e-3 * kSolverG * kSolverDt) << "axis " << a;
   // p rises by rho g dx per cell downwards, and p >= 0 everywhere.
   const std::vector<double>& p = solver.pressure();
   for (double x : p) EXPECT_GE(x, 0.0);
   for (int j = 0; j + 1 < height; ++j) {
     const std::size_t lo = (static_cast<std::size_t>(2) * res[1] + j) * res[0] + 2;
     const std::size_t hi = lo + static_cast<std::size_t>(res[0]);
-    EXPECT_NEAR(p[lo] - p[hi], kRho * kG * kDx, 1e-3 * kRho * kG * kDx) << "row " << j;
+    EXPECT_NEAR(p[lo] - p[hi], kSolverRho * kSolverG * kSolverDx, 1e-3 * kSolverRho * kSolverG * kSolverDx) << "row " << j;
   }
 }
 
@@ -117,7 +117,7 @@ TEST(GranularStress, DivergingFlowFeelsNoPressure) {
   FaceField& v = pulled.v;
   const FaceField before = v;
   StressSolver solver;
-  solver.solve(st, kDt, v, {});
+  solver.solve(st, kSolverDt, v, {});
   EXPECT_EQ(maxAbs(solver.pressure()), 0.0);
   for (std::size_t i = 0; i < v.values[1].size(); ++i) EXPECT_DOUBLE_EQ(v.values[1][i], before.values[1][i]);
 }
@@ -131,7 +131,7 @@ TEST(GranularStress, BilateralMaterialIsHeldTogetherLikeALiquid) {
   const GranularGridState& st = pulled.st;
   FaceField& v = pulled.v;
   StressSolver solver(StressSolverSettings{.friction = false, .tolerance = 1e-8, .bilateral = true});
-  solver.solve(st, kDt, v, {});
+  solver.solve(st, kSolverDt, v, {});
   const std::vector<double>& p = solver.pressure();
   EXPECT_LT(*std::min_element(p.begin(), p.end()), 0.0);
   for (int j = 2; j < 10; ++j) {
@@ -151,11 +151,11 @@ TEST(GranularStress, ConvergingFlowStopsAtTheDensityBound) {
     if (st.open.values[0][i] != 0.0) v.values[0][i] = fi < res[0] / 2 ? 2.0 : -2.0;
   }
   StressSolver solver(StressSolverSettings{.friction = false});
-  solver.solve(st, kDt, v, {});
+  solver.solve(st, kSolverDt, v, {});
   // Net flux into each cell <= its free volume (zero here).
   for (int i = 0; i < res[0]; ++i) {
     const std::size_t lo = st.open.index(0, IVec3(i, 1, 1)), hi = st.open.index(0, IVec3(i + 1, 1, 1));
-    const double phiNext = 1.0 - kDt * (v.values[0][hi] - v.values[0][lo]) / kDx;
+    const double phiNext = 1.0 - kSolverDt * (v.values[0][hi] - v.values[0][lo]) / kSolverDx;
     EXPECT_LE(phiNext, 1.0 + 1e-4) << "cell " << i;
   }
   EXPECT_GT(solver.stats().activePressureCells, 0);
@@ -176,9 +176,9 @@ struct SlidingBlock {
   // a step's first friction solve uses the last step's p); returns the block's mean x velocity.
   double step(double v0) {
     FaceField warm = predicted(st, 0.0);
-    solver.solve(st, kDt, warm, {});
+    solver.solve(st, kSolverDt, warm, {});
     FaceField v = predicted(st, v0);
-    solver.solve(st, kDt, v, {});
+    solver.solve(st, kSolverDt, v, {});
     double sum = 0.0;
     int count = 0;
     for (int k = 0; k < res[2]; ++k)
@@ -208,10 +208,10 @@ TEST(GranularStress, FastBlockSlidesWithFrictionAtItsBound) {
   const std::vector<double>& p = b.solver.pressure();
   auto pAt = [&](int i, int j, int k) { return p[(static_cast<std::size_t>(k) * b.res[1] + j) * b.res[0] + i]; };
   double sides = 0.0;
-  for (int j = 0; j < b.height; ++j) sides += pAt(16, j, 0) * kDx;
-  const double width = b.res[2] * kDx, depth = b.height * kDx;
-  const double decel = b.alpha * (pAt(16, 0, 1) * width + 2.0 * sides) / (kRho * width * depth);
-  EXPECT_NEAR(v0 - v1, kDt * decel, 0.1 * kDt * decel);
+  for (int j = 0; j < b.height; ++j) sides += pAt(16, j, 0) * kSolverDx;
+  const double width = b.res[2] * kSolverDx, depth = b.height * kSolverDx;
+  const double decel = b.alpha * (pAt(16, 0, 1) * width + 2.0 * sides) / (kSolverRho * width * depth);
+  EXPECT_NEAR(v0 - v1, kSolverDt * decel, 0.1 * kSolverDt * decel);
   // The floor edges under the middle of the block carry s_xy = alpha p (the floor row's face gets
   // -s_xy / dx: opposing +x motion), with
   // p the pressure iterate before the last one (the staggered projections solve friction first):

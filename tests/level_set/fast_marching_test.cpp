@@ -8,16 +8,14 @@
 #include <stdexcept>
 
 #include "msim/numerics/level_set/fast_marching.hpp"
+#include "../unit_box.hpp"
 
 using namespace msim;
 using namespace msim::numerics;
 
 namespace {
 
-template <int D>
-GridSpec<D> unitBox(int n) {
-  return GridSpec<D>(Vec<D>::Zero(), 1.0 / n, IVec<D>::Constant(n));
-}
+using msim::test::unitBox;
 
 struct BandError {
   double maxError = 0.0;   // max |phi - exact| over cells within 3 cells of the interface [dx]

@@ -15,6 +15,7 @@
 #include "msim/core/rng.hpp"
 #include "msim/numerics/bound_qp.hpp"
 #include "msim/numerics/bound_qp_mic0.hpp"
+#include "random_spd.hpp"
 
 using namespace msim;
 using namespace msim::numerics;
@@ -70,12 +71,6 @@ Eigen::SparseMatrix<double> assemble(const Stencil& s) {
   Eigen::SparseMatrix<double> A(kN * kN, kN * kN);
   A.setFromTriplets(t.begin(), t.end());
   return A;
-}
-
-Eigen::VectorXd randomVector(Eigen::Index n, Rng& rng, double lo, double hi) {
-  Eigen::VectorXd v(n);
-  for (double& x : v) x = rng.uniform(lo, hi);
-  return v;
 }
 
 void print(const char* name, const BoundQpResult& r) {

@@ -50,12 +50,6 @@ SpMat poisson2d(int nx, int ny, Rng& rng, double wMin, double wMax) {
   return A;
 }
 
-Eigen::VectorXd randomVector(Eigen::Index n, Rng& rng, double lo, double hi) {
-  Eigen::VectorXd v(n);
-  for (Eigen::Index i = 0; i < n; ++i) v[i] = rng.uniform(lo, hi);
-  return v;
-}
-
 // The unique KKT point by exhaustive search over the 2^n free sets: solve A_FF p_F = b_F and keep
 // the one with p_F >= 0 and (A p - b)_i >= 0 off F.
 Eigen::VectorXd bruteForce(const Eigen::MatrixXd& A, const Eigen::VectorXd& b) {

@@ -22,14 +22,14 @@ using testing::fromRoot;
 using testing::worldRank;
 using testing::worldSize;
 
-const GridSpec<3> kGlobal(Vec<3>(-0.5, -0.4, -0.3), 1.0 / 34, IVec<3>(34, 27, 21));
+const GridSpec<3> kAdvectionGrid(Vec<3>(-0.5, -0.4, -0.3), 1.0 / 34, IVec<3>(34, 27, 21));
 constexpr double kCfl = 0.9;
-constexpr int kSteps = 6;
+constexpr int kAdvectionSteps = 6;
 
 // A swirl about a tilted axis plus a shear: divergent and varying on every axis, so feet land
 // in every direction and off the lattice. Scaled so the fastest face moves kCfl cells per step.
 MacGrid<3> initialVelocity(double& dt) {
-  MacGrid<3> u(kGlobal);
+  MacGrid<3> u(kAdvectionGrid);
   double fastest = 0.0;
   for (int a = 0; a < 3; ++a) {
     Grid<float, 3>& c = u.component(a);
@@ -40,13 +40,13 @@ MacGrid<3> initialVelocity(double& dt) {
       fastest = std::max(fastest, std::abs(double(c[i])));
     }
   }
-  dt = kCfl * kGlobal.dx / fastest;
+  dt = kCfl * kAdvectionGrid.dx / fastest;
   return u;
 }
 
 // A smooth blob with a sharp-edged box inside: the limiter acts at the edges.
 Grid<float, 3> initialDensity() {
-  Grid<float, 3> d(kGlobal);
+  Grid<float, 3> d(kAdvectionGrid);
   for (std::size_t i = 0; i < d.count(); ++i) {
     const Vec<3> x = d.position(d.coord(i));
     const double blob = std::exp(-12.0 * (x - Vec<3>(0.1, 0.0, 0.0)).squaredNorm());
@@ -67,12 +67,12 @@ struct Fields {
   MacGrid<3> velocity;
 };
 
-// kSteps of: density advected by the velocity, then the velocity by itself.
+// kAdvectionSteps of: density advected by the velocity, then the velocity by itself.
 Fields serialRun(AdvectionScheme scheme) {
   double dt = 0.0;
   Fields f{initialDensity(), initialVelocity(dt)};
-  Advector<float, 3> advector(kGlobal, settingsFor(scheme));
-  for (int step = 0; step < kSteps; ++step) {
+  Advector<float, 3> advector(kAdvectionGrid, settingsFor(scheme));
+  for (int step = 0; step < kAdvectionSteps; ++step) {
     advector.advect(f.density, f.velocity, dt);
     advector.advect(f.velocity, f.velocity, dt);
   }
@@ -84,12 +84,12 @@ Fields serialRun(AdvectionScheme scheme) {
 Fields distributedRun(AdvectionScheme scheme, const IVec<3>& lattice, int ghost) {
   double dt = 0.0;
   const Fields initial{initialDensity(), initialVelocity(dt)};
-  const GridBlock<3> block(kGlobal, BlockDecomposition<3>(kGlobal.res, lattice, 1, "test"), worldRank(), ghost);
+  const GridBlock<3> block(kAdvectionGrid, BlockDecomposition<3>(kAdvectionGrid.res, lattice, 1, "test"), worldRank(), ghost);
   Fields local{localPart(initial.density, block), localPart(initial.velocity, block)};
   GhostExchange<float, 3> densityGhosts(block, IVec<3>::Zero(), MPI_COMM_WORLD);
   MacGhostExchange<3> velocityGhosts(block, MPI_COMM_WORLD);
   Advector<float, 3> advector(block.localSpec(), settingsFor(scheme), numerics::allClamped<3>(), block.placement());
-  for (int step = 0; step < kSteps; ++step) {
+  for (int step = 0; step < kAdvectionSteps; ++step) {
     densityGhosts.exchange(local.density);
     velocityGhosts.exchange(local.velocity);
     advector.advect(local.density, local.velocity, dt);

@@ -30,9 +30,9 @@ using testing::References;
 using testing::worldRank;
 using testing::worldSize;
 
-const GridSpec<3> kGlobal(Vec<3>::Zero(), 1.0 / 32, IVec<3>(32, 28, 24));
-constexpr int kSteps = 40;
-constexpr double kDt = 0.004;  // [s]; the water reaches about 1.5 m/s: 0.2 cells per step
+const GridSpec<3> kLiquidGrid(Vec<3>::Zero(), 1.0 / 32, IVec<3>(32, 28, 24));
+constexpr int kLiquidSteps = 40;
+constexpr double kLiquidDt = 0.004;  // [s]; the water reaches about 1.5 m/s: 0.2 cells per step
 
 struct LiquidRun {
   Grid<float, 3> phi;     // on rank 0 (split runs: gathered)
@@ -76,10 +76,10 @@ LiquidRun runDamBreak(const GridSpec<3>& spec, DomainSplit<3>* split, Extra extr
     v.seed.regionMin = Vec<3>(0.02, 0.05, 0.05);
     v.seed.regionMax = Vec<3>(0.33, 0.7, 0.7);  // above the column's top (0.55): deleted in the air
     v.seed.magnitude = 30.0;
-    v.seed.radius = 3.0 * kGlobal.dx;
+    v.seed.radius = 3.0 * kLiquidGrid.dx;
     v.seed.strength = 2e-4;
     v.initialCount = 300;
-    solver.setVortexLayer(std::make_unique<fluid::VortexLayer<3>>(v, kGlobal, "test vortex particles"));
+    solver.setVortexLayer(std::make_unique<fluid::VortexLayer<3>>(v, kLiquidGrid, "test vortex particles"));
   }
   const auto box = [&](const Vec<3>& lo, const Vec<3>& hi) {
     Grid<float, 3> region(spec);
@@ -93,14 +93,14 @@ LiquidRun runDamBreak(const GridSpec<3>& spec, DomainSplit<3>* split, Extra extr
   const Grid<float, 3> sink = box(Vec<3>(0.8, 0.0, 0.3), Vec<3>(1.0, 0.08, 0.5));
   LiquidRun run;
   run.initialVolume = solver.liquidVolume();
-  for (int s = 0; s < kSteps; ++s) {
-    EXPECT_LE(kDt, solver.cflTimestep()) << "step " << s;
+  for (int s = 0; s < kLiquidSteps; ++s) {
+    EXPECT_LE(kLiquidDt, solver.cflTimestep()) << "step " << s;
     const std::size_t before = solver.statistics().particles;
     if (extra == Extra::EmitterAndSink) {
       solver.emit(emitter, Vec<3>(0.0, 0.0, 1.2));
       solver.drain(sink);
     }
-    solver.step(kDt);
+    solver.step(kLiquidDt);
     const bool reseeded = extra != Extra::Flip && solver.steps() % solver.params().reseedInterval == 0;
     if (s > 0 && !reseeded && extra != Extra::EmitterAndSink)  // they delete the particles in their shapes
       run.particlesLost += long(before) - long(solver.statistics().particles);
@@ -130,7 +130,7 @@ LiquidRun runDamBreak(const GridSpec<3>& spec, DomainSplit<3>* split, Extra extr
 LiquidRun runSplit(MPI_Comm comm, Extra extra, int extraLayers = 0) {
   const fluid::LiquidParams<3> params;
   const int ghost = liquidGhostLayers(params.advection, params.cfl, params.bandCells) + extraLayers;
-  const GridBlock<3> block(kGlobal, BlockDecomposition<3>(kGlobal.res, sizeOf(comm), ghost, "test"), rankOf(comm),
+  const GridBlock<3> block(kLiquidGrid, BlockDecomposition<3>(kLiquidGrid.res, sizeOf(comm), ghost, "test"), rankOf(comm),
                            ghost);
   MpiDomainSplit split(block, params.sides, params.projection.pcg, comm);
   return runDamBreak(block.localSpec(), &split, extra);
@@ -140,8 +140,8 @@ LiquidRun runSplit(MPI_Comm comm, Extra extra, int extraLayers = 0) {
 double surfaceDifference(const Grid<float, 3>& a, const Grid<float, 3>& b) {
   double worst = 0.0;
   for (std::size_t i = 0; i < a.count(); ++i)
-    if (std::abs(b[i]) < 3.0 * kGlobal.dx) worst = std::max(worst, double(std::abs(a[i] - b[i])));
-  return worst / kGlobal.dx;
+    if (std::abs(b[i]) < 3.0 * kLiquidGrid.dx) worst = std::max(worst, double(std::abs(a[i] - b[i])));
+  return worst / kLiquidGrid.dx;
 }
 
 // The split run against the one-rank run and the serial solver (MG-PCG). With ceil(band) ghost
@@ -159,8 +159,8 @@ TEST_P(DistributedLiquid, DamBreakFollowsTheOneRankRun) {
   // The rock on 8 ranks (blocks touching at corners), the others on 2.
   if (worldSize() != (extra == Extra::Rock ? 8 : 2)) GTEST_SKIP() << "run on 2 ranks (the rock on 8)";
   const References<LiquidRun> ref = referenceRuns(
-      [&](MPI_Comm alone) { return runSplit(alone, extra); }, [&] { return runDamBreak(kGlobal, nullptr, extra); },
-      LiquidRun{Grid<float, 3>(kGlobal)}, [](LiquidRun& run, int from) {
+      [&](MPI_Comm alone) { return runSplit(alone, extra); }, [&] { return runDamBreak(kLiquidGrid, nullptr, extra); },
+      LiquidRun{Grid<float, 3>(kLiquidGrid)}, [](LiquidRun& run, int from) {
         sendToRoot(run.phi.data(), from);
         std::vector<double> numbers = {run.volume, run.targetVolume, double(run.vortexParticles)};
         sendToRoot(numbers, from);
@@ -184,7 +184,7 @@ TEST_P(DistributedLiquid, DamBreakFollowsTheOneRankRun) {
                 : extra == Extra::EmitterAndSink  ? " with an emitter and a sink"
                 : extra == Extra::Flip            ? ", FLIP"
                                                   : "",
-                kSteps, worldSize(), extraLayers, toOne, toSerial, volumeToOne, volumeToSerial, split.particles,
+                kLiquidSteps, worldSize(), extraLayers, toOne, toSerial, volumeToOne, volumeToSerial, split.particles,
                 one->particles, particlesToOne);
     // FLIP rebuilds its surface from the particles every step, switching cells between deep inside
     // and the kernel's value: the fast marching's differences grow (the particles, bit for bit for 30

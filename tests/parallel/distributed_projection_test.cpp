@@ -20,12 +20,12 @@ using testing::fromRoot;
 using testing::worldRank;
 using testing::worldSize;
 
-const GridSpec<3> kGlobal(Vec<3>::Zero(), 1.0 / 32, IVec<3>(32, 28, 24));
+const GridSpec<3> kProjectionGrid(Vec<3>::Zero(), 1.0 / 32, IVec<3>(32, 28, 24));
 constexpr double kTolerance = 1e-6;
 
 // A velocity with divergence everywhere: the projection has work on every block.
 MacGrid<3> divergentVelocity() {
-  MacGrid<3> u(kGlobal);
+  MacGrid<3> u(kProjectionGrid);
   for (int a = 0; a < 3; ++a) {
     Grid<float, 3>& c = u.component(a);
     for (std::size_t i = 0; i < c.count(); ++i) {
@@ -39,7 +39,7 @@ MacGrid<3> divergentVelocity() {
 }
 
 MacGrid<3> sphereOpenFractions() {
-  return numerics::openFaceFractionsFromSdf<3>(kGlobal, [](const Vec<3>& x) {
+  return numerics::openFaceFractionsFromSdf<3>(kProjectionGrid, [](const Vec<3>& x) {
     return (x - Vec<3>(0.45, 0.42, 0.37)).norm() - 0.17;  // solid inside
   });
 }
@@ -70,12 +70,12 @@ TEST_P(DistributedProjectionTest, MatchesTheSerialProjectionWithinTheTolerance) 
   if (worldRank() == 0) {
     numerics::ProjectionSettings settings;
     settings.pcg = pcg;
-    numerics::PressureProjection<3> projection(kGlobal, c.sides, settings);
+    numerics::PressureProjection<3> projection(kProjectionGrid, c.sides, settings);
     projection.setSolids(open);
     serialStats = projection.project(serial, dt, density);
   }
 
-  const GridBlock<3> block(kGlobal, BlockDecomposition<3>(kGlobal.res, worldSize(), 2, "test"), worldRank(), 1);
+  const GridBlock<3> block(kProjectionGrid, BlockDecomposition<3>(kProjectionGrid.res, worldSize(), 2, "test"), worldRank(), 1);
   MacGrid<3> local = localPart(divergentVelocity(), block);
   DistributedProjection projection(block, c.sides, pcg, MPI_COMM_WORLD);
   projection.setOpenFractions(localPart(open, block));
@@ -128,11 +128,11 @@ TEST(DistributedProjection, FreeSurfaceMatchesTheSerialProjection) {
   if (worldRank() == 0) {
     numerics::ProjectionSettings settings;
     settings.pcg = pcg;
-    numerics::PressureProjection<3> projection(kGlobal, DomainSides<3>::allWalls(), settings);
-    projection.setFreeSurface(liquidPhi(kGlobal));
+    numerics::PressureProjection<3> projection(kProjectionGrid, DomainSides<3>::allWalls(), settings);
+    projection.setFreeSurface(liquidPhi(kProjectionGrid));
     EXPECT_TRUE(projection.project(serial, dt, density).converged);
   }
-  const GridBlock<3> block(kGlobal, BlockDecomposition<3>(kGlobal.res, worldSize(), 2, "test"), worldRank(), 1);
+  const GridBlock<3> block(kProjectionGrid, BlockDecomposition<3>(kProjectionGrid.res, worldSize(), 2, "test"), worldRank(), 1);
   MacGrid<3> local = localPart(divergentVelocity(), block);
   DistributedProjection projection(block, DomainSides<3>::allWalls(), pcg, MPI_COMM_WORLD);
   projection.setFreeSurface(liquidPhi(block.localSpec()));

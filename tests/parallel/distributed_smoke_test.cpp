@@ -28,9 +28,9 @@ using testing::References;
 using testing::worldRank;
 using testing::worldSize;
 
-const GridSpec<3> kGlobal(Vec<3>::Zero(), 1.0 / 40, IVec<3>(40, 48, 36));
-constexpr int kSteps = 50;
-constexpr double kDt = 0.008;
+const GridSpec<3> kSmokeGrid(Vec<3>::Zero(), 1.0 / 40, IVec<3>(40, 48, 36));
+constexpr int kSmokeSteps = 50;
+constexpr double kSmokeDt = 0.008;
 
 fluid::SmokeParams<3> plumeParams() {
   fluid::SmokeParams<3> p;
@@ -114,7 +114,7 @@ Grid<float, 3> runPlume(const GridSpec<3>& spec, DomainSplit<3>* split, Variant 
     v.seed.regionMin = Vec<3>(0.35, 0.05, 0.32);
     v.seed.regionMax = Vec<3>(0.55, 0.25, 0.52);
     v.seed.magnitude = 40.0;
-    v.seed.radius = 3.0 * kGlobal.dx;
+    v.seed.radius = 3.0 * kSmokeGrid.dx;
     v.seed.strength = 1e-4;
     v.initialCount = 100;
     v.rate = 2000.0;
@@ -123,21 +123,21 @@ Grid<float, 3> runPlume(const GridSpec<3>& spec, DomainSplit<3>* split, Variant 
       v.seed.vorticity = fluid::SeedVorticity::LocalFlow;
       v.seed.minimumFlowVorticity = 5.0;
     }
-    solver.setVortexLayer(std::make_unique<fluid::VortexLayer<3>>(v, kGlobal, "test vortex particles"));
+    solver.setVortexLayer(std::make_unique<fluid::VortexLayer<3>>(v, kSmokeGrid, "test vortex particles"));
   }
   if (variant != Variant::Plume && variant != Variant::Expanding) place(0.0);
   solver.addSource(plumeSource(spec, variant == Variant::Expanding ? 4.0 : 0.0));
-  for (int s = 0; s < kSteps; ++s) {
-    EXPECT_LE(kDt, solver.cflTimestep()) << "step " << s;
-    if (variant == Variant::MovingBall) place((s + 0.5) * kDt);
-    solver.step(kDt);
+  for (int s = 0; s < kSmokeSteps; ++s) {
+    EXPECT_LE(kSmokeDt, solver.cflTimestep()) << "step " << s;
+    if (variant == Variant::MovingBall) place((s + 0.5) * kSmokeDt);
+    solver.step(kSmokeDt);
   }
   return solver.density();
 }
 
 Grid<float, 3> runSplit(MPI_Comm comm, Variant variant) {
   const fluid::SmokeParams<3> params = variantParams(variant);
-  const GridBlock<3> block(kGlobal, BlockDecomposition<3>(kGlobal.res, sizeOf(comm), 4, "test"), rankOf(comm),
+  const GridBlock<3> block(kSmokeGrid, BlockDecomposition<3>(kSmokeGrid.res, sizeOf(comm), 4, "test"), rankOf(comm),
                            smokeGhostLayers(params.advection, 1.0,
                                             params.scalarTransport == fluid::ScalarTransport::Conservative));
   MpiDomainSplit split(block, params.sides, params.projection.pcg, comm);
@@ -171,8 +171,8 @@ TEST_P(DistributedSmoke, FiftyStepsMatchOneRankWithin1e4Relative) {
   if (variant == Variant::Viscous && worldSize() != 2) GTEST_SKIP() << "run on 2 ranks";
   // The one-rank run and the serial solver's, then the split run on every rank.
   const References<Grid<float, 3>> ref = referenceRuns(
-      [&](MPI_Comm alone) { return runSplit(alone, variant); }, [&] { return runPlume(kGlobal, nullptr, variant); },
-      Grid<float, 3>(kGlobal), [](Grid<float, 3>& g, int from) { sendToRoot(g.data(), from); });
+      [&](MPI_Comm alone) { return runSplit(alone, variant); }, [&] { return runPlume(kSmokeGrid, nullptr, variant); },
+      Grid<float, 3>(kSmokeGrid), [](Grid<float, 3>& g, int from) { sendToRoot(g.data(), from); });
   const auto& one = ref.one;
   const auto& serial = ref.serial;
   const Grid<float, 3> split = runSplit(MPI_COMM_WORLD, variant);
@@ -190,7 +190,7 @@ TEST_P(DistributedSmoke, FiftyStepsMatchOneRankWithin1e4Relative) {
                        : variant == Variant::VortexLocalFlow ? " around a ball, with vortex particles of the flow's vorticity"
                                                         : " around a ball, scalars in flux form";
     std::printf("smoke plume%s, %d steps on %d ranks: max density %.3f; relative difference to 1 rank %.1e, to the "
-                "serial MG-PCG solver %.1e\n", name, kSteps, worldSize(), scale, toOne, toSerial);
+                "serial MG-PCG solver %.1e\n", name, kSmokeSteps, worldSize(), scale, toOne, toSerial);
     EXPECT_GT(scale, 0.5);
     EXPECT_LT(toOne, 1e-4);
     EXPECT_LT(toSerial, 1e-2);

@@ -19,13 +19,13 @@ using testing::fromRoot;
 using testing::worldRank;
 using testing::worldSize;
 
-const GridSpec<3> kGlobal(Vec<3>(-1.0, 0.0, 0.5), 1.0 / 24, IVec<3>(24, 20, 16));
+const GridSpec<3> kMigrationGrid(Vec<3>(-1.0, 0.0, 0.5), 1.0 / 24, IVec<3>(24, 20, 16));
 
 // An attribute that is a function of the particle's identity: a copy with a wrong pairing shows.
 Vecf<3> tagOf(float id) { return Vecf<3>(id, 2.0f * id + 1.0f, -id); }
 
 TEST(ParticleMigration, EveryParticleHasOneOwnerAndNoneIsLostOrDuplicated) {
-  const GridBlock<3> block(kGlobal, BlockDecomposition<3>(kGlobal.res, worldSize(), 2, "test"), worldRank(), 1);
+  const GridBlock<3> block(kMigrationGrid, BlockDecomposition<3>(kMigrationGrid.res, worldSize(), 2, "test"), worldRank(), 1);
   // 2000 particles spread over the domain, each rank keeping those in its cells.
   constexpr int kTotal = 2000;
   Particles<3> p;
@@ -35,7 +35,7 @@ TEST(ParticleMigration, EveryParticleHasOneOwnerAndNoneIsLostOrDuplicated) {
   for (int n = 0; n < kTotal; ++n) {
     Vecf<3> x;
     for (int a = 0; a < 3; ++a)
-      x[a] = static_cast<float>(kGlobal.origin[a] + seeder.uniform() * kGlobal.res[a] * kGlobal.dx);
+      x[a] = static_cast<float>(kMigrationGrid.origin[a] + seeder.uniform() * kMigrationGrid.res[a] * kMigrationGrid.dx);
     if (ownerOf<3>(x, block) != worldRank()) continue;
     const std::size_t i = p.append(x);
     p.scalar("id")[i] = static_cast<float>(n);
@@ -46,7 +46,7 @@ TEST(ParticleMigration, EveryParticleHasOneOwnerAndNoneIsLostOrDuplicated) {
     // Each particle jumps up to 3 cells (some leave the domain: they go to the nearest cell's owner).
     for (std::size_t i = 0; i < p.size(); ++i) {
       Rng r(static_cast<std::uint64_t>(p.scalar("id")[i]) * 31 + round);
-      for (int a = 0; a < 3; ++a) p.positions()[i][a] += static_cast<float>((2.0 * r.uniform() - 1.0) * 3 * kGlobal.dx);
+      for (int a = 0; a < 3; ++a) p.positions()[i][a] += static_cast<float>((2.0 * r.uniform() - 1.0) * 3 * kMigrationGrid.dx);
     }
     sentTotal += static_cast<long>(migrateParticles<3>(p, block, MPI_COMM_WORLD));
     int misplaced = 0;
@@ -84,18 +84,18 @@ TEST(ParticleMigration, EveryParticleHasOneOwnerAndNoneIsLostOrDuplicated) {
 // on its owner, none lost or duplicated (gathered on rank 0), and every rank's neighbour copies
 // exactly the other ranks' rows within 1 and 2 cells of its own (checked against the gathered set).
 TEST(ParticleMigration, RowsMigrateAndNeighboursReceiveTheRowsNearTheirCells) {
-  const GridBlock<3> block(kGlobal, BlockDecomposition<3>(kGlobal.res, worldSize(), 2, "test"), worldRank(), 2);
+  const GridBlock<3> block(kMigrationGrid, BlockDecomposition<3>(kMigrationGrid.res, worldSize(), 2, "test"), worldRank(), 2);
   constexpr int kTotal = 1500, kWidth = 4;  // position and an identity
   std::vector<double> rows;
   Rng seeder(11);
   for (int n = 0; n < kTotal; ++n) {
     Vec<3> x;
-    for (int a = 0; a < 3; ++a) x[a] = kGlobal.origin[a] + seeder.uniform() * kGlobal.res[a] * kGlobal.dx;
+    for (int a = 0; a < 3; ++a) x[a] = kMigrationGrid.origin[a] + seeder.uniform() * kMigrationGrid.res[a] * kMigrationGrid.dx;
     if (ownerOf<3>(x, block) == worldRank()) rows.insert(rows.end(), {x[0], x[1], x[2], double(n)});
   }
   for (std::size_t at = 0; at < rows.size(); at += kWidth) {
     Rng r(static_cast<std::uint64_t>(rows[at + 3]));
-    for (int a = 0; a < 3; ++a) rows[at + a] += (2.0 * r.uniform() - 1.0) * 3 * kGlobal.dx;
+    for (int a = 0; a < 3; ++a) rows[at + a] += (2.0 * r.uniform() - 1.0) * 3 * kMigrationGrid.dx;
   }
   long sent = static_cast<long>(migrateRows<3>(rows, kWidth, block, MPI_COMM_WORLD));
   int misplaced = 0;
@@ -118,7 +118,7 @@ TEST(ParticleMigration, RowsMigrateAndNeighboursReceiveTheRowsNearTheirCells) {
       const Vec<3> x(all[at], all[at + 1], all[at + 2]);
       IVec<3> c;
       for (int a = 0; a < 3; ++a)
-        c[a] = std::clamp(static_cast<int>(std::floor((x[a] - kGlobal.origin[a]) / kGlobal.dx)), 0, kGlobal.res[a] - 1);
+        c[a] = std::clamp(static_cast<int>(std::floor((x[a] - kMigrationGrid.origin[a]) / kMigrationGrid.dx)), 0, kMigrationGrid.res[a] - 1);
       const bool near = IndexBox<3>{own.lo.array() - reach, own.hi.array() + reach}.contains(c);
       if (near && ownerOf<3>(x, block) != worldRank()) expected.push_back(all[at + 3]);
     }

@@ -14,12 +14,12 @@ using testing::fromRoot;
 using testing::worldRank;
 using testing::worldSize;
 
-const GridSpec<3> kGlobal(Vec<3>::Zero(), 1.0 / 40, IVec<3>(40, 36, 32));
+const GridSpec<3> kLevelSetGrid(Vec<3>::Zero(), 1.0 / 40, IVec<3>(40, 36, 32));
 constexpr double kBand = 6.0;  // the serial reinitialisation's band [cells]
 
 // A wobbly ball whose phi is far from a distance (scaled and bumped): the march has work.
 Grid<float, 3> wobblyBall() {
-  Grid<float, 3> phi(kGlobal);
+  Grid<float, 3> phi(kLevelSetGrid);
   for (std::size_t i = 0; i < phi.count(); ++i) {
     const Vec<3> x = phi.position(phi.coord(i)) - Vec<3>(0.52, 0.44, 0.41);
     const double r = x.norm(), bump = 0.04 * std::sin(9 * x[0]) * std::cos(7 * x[1]) + 0.03 * std::sin(11 * x[2]);
@@ -33,7 +33,7 @@ Grid<float, 3> wobblyBall() {
 double differenceWithin(double k, int ghost) {
   Grid<float, 3> serial = wobblyBall();
   if (worldRank() == 0) numerics::reinitializeFastMarching<3>(serial, kBand);
-  const GridBlock<3> block(kGlobal, BlockDecomposition<3>(kGlobal.res, worldSize(), 2, "test"), worldRank(), ghost);
+  const GridBlock<3> block(kLevelSetGrid, BlockDecomposition<3>(kLevelSetGrid.res, worldSize(), 2, "test"), worldRank(), ghost);
   Grid<float, 3> local = localPart(wobblyBall(), block);
   GhostExchange<float, 3> ghosts(block, IVec<3>::Zero(), MPI_COMM_WORLD);
   reinitializeSplit<3>(local, ghosts, kBand);
@@ -41,8 +41,8 @@ double differenceWithin(double k, int ghost) {
   double worst = 0.0;
   if (worldRank() == 0)
     for (std::size_t i = 0; i < serial.count(); ++i)
-      if (std::abs(serial[i]) <= k * kGlobal.dx) worst = std::max(worst, double(std::abs(serial[i] - split[i])));
-  return worst / kGlobal.dx;
+      if (std::abs(serial[i]) <= k * kLevelSetGrid.dx) worst = std::max(worst, double(std::abs(serial[i] - split[i])));
+  return worst / kLevelSetGrid.dx;
 }
 
 // The chapter's rule: a band of k valid cells needs ceil(k) ghost layers. The discrete distance

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "../cell_field.hpp"
+#include "../unit_box.hpp"
 #include "msim/core/rng.hpp"
 #include "msim/numerics/pressure/projection.hpp"
 
@@ -16,10 +17,7 @@ using namespace msim::numerics;
 
 namespace {
 
-template <int D>
-GridSpec<D> unitBox(int n) {
-  return GridSpec<D>(Vec<D>::Zero(), 1.0 / n, IVec<D>::Constant(n));
-}
+using msim::test::unitBox;
 
 ProjectionSettings tightSettings() {
   ProjectionSettings s;

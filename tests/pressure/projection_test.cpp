@@ -12,16 +12,14 @@
 #include "msim/numerics/pressure/face_fractions.hpp"
 #include "msim/numerics/pressure/projection.hpp"
 #include "msim/numerics/pressure/vector_ops.hpp"
+#include "../unit_box.hpp"
 
 using namespace msim;
 using namespace msim::numerics;
 
 namespace {
 
-template <int D>
-GridSpec<D> unitBox(int n) {
-  return GridSpec<D>(Vec<D>::Zero(), 1.0 / n, IVec<D>::Constant(n));
-}
+using msim::test::unitBox;
 
 template <int D>
 MacGrid<D> randomVelocity(const GridSpec<D>& spec, std::uint64_t seed) {

@@ -11,13 +11,12 @@
 
 #include "msim/core/error.hpp"
 #include "msim/rigid/mass_properties.hpp"
+#include "rotations.hpp"
 
 namespace msim::rigid {
 namespace {
 
-Eigen::Quaterniond about(double angle, const Vec3& axis) {
-  return Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis.normalized()));
-}
+using testing::about;
 
 // The L-shaped prism {(x, z) in the L below} x [0, 1] in y as a closed outward-wound mesh.
 // L in the (x, z) plane, counter-clockwise: (0,0) (2,0) (2,0.5) (0.5,0.5) (0.5,2) (0,2).

@@ -10,12 +10,13 @@
 #include <numbers>
 
 #include "msim/rigid/mass_properties.hpp"
+#include "rotations.hpp"
 #include "test_meshes.hpp"
 
 namespace msim::rigid {
 namespace {
 
-constexpr double kG = 9.81;
+constexpr double kGravity = 9.81;
 
 RigidBody placed(Shape shape, const Vec3& position, const Eigen::Quaterniond& orientation) {
   RigidBody b = RigidBody::fromDensity(std::move(shape), 1000.0);
@@ -24,9 +25,7 @@ RigidBody placed(Shape shape, const Vec3& position, const Eigen::Quaterniond& or
   return b;
 }
 
-Eigen::Quaterniond about(double angle, const Vec3& axis) {
-  return Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis.normalized()));
-}
+using testing::about;
 
 std::vector<Contact> contactsOf(const RigidBody& a, const RigidBody& b, double margin = 1e-6) {
   std::vector<Contact> out;
@@ -140,10 +139,10 @@ TEST(RigidPolyhedronContact, StackOfThreeBoxesStaysStacked) {
     yaw = std::max(yaw, std::abs(b.angularVelocity.z()));
   }
   std::printf("box stack, 2 s: drift %.3g m, tilt %.3g rad, max |v_z| in 2nd second %.3g m/s "
-              "(g dt = %.3g m/s), yaw rate %.3g rad/s\n", drift, tilt, maxVertical, kG * dt, yaw);
+              "(g dt = %.3g m/s), yaw rate %.3g rad/s\n", drift, tilt, maxVertical, kGravity * dt, yaw);
   EXPECT_LT(drift, 1e-3);
   EXPECT_LT(tilt, 1e-3);
-  EXPECT_LT(maxVertical, 0.01 * kG * dt);
+  EXPECT_LT(maxVertical, 0.01 * kGravity * dt);
 }
 
 // Box of side 0.2 dropped 1 mm onto a static slab tilted by `angle` about y; returns the speed
@@ -172,7 +171,7 @@ TEST(RigidPolyhedronContact, BoxOnSlopeSlidesIffTangentExceedsFriction) {
   const double stuckSpeed = slideOnSlope(critical - delta, mu).first;
   const auto [slideSpeed, slideHalf] = slideOnSlope(critical + delta, mu);
   const double theta = critical + delta;
-  const double a = kG * (std::sin(theta) - mu * std::cos(theta));  // Coulomb sliding
+  const double a = kGravity * (std::sin(theta) - mu * std::cos(theta));  // Coulomb sliding
   std::printf("slope mu = %.2f: at %.2f deg speed %.3g m/s; at %.2f deg acceleration %.4f m/s^2 "
               "(expected %.4f)\n", mu, (critical - delta) * 180 / std::numbers::pi, stuckSpeed,
               theta * 180 / std::numbers::pi, (slideSpeed - slideHalf) / 0.5, a);

@@ -17,6 +17,7 @@
 #include "msim/core/rng.hpp"
 #include "msim/solids/collision/ccd.hpp"
 #include "msim/solids/collision/proximity.hpp"
+#include "random_points.hpp"
 
 using namespace msim;
 using namespace msim::solids;
@@ -79,10 +80,6 @@ SampledCollision sampledCollision(const Points& x0, const Points& x1, const Dist
 
 double pointTriangleDistance(const Points& x) { return pointTriangleProximity(x[0], x[1], x[2], x[3]).distance; }
 double edgeEdgeDistance(const Points& x) { return edgeEdgeProximity(x[0], x[1], x[2], x[3]).distance; }
-
-Vec3 randomVector(Rng& rng, double half) {
-  return Vec3(rng.uniform(-half, half), rng.uniform(-half, half), rng.uniform(-half, half));
-}
 
 }  // namespace
 

@@ -15,6 +15,7 @@
 
 #include "msim/core/rng.hpp"
 #include "msim/solids/collision/impact_zone.hpp"
+#include "random_points.hpp"
 
 using namespace msim;
 using namespace msim::solids;
@@ -28,10 +29,6 @@ struct Particles {
   std::vector<char> pinned;
   std::vector<Vec3> x0, x1;
 };
-
-Vec3 randomVector(Rng& rng, double half) {
-  return Vec3(rng.uniform(-half, half), rng.uniform(-half, half), rng.uniform(-half, half));
-}
 
 Particles randomParticles(Rng& rng, int n) {
   Particles p;

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "msim/core/parallel.hpp"
+#include "msim/core/seconds_since.hpp"
 #include "msim/render/phase_function.hpp"
 
 namespace msim::render {
@@ -28,10 +29,6 @@ double closestApproachGaussian(double d2, double sigma) {
 double chordIntegral(double mass, double sigma, double c, double d2, double a, double b) {
   const double k = 1.0 / (std::numbers::sqrt2 * sigma);
   return mass * closestApproachGaussian(d2, sigma) * 0.5 * (std::erf((b - c) * k) - std::erf((a - c) * k));
-}
-
-double secondsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 }  // namespace

@@ -3,15 +3,9 @@
 #include <chrono>
 #include <stdexcept>
 
+#include "msim/core/seconds_since.hpp"
+
 namespace msim::render {
-
-namespace {
-
-double secondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-}  // namespace
 
 std::vector<Light> defaultLights() {
   Light key;

@@ -15,6 +15,7 @@
 #include <fmt/format.h>
 
 #include "msim/core/parallel.hpp"
+#include "msim/core/seconds_since.hpp"
 #include "msim/render/blackbody.hpp"
 #include "msim/render/grid_sampler.hpp"
 #include "msim/render/liquid_tracer.hpp"
@@ -452,10 +453,6 @@ Vec3 entryFaceNormal(const Ray& r, const Vec3& lo, const Vec3& hi) {
   Vec3 n = Vec3::Zero();
   n[face] = r.direction[face] > 0.0 ? -1.0 : 1.0;
   return n;
-}
-
-double secondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 }  // namespace

@@ -5,17 +5,10 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "msim/core/seconds_since.hpp"
 #include "msim/solids/strain_limit.hpp"
 
 namespace msim::solids {
-
-namespace {
-
-double secondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-}  // namespace
 
 ClothCollisionLoop::ClothCollisionLoop(std::vector<std::array<int, 3>> triangles, std::size_t particleCount,
                                        const NewmarkSettings& newmark, const ClothCollisionSettings& settings)

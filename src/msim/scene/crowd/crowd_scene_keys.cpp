@@ -287,7 +287,7 @@ crowd::AgentModel modelOf(const std::string& name) {
   return crowd::AgentModel::Uic;
 }
 
-struct Builder {
+struct CrowdSceneBuilder {
   const Scene& scene;
   const json& r;
   std::string source;
@@ -741,7 +741,7 @@ void declareCrowdKeys(Schema& root) {
 }
 
 CrowdSceneSetup buildCrowdScene(const Scene& scene) {
-  Builder b{scene, scene.resolved, scene.file.string(), {}, {}, {}};
+  CrowdSceneBuilder b{scene, scene.resolved, scene.file.string(), {}, {}, {}};
   b.domainAndGrid();
   b.settings();
   b.obstacles();

@@ -94,7 +94,7 @@ Schema solidSchema() {
   return s;
 }
 
-struct Builder {
+struct GranularSceneBuilder {
   const Scene& scene;
   const json& r;
   std::string source;
@@ -260,7 +260,7 @@ void declareGranularKeys(Schema& root) {
 }
 
 GranularSceneSetup buildGranularScene(const Scene& scene) {
-  Builder b{scene, scene.resolved, scene.file.string(), {}, {}, {}};
+  GranularSceneBuilder b{scene, scene.resolved, scene.file.string(), {}, {}, {}};
   b.simulation();
   b.solids();
   try {
