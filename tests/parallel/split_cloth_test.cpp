@@ -2,11 +2,12 @@
 // particle, computes its own particles' rows of the implicit solves and shares them; collision
 // impulses run in the two phases. Checked on 1, 2, 4 and 8 ranks: the exchange hands every
 // particle its owner's value, the split implicit step is the one-process step within the solve's
-// tolerance, and a cloth crumpling on a floor never passes through itself while every rank keeps
-// the same bits.
+// tolerance, the pairs and contacts found together are one process's, and a cloth crumpling on a
+// floor never passes through itself while every rank keeps the same bits.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <memory>
 
@@ -81,6 +82,42 @@ TEST(SplitCloth, ImplicitStepsEqualOneProcessWithinTheSolveTolerance) {
   EXPECT_LE(worst, 1e-8 * travel) << "the split solve's answer";
   EXPECT_TRUE(sameOnEveryRank(shared.x));
   EXPECT_TRUE(sameOnEveryRank(shared.v));
+}
+
+// A sheet folded over itself in a wave: the pairs within reach (step A) and the repulsions'
+// contacts found by the processes together equal one process's.
+TEST(SplitCloth, PairsAndContactsFoundTogetherAreOneProcesssOwn) {
+  TriangleMesh mesh = clothPatch(Vec3(-0.3, 0.0, -0.3), Vec3(0.6, 0.0, 0.0), Vec3(0.0, 0.0, 0.6), 20, 20);
+  for (Vec3& x : mesh.vertices) x[1] = 0.004 * std::sin(25.0 * x[0]) + 0.006 * std::cos(31.0 * x[2]);  // bumps
+  for (std::size_t k = 0; k < 10 * 21; ++k) {  // the rows at z < 0 folded over those at z > 0, 9 mm above
+    Vec3& x = mesh.vertices[k];
+    x = Vec3(x[0], 0.009 + x[1], -x[2]);
+  }
+  const SplitCloth split(mesh.vertices, MPI_COMM_WORLD);
+  const auto find = [&](const ParticleSplit* s) {
+    CollisionPairs pairs(mesh.triangles, mesh.vertices.size());
+    std::vector<PointTrianglePair> pointTriangle;
+    std::vector<EdgeEdgePair> edgeEdge;
+    pairs.find(mesh.vertices, mesh.vertices, 0.02, pointTriangle, edgeEdge, nullptr, s);
+    return std::make_pair(pointTriangle, edgeEdge);
+  };
+  const auto whole = find(nullptr), joined = find(&split);
+  EXPECT_GT(whole.first.size(), 1000u);
+  EXPECT_GT(whole.second.size(), 1000u);
+  EXPECT_TRUE(joined.first == whole.first);
+  EXPECT_TRUE(joined.second == whole.second);
+  const auto contacts = [&](const ParticleSplit* s) {
+    CollisionPairs pairs(mesh.triangles, mesh.vertices.size());
+    SelfRepulsion repulsion({.thickness = 0.01});
+    repulsion.setSplit(s);
+    repulsion.findPairs(pairs, mesh.vertices, mesh.vertices);
+    std::vector<Vec3> v(mesh.vertices.size(), Vec3(0.0, -0.1, 0.0));
+    const std::vector<double> inverseMass(mesh.vertices.size(), 1.0);
+    return repulsion.repelEndVelocity(mesh.vertices, v, inverseMass);
+  };
+  const int alone = contacts(nullptr);
+  EXPECT_GT(alone, 100);
+  EXPECT_EQ(contacts(&split), alone);
 }
 
 // The collision loop's test scene (tests/solids/cloth_self_collision_test.cpp), smaller: a 0.6 m

@@ -64,6 +64,18 @@ long fromRankZero(long value) {
   return value;
 }
 
+std::vector<double> joinedFromAll(const std::vector<double>& mine, MPI_Comm comm) {
+  const int ranks = sizeOf(comm);
+  const int count = static_cast<int>(mine.size());
+  std::vector<int> counts(static_cast<std::size_t>(ranks)), offsets(static_cast<std::size_t>(ranks), 0);
+  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
+  for (int r = 1; r < ranks; ++r)
+    offsets[static_cast<std::size_t>(r)] = offsets[static_cast<std::size_t>(r - 1)] + counts[static_cast<std::size_t>(r - 1)];
+  std::vector<double> all(static_cast<std::size_t>(offsets.back() + counts.back()));
+  MPI_Allgatherv(mine.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE, comm);
+  return all;
+}
+
 void agreeOnFailure(std::exception_ptr local, MPI_Comm comm) {
   if (!mpiRunning()) {
     if (local) std::rethrow_exception(local);

@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 namespace msim::parallel {
 
@@ -62,6 +63,9 @@ auto collectively(F&& f) -> decltype(f()) {
   agreeOnFailure(failure, MPI_COMM_WORLD);
   throw std::logic_error("agreeOnFailure returned after a failure");  // not reached
 }
+
+// Every rank's `mine`, joined in rank order, on every rank of `comm`. Collective.
+std::vector<double> joinedFromAll(const std::vector<double>& mine, MPI_Comm comm);
 
 int rankOf(MPI_Comm comm);
 int sizeOf(MPI_Comm comm);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <numeric>
+#include <stdexcept>
 
 #include "msim/parallel/median_partition.hpp"
 #include "msim/parallel/mpi_session.hpp"
@@ -9,8 +10,22 @@
 
 namespace msim::parallel {
 
+namespace {
+
+std::vector<char> ownedBy(const std::vector<int>& owner, int rank) {
+  std::vector<char> mine(owner.size());
+  for (std::size_t p = 0; p < owner.size(); ++p) mine[p] = owner[p] == rank;
+  return mine;
+}
+
+}  // namespace
+
 SplitCloth::SplitCloth(const std::vector<Vec3>& positions, MPI_Comm comm)
-    : comm_(comm), rank_(rankOf(comm)), ranks_(sizeOf(comm)), owner_(recursiveMedianPartition(positions, ranks_)) {
+    : SplitCloth(recursiveMedianPartition(positions, sizeOf(comm)), comm) {}
+
+SplitCloth::SplitCloth(std::vector<int> owner, MPI_Comm comm)
+    : ParticleSplit(ownedBy(owner, rankOf(comm))), comm_(comm), rank_(rankOf(comm)), ranks_(sizeOf(comm)),
+      owner_(std::move(owner)) {
   byOwner_.resize(owner_.size());
   std::iota(byOwner_.begin(), byOwner_.end(), 0);
   std::stable_sort(byOwner_.begin(), byOwner_.end(),
@@ -46,6 +61,11 @@ double SplitCloth::sum(double local) const {
   std::vector<double> parts(static_cast<std::size_t>(ranks_));
   MPI_Allgather(&local, 1, MPI_DOUBLE, parts.data(), 1, MPI_DOUBLE, comm_);
   return std::accumulate(parts.begin(), parts.end(), 0.0);
+}
+
+void SplitCloth::gatherRows(std::vector<double>& rows, int width) const {
+  rows = joinedFromAll(rows, comm_);
+  if (rows.size() % static_cast<std::size_t>(width) != 0) throw std::logic_error("gatherRows: rows of another width");
 }
 
 void SplitCloth::gaussSeidel(const std::vector<std::array<int, 4>>& items, std::vector<Vec3>& v,

@@ -3,8 +3,9 @@
 // Selle ch. 8.2: the particles are cut by recursiveMedianPartition at their starting positions,
 // fixed for the run; every process stores every particle. shareOwned() exchanges the rows each
 // process computed (MPI_Allgatherv of the owners' values), sum() adds one number per process in
-// rank order (the same bits everywhere, so all processes take the same CG steps), gaussSeidel()
-// runs a collision pass in the two phases of two_phase_collisions.hpp.
+// rank order (the same bits everywhere, so all processes take the same CG steps), gatherRows()
+// joins what each process found (MPI_Allgatherv), gaussSeidel() runs a collision pass in the two
+// phases of two_phase_collisions.hpp.
 #include <mpi.h>
 
 #include <vector>
@@ -22,12 +23,15 @@ class SplitCloth final : public solids::ParticleSplit {
   std::span<const int> owned() const override;
   void shareOwned(double* values) const override;
   double sum(double local) const override;
+  void gatherRows(std::vector<double>& rows, int width) const override;
   void gaussSeidel(const std::vector<std::array<int, 4>>& items, std::vector<Vec3>& v,
                    const std::function<void(std::size_t)>& respond) const override;
 
   const std::vector<int>& owner() const { return owner_; }
 
  private:
+  SplitCloth(std::vector<int> owner, MPI_Comm comm);
+
   MPI_Comm comm_;
   int rank_ = 0, ranks_ = 1;
   std::vector<int> owner_;

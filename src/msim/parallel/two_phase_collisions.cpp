@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <numeric>
 
+#include "msim/parallel/mpi_session.hpp"
+
 namespace msim::parallel {
 
 namespace {
@@ -91,8 +93,6 @@ std::vector<int> nodesOf(const std::vector<CollisionItem>& items, const std::vec
 }
 
 void shareVelocities(const std::vector<int>& nodes, std::vector<Vec3>& v, MPI_Comm comm) {
-  int ranks = 1;
-  MPI_Comm_size(comm, &ranks);
   // Rows of (node, vx, vy, vz) in doubles: node indices below 2^53 are exact.
   std::vector<double> rows;
   rows.reserve(4 * nodes.size());
@@ -100,12 +100,7 @@ void shareVelocities(const std::vector<int>& nodes, std::vector<Vec3>& v, MPI_Co
     const Vec3& x = v[static_cast<std::size_t>(n)];
     rows.insert(rows.end(), {double(n), x[0], x[1], x[2]});
   }
-  const int count = static_cast<int>(rows.size());
-  std::vector<int> counts(static_cast<std::size_t>(ranks)), offsets(static_cast<std::size_t>(ranks), 0);
-  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
-  for (int r = 1; r < ranks; ++r) offsets[static_cast<std::size_t>(r)] = offsets[static_cast<std::size_t>(r - 1)] + counts[static_cast<std::size_t>(r - 1)];
-  std::vector<double> all(static_cast<std::size_t>(offsets.back() + counts.back()));
-  MPI_Allgatherv(rows.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE, comm);
+  const std::vector<double> all = joinedFromAll(rows, comm);
   for (std::size_t at = 0; at < all.size(); at += 4)
     v[static_cast<std::size_t>(all[at])] = Vec3(all[at + 1], all[at + 2], all[at + 3]);
 }

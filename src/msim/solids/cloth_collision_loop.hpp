@@ -60,11 +60,12 @@ class ClothCollisionLoop {
                            const BodyContact* bodies, const std::function<void(double)>& placeBodies = {});
 
   const ClothCollisionSettings& settings() const { return settings_; }
-  // Splits the inner steps' solves and repulsions among processes (particle_split.hpp; null: this
-  // process alone). Steps A and C run whole on every process, alike.
+  // Splits the search for pairs and crossings (steps A and C), the inner steps' solves and the
+  // repulsions among processes (particle_split.hpp; null: this process alone).
   void setSplit(const ParticleSplit* split) {
     stepper_.setSplit(split);
     repulsion_.setSplit(split);
+    resolver_.setSplit(split);
   }
 
  private:

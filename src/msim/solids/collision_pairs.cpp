@@ -64,6 +64,23 @@ void findInChunks(std::size_t count, std::vector<std::vector<Pair>>& chunks, std
   for (std::size_t c = 0; c < chunkCount; ++c) out.insert(out.end(), chunks[c].begin(), chunks[c].end());
 }
 
+// Every process's pairs, each process's in the order of its queries (by point or first edge, each
+// queried by one process), joined on every process and put in the order of the queries: the
+// pairs one process alone finds.
+template <typename Pair, typename Fields>
+void joinPairs(const ParticleSplit& split, std::vector<Pair>& pairs, Fields&& fields) {
+  std::vector<double> rows;
+  rows.reserve(2 * pairs.size());
+  for (const Pair& p : pairs) {
+    const std::array<int, 2> f = fields(p);
+    rows.insert(rows.end(), {double(f[0]), double(f[1])});
+  }
+  split.gatherRows(rows, 2);
+  pairs.resize(rows.size() / 2);
+  for (std::size_t k = 0; k < pairs.size(); ++k) pairs[k] = Pair{static_cast<int>(rows[2 * k]), static_cast<int>(rows[2 * k + 1])};
+  std::stable_sort(pairs.begin(), pairs.end(), [&](const Pair& a, const Pair& b) { return fields(a)[0] < fields(b)[0]; });
+}
+
 }  // namespace
 
 CollisionPairs::CollisionPairs(std::vector<std::array<int, 3>> triangles, std::size_t vertexCount)
@@ -141,7 +158,7 @@ void CollisionPairs::groupPieces(const std::vector<Vec3>& start, const std::vect
 
 void CollisionPairs::find(const std::vector<Vec3>& start, const std::vector<Vec3>& end, double margin,
                           std::vector<PointTrianglePair>& pointTriangle, std::vector<EdgeEdgePair>& edgeEdge,
-                          const std::vector<char>* moved) {
+                          const std::vector<char>* moved, const ParticleSplit* split) {
   if (start.size() != vertexCount_ || end.size() != vertexCount_)
     throw std::invalid_argument("collision pairs: the positions do not match the mesh's vertex count");
   groupPieces(start, end, margin);
@@ -166,9 +183,11 @@ void CollisionPairs::find(const std::vector<Vec3>& start, const std::vector<Vec3
   }
   ++queries_;
   const auto isMoved = [&](int v) { return moved == nullptr || (*moved)[static_cast<std::size_t>(v)] != 0; };
+  const auto queries = [&](int v) { return split == nullptr || split->owns(v); };
 
   findInChunks(vertexCount_, pointTriangleChunks_, pointTriangle, [&](std::size_t v, std::vector<PointTrianglePair>& out) {
         const int point = static_cast<int>(v);
+        if (!queries(point)) return;
         triangleTree_.forEachOverlap(vertexBoxes_[v], [&](int t) {
           const auto& tri = triangles_[static_cast<std::size_t>(t)];
           if (tri[0] == point || tri[1] == point || tri[2] == point) return;
@@ -181,6 +200,7 @@ void CollisionPairs::find(const std::vector<Vec3>& start, const std::vector<Vec3
 
   findInChunks(edges_.size(), edgeEdgeChunks_, edgeEdge, [&](std::size_t e, std::vector<EdgeEdgePair>& out) {
         const auto& edge = edges_[e];
+        if (!queries(edge[0])) return;
         edgeTree_.forEachOverlap(edgeBoxes_[e], [&](int f) {
           if (f <= static_cast<int>(e)) return;  // each pair once
           const auto& other = edges_[static_cast<std::size_t>(f)];
@@ -191,6 +211,10 @@ void CollisionPairs::find(const std::vector<Vec3>& start, const std::vector<Vec3
           out.push_back({static_cast<int>(e), f});
         });
       });
+  if (split) {
+    joinPairs(*split, pointTriangle, [](const PointTrianglePair& p) { return std::array<int, 2>{p.point, p.triangle}; });
+    joinPairs(*split, edgeEdge, [](const EdgeEdgePair& p) { return std::array<int, 2>{p.first, p.second}; });
+  }
 }
 
 }  // namespace msim::solids

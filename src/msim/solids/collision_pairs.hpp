@@ -19,6 +19,7 @@
 
 #include "msim/core/vec.hpp"
 #include "msim/numerics/bvh.hpp"
+#include "msim/solids/particle_split.hpp"
 
 namespace msim::solids {
 
@@ -45,10 +46,13 @@ class CollisionPairs {
 
   // Pairs whose boxes over `start` and `end` (the same vector for a mesh at rest), each grown by
   // `margin`, overlap; by point (edge), then in the trees' order: the same whatever the thread count. `moved`, when
-  // given, keeps only pairs with at least one vertex flagged (the later passes of step C.5).
+  // given, keeps only pairs with at least one vertex flagged (the later passes of step C.5). With a
+  // split among processes (particle_split.hpp; collective), each process queries its own points
+  // and the edges whose first vertex it owns, and every process ends with all the pairs, in the
+  // same order as one process alone.
   void find(const std::vector<Vec3>& start, const std::vector<Vec3>& end, double margin,
             std::vector<PointTrianglePair>& pointTriangle, std::vector<EdgeEdgePair>& edgeEdge,
-            const std::vector<char>* moved = nullptr);
+            const std::vector<char>* moved = nullptr, const ParticleSplit* split = nullptr);
 
  private:
   // The vertices' boxes in the frame of their group's mean displacement, and the groups.

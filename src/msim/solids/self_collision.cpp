@@ -41,12 +41,18 @@ void SelfCollisionResolver::detect(const CollisionPairs& pairs, const std::vecto
     return k < nPoint ? Crossing{true, candidatesPointTriangle_[k].point, candidatesPointTriangle_[k].triangle}
                       : Crossing{false, candidatesEdgeEdge_[k - nPoint].first, candidatesEdgeEdge_[k - nPoint].second};
   };
-  // One flag per candidate, filled in parallel, then read in order: deterministic.
+  // One flag per candidate, filled in parallel, then read in order: deterministic. With a split,
+  // each process tests the candidates of its own points and of the edges whose first vertex it
+  // owns, and the crossings found are joined.
+  const auto tests = [&](const Crossing& c) {
+    return split_ == nullptr || split_->owns(c.pointTriangle ? c.first : pairs.edges()[static_cast<std::size_t>(c.first)][0]);
+  };
   hit_.assign(n, 0);
   parallelFor(
       0, n,
       [&](std::size_t k) {
         const Crossing c = candidate(k);
+        if (!tests(c)) return;
         const std::array<int, 4> nodes = particles(pairs, c);
         const auto a0 = gatherPositions(nodes, x0), a1 = gatherPositions(nodes, x1);
         const auto t = c.pointTriangle ? pointTriangleCollisionTime(a0, a1, settings_.tolerance)
@@ -54,6 +60,13 @@ void SelfCollisionResolver::detect(const CollisionPairs& pairs, const std::vecto
         hit_[k] = t.has_value() ? 1 : 0;
       },
       64);
+  if (split_) {
+    std::vector<double> found;
+    for (std::size_t k = 0; k < n; ++k)
+      if (hit_[k]) found.push_back(static_cast<double>(k));
+    split_->gatherRows(found, 1);
+    for (const double k : found) hit_[static_cast<std::size_t>(k)] = 1;
+  }
   crossings_.clear();
   for (std::size_t k = 0; k < n; ++k)
     if (hit_[k]) crossings_.push_back(candidate(k));
@@ -120,7 +133,8 @@ SelfCollisionStats SelfCollisionResolver::resolve(CollisionPairs& pairs, const s
   ImpactZones zones(static_cast<int>(n));
   const int totalPasses = settings_.gaussSeidelPasses + settings_.impactZonePasses;
   for (int pass = 0; pass < totalPasses; ++pass) {
-    pairs.find(x0, x1, settings_.tolerance, candidatesPointTriangle_, candidatesEdgeEdge_, pass == 0 ? nullptr : &movedThisPass_);
+    pairs.find(x0, x1, settings_.tolerance, candidatesPointTriangle_, candidatesEdgeEdge_, pass == 0 ? nullptr : &movedThisPass_,
+               split_);
     detect(pairs, x0, x1);
     ++stats.passes;
     stats.unresolved = static_cast<int>(crossings_.size());
@@ -147,7 +161,7 @@ SelfCollisionStats SelfCollisionResolver::resolve(CollisionPairs& pairs, const s
   }
   if (stats.unresolved > 0 && stats.passes == totalPasses) {
     // The last pass changed positions after its detection: look once more.
-    pairs.find(x0, x1, settings_.tolerance, candidatesPointTriangle_, candidatesEdgeEdge_, &movedThisPass_);
+    pairs.find(x0, x1, settings_.tolerance, candidatesPointTriangle_, candidatesEdgeEdge_, &movedThisPass_, split_);
     detect(pairs, x0, x1);
     stats.unresolved = static_cast<int>(crossings_.size());
   }

@@ -19,6 +19,7 @@
 #include "msim/core/vec.hpp"
 #include "msim/solids/body_contact.hpp"
 #include "msim/solids/collision_pairs.hpp"
+#include "msim/solids/particle_split.hpp"
 #include "msim/solids/self_repulsion.hpp"
 
 namespace msim::solids {
@@ -40,6 +41,10 @@ struct SelfCollisionStats {
 class SelfCollisionResolver {
  public:
   explicit SelfCollisionResolver(const SelfCollisionSettings& settings = {}) : settings_(settings) {}
+  // Splits the detection among processes (particle_split.hpp; null: this process alone): each
+  // finds the candidates and tests the crossings of its own points and of the edges whose first
+  // vertex it owns, and all join them; the impulses and impact zones run alike on every process.
+  void setSplit(const ParticleSplit* split) { split_ = split; }
 
   // Makes x1 collision-free relative to x0 (itself collision-free). T: the outer step [s];
   // innerDt: the average inner step; repulsion: the thickness and stiffness of eq. 6.1; pinned
@@ -67,6 +72,7 @@ class SelfCollisionResolver {
   std::vector<char> hit_, moved_, movedThisPass_;
   std::vector<double> inverseMass_;
   std::vector<Vec3> velocity_;
+  const ParticleSplit* split_ = nullptr;
 };
 
 }  // namespace msim::solids

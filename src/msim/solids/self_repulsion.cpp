@@ -14,25 +14,36 @@ namespace msim::solids {
 void SelfRepulsion::findPairs(CollisionPairs& pairs, const std::vector<Vec3>& x, const std::vector<Vec3>& predicted) {
   mesh_ = &pairs;
   gatheredValid_ = false;  // new pairs: the next gathering examines them all
-  pairs.find(x, predicted, settings_.thickness, foundPointTriangle_, foundEdgeEdge_);
-  // Each pair's side in the collision-free state (eq. 6.2's history), on all cores.
+  pairs.find(x, predicted, settings_.thickness, foundPointTriangle_, foundEdgeEdge_, nullptr, split_);
+  // Each pair's side in the collision-free state (eq. 6.2's history), on all cores; with a split,
+  // of the pairs this process examines.
   pointTriangle_.resize(foundPointTriangle_.size());
+  edgeEdge_.resize(foundEdgeEdge_.size());
+  for (std::size_t i = 0; i < foundPointTriangle_.size(); ++i) pointTriangle_[i].pair = foundPointTriangle_[i];
+  for (std::size_t i = 0; i < foundEdgeEdge_.size(); ++i) edgeEdge_[i].pair = foundEdgeEdge_[i];
   parallelFor(0, foundPointTriangle_.size(), [&](std::size_t i) {
+    if (!examines(i)) return;
     const PointTrianglePair& p = foundPointTriangle_[i];
     const auto& t = pairs.triangles()[static_cast<std::size_t>(p.triangle)];
     const Vec3& a = x[static_cast<std::size_t>(t[0])];
     const double side = (x[static_cast<std::size_t>(t[1])] - a).cross(x[static_cast<std::size_t>(t[2])] - a).dot(x[static_cast<std::size_t>(p.point)] - a);
-    pointTriangle_[i] = {p, side < 0.0};
+    pointTriangle_[i].flipped = side < 0.0;
   });
-  edgeEdge_.resize(foundEdgeEdge_.size());
   parallelFor(0, foundEdgeEdge_.size(), [&](std::size_t i) {
+    if (!examines(foundPointTriangle_.size() + i)) return;
     const EdgeEdgePair& p = foundEdgeEdge_[i];
     const auto& e = pairs.edges()[static_cast<std::size_t>(p.first)];
     const auto& f = pairs.edges()[static_cast<std::size_t>(p.second)];
     const EdgeEdgeProximity prox = edgeEdgeProximity(x[static_cast<std::size_t>(e[0])], x[static_cast<std::size_t>(e[1])],
                                                      x[static_cast<std::size_t>(f[0])], x[static_cast<std::size_t>(f[1])]);
-    edgeEdge_[i] = {p, prox.normal};
+    edgeEdge_[i].side = prox.normal;
   });
+}
+
+bool SelfRepulsion::examines(std::size_t pair) const {
+  if (split_ == nullptr) return true;
+  if (pair < pointTriangle_.size()) return split_->owns(pointTriangle_[pair].pair.point);
+  return split_->owns(mesh_->edges()[static_cast<std::size_t>(edgeEdge_[pair - pointTriangle_.size()].pair.first)][0]);
 }
 
 int SelfRepulsion::repelPositionVelocity(const std::vector<Vec3>& x, std::vector<Vec3>& v,
@@ -146,6 +157,7 @@ void SelfRepulsion::gatherContacts(const std::vector<Vec3>& x) {
     const auto &e = edges[static_cast<std::size_t>(p.first)], &f = edges[static_cast<std::size_t>(p.second)];
     return moved(e[0]) || moved(e[1]) || moved(f[0]) || moved(f[1]);
   };
+  // With a split, the contacts each process examined are joined below.
   constexpr std::size_t kBlock = 2048;
   const std::size_t pairs = pointTriangle_.size() + edgeEdge_.size();
   const std::size_t blocks = (pairs + kBlock - 1) / kBlock;
@@ -158,6 +170,7 @@ void SelfRepulsion::gatherContacts(const std::vector<Vec3>& x) {
     auto kept = std::lower_bound(contacts_.begin(), contacts_.end(), static_cast<int>(first),
                                  [](const Contact& c, int pair) { return c.pair < pair; });
     for (std::size_t i = first; i < end; ++i) {
+      if (!examines(i)) continue;
       if (incremental && !pairMoved(i)) {
         while (kept != contacts_.end() && kept->pair < static_cast<int>(i)) ++kept;
         if (kept != contacts_.end() && kept->pair == static_cast<int>(i)) found.push_back(*kept);
@@ -171,6 +184,34 @@ void SelfRepulsion::gatherContacts(const std::vector<Vec3>& x) {
   contacts_.clear();
   for (std::size_t block = 0; block < blocks; ++block)
     contacts_.insert(contacts_.end(), blockContacts_[block].begin(), blockContacts_[block].end());
+  if (split_) joinContacts();
+}
+
+// Every process's contacts as rows of 13 doubles (particles, weights, normal, gap, pair), joined on
+// every process and put in the pairs' order: the contacts one process alone finds.
+void SelfRepulsion::joinContacts() {
+  constexpr int kWidth = 13;
+  std::vector<double>& rows = contactRows_;
+  rows.clear();
+  for (const Contact& c : contacts_) {
+    for (int k = 0; k < 4; ++k) rows.push_back(c.stencil.node[static_cast<std::size_t>(k)]);
+    rows.insert(rows.end(), c.stencil.weight.begin(), c.stencil.weight.end());
+    rows.insert(rows.end(), {c.normal[0], c.normal[1], c.normal[2], c.gap, double(c.pair)});
+  }
+  split_->gatherRows(rows, kWidth);
+  contacts_.resize(rows.size() / kWidth);
+  for (std::size_t i = 0; i < contacts_.size(); ++i) {
+    const double* row = rows.data() + kWidth * i;
+    Contact& c = contacts_[i];
+    for (std::size_t k = 0; k < 4; ++k) {
+      c.stencil.node[k] = static_cast<int>(row[k]);
+      c.stencil.weight[k] = row[4 + k];
+    }
+    c.normal = Vec3(row[8], row[9], row[10]);
+    c.gap = row[11];
+    c.pair = static_cast<int>(row[12]);
+  }
+  std::sort(contacts_.begin(), contacts_.end(), [](const Contact& a, const Contact& b) { return a.pair < b.pair; });
 }
 
 int SelfRepulsion::respond(Pass pass, std::vector<Vec3>& v, const std::vector<double>& inverseMass, double dt) const {

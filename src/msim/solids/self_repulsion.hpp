@@ -54,10 +54,11 @@ class SelfRepulsion {
                             double dt);
   int repelEndVelocity(const std::vector<Vec3>& x, std::vector<Vec3>& v, const std::vector<double>& inverseMass);
 
-  // Runs the Gauss-Seidel passes in the two phases of a split among processes (particle_split.hpp;
-  // null: this process alone). Every process holds every position, so each gathers the same
-  // contacts; the passes' order is then the phases' (the contacts that span processes, in connected
-  // groups, before each process's own) instead of the pairs'.
+  // Splits the work among processes (particle_split.hpp; null: this process alone): each finds the
+  // pairs (step A) and examines the contacts of its own points and of the edges whose first vertex
+  // it owns, and all join them, so that every process holds the contacts one process alone finds;
+  // the Gauss-Seidel passes run in the split's two phases, whose order (the contacts that span
+  // processes, in connected groups, before each process's own) replaces the pairs'.
   void setSplit(const ParticleSplit* split) { split_ = split; }
 
   RepulsionStats stats() const { return {static_cast<int>(pointTriangle_.size()), static_cast<int>(edgeEdge_.size())}; }
@@ -76,6 +77,11 @@ class SelfRepulsion {
   // ends, in the pairs' order (points first); pairs whose particles have not moved since the last
   // call keep its finding.
   void gatherContacts(const std::vector<Vec3>& x);
+  // With a split: every process's contacts on every process, in the pairs' order.
+  void joinContacts();
+  // Whether this process examines pair i (points' pairs first): with a split, the pairs of its own
+  // points and of the edges whose first vertex it owns.
+  bool examines(std::size_t pair) const;
   // One Gauss-Seidel pass over the gathered contacts; returns their count.
   int respond(Pass pass, std::vector<Vec3>& v, const std::vector<double>& inverseMass, double dt) const;
   // Contact c's impulse of the pass.
@@ -118,6 +124,7 @@ class SelfRepulsion {
   bool gatheredValid_ = false;
   const ParticleSplit* split_ = nullptr;
   mutable std::vector<std::array<int, 4>> contactParticles_;  // with a split: each contact's stencil's particles
+  std::vector<double> contactRows_;                           // with a split: joinContacts' exchange
 };
 
 }  // namespace msim::solids

@@ -582,9 +582,9 @@ class MassSpringPhenomenon final : public Phenomenon {
   }
 
   // Under mpirun (Selle ch. 8.2): the particles cut by the recursive median at their starting
-  // places, every process holding the whole cloth; the inner steps' solves and repulsions split
-  // (solids/particle_split.hpp), everything else run alike on every process, so that all keep the
-  // same state and rank 0 writes it.
+  // places, every process holding the whole cloth; the solves, the search for pairs, contacts and
+  // crossings and the repulsions split (solids/particle_split.hpp), everything else run alike on
+  // every process, so that all keep the same state and rank 0 writes it.
   void splitAmongProcesses(const solids::NewmarkSettings& settings) {
     const int ranks = parallel::worldSize();
     if ((ranks & (ranks - 1)) != 0)
