@@ -9,12 +9,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <memory>
 
-#include "msim/geometry/analytic_shapes.hpp"
+#include "../solids/floor_drop.hpp"
 #include "msim/parallel/split_cloth.hpp"
-#include "msim/solids/cloth_collision_loop.hpp"
-#include "msim/solids/cloth_mesh.hpp"
 #include "msim/solids/collision/triangle_intersection.hpp"
 #include "mpi_test_support.hpp"
 
@@ -120,23 +117,14 @@ TEST(SplitCloth, PairsAndContactsFoundTogetherAreOneProcesssOwn) {
   EXPECT_EQ(contacts(&split), alone);
 }
 
-// The collision loop's test scene (tests/solids/cloth_self_collision_test.cpp), smaller: a 0.6 m
-// square of 16 x 16 quads dropped edge down onto a floor folds over itself.
+// The collision loop's test scene (tests/solids/floor_drop.hpp), smaller: a 0.6 m square of 16 x 16
+// quads dropped edge down onto a floor folds over itself.
 TEST(SplitCloth, ClothCrumplingOnAFloorNeverPassesThroughItself) {
-  const TriangleMesh mesh = clothPatch(Vec3(-0.3, 0.7, 0.0), Vec3(0.6, 0.0, 0.0), Vec3(0.0, -0.6, 0.05), 16, 16);
-  MassSpringSystem system =
-      clothSystem(mesh, {.edgeStiffness = 20.0, .edgeDamping = 0.002, .bendStiffness = 0.05, .bendDamping = 0.0001});
-  BodyContact floor;
-  floor.addBody({std::make_shared<geometry::Plane<3>>(Vec3::Zero(), Vec3(0.0, 1.0, 0.0)), Vec3::Zero(), 0.5});
-  NewmarkSettings newmark;
-  newmark.implicitSprings = true;
-  newmark.cgTolerance = 1e-4;
-  ClothCollisionSettings settings;
-  settings.innerSteps = 8;
-  settings.repulsion.thickness = 0.005;
-  settings.repulsion.stiffness = 800.0;
-  settings.strainLimit = 0.1;
-  ClothCollisionLoop loop(mesh.triangles, system.size(), newmark, settings);
+  FloorDrop drop = floorDrop(16);
+  const TriangleMesh& mesh = drop.mesh;
+  MassSpringSystem& system = drop.system;
+  const BodyContact& floor = drop.floor;
+  ClothCollisionLoop loop(mesh.triangles, system.size(), drop.newmark, drop.settings);
   const SplitCloth split(system.x, MPI_COMM_WORLD);
   loop.setSplit(&split);
   const double T = 0.01;

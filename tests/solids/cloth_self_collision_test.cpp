@@ -20,6 +20,7 @@
 #include "msim/solids/cloth_mesh.hpp"
 #include "msim/solids/collision/triangle_intersection.hpp"
 #include "msim/solids/newmark.hpp"
+#include "floor_drop.hpp"
 
 using namespace msim;
 using namespace msim::solids;
@@ -126,24 +127,14 @@ struct Drop {
   int repulsions = 0, collisions = 0;
 };
 
-// A 0.6 m square of cloth hanging edge down (24 x 24 quads, tilted 5 degrees) dropped onto a
-// floor with friction 0.5, outer steps of 1/100 s in 8 inner steps, for `seconds`.
+// The floor drop (floor_drop.hpp) of 24 x 24 quads in outer steps of 1/100 s, for `seconds`.
 Drop dropOntoFloor(bool collisions, double seconds) {
-  TriangleMesh mesh = clothPatch(Vec3(-0.3, 0.7, 0.0), Vec3(0.6, 0.0, 0.0), Vec3(0.0, -0.6, 0.05), 24, 24);
-  MassSpringSystem system = clothSystem(
-      mesh, {.edgeStiffness = 20.0, .edgeDamping = 0.002, .bendStiffness = 0.05, .bendDamping = 0.0001});
-  BodyContact floor;
-  floor.addBody({std::make_shared<geometry::Plane<3>>(Vec3::Zero(), Vec3(0.0, 1.0, 0.0)), Vec3::Zero(), 0.5});
-  NewmarkSettings newmark;
-  newmark.implicitSprings = true;
-  newmark.cgTolerance = 1e-4;
-  ClothCollisionSettings settings;
-  settings.innerSteps = 8;
-  settings.repulsion.thickness = 0.005;
-  settings.repulsion.stiffness = 800.0;  // about k / l0 of the edge springs
-  settings.strainLimit = 0.1;
-  ClothCollisionLoop loop(mesh.triangles, system.size(), newmark, settings);
-  NewmarkStepper plain(newmark);
+  FloorDrop scene = floorDrop(24);
+  const TriangleMesh& mesh = scene.mesh;
+  MassSpringSystem& system = scene.system;
+  const BodyContact& floor = scene.floor;
+  ClothCollisionLoop loop(mesh.triangles, system.size(), scene.newmark, scene.settings);
+  NewmarkStepper plain(scene.newmark);
   const double T = 0.01;
   Drop drop;
   for (int step = 0; step < static_cast<int>(seconds / T + 0.5); ++step) {
