@@ -58,9 +58,9 @@ void SplitCloth::shareOwned(double* values) const {
 // order that differs between processes, and processes that disagreed by a rounding would take
 // different CG steps.
 double SplitCloth::sum(double local) const {
-  std::vector<double> parts(static_cast<std::size_t>(ranks_));
-  MPI_Allgather(&local, 1, MPI_DOUBLE, parts.data(), 1, MPI_DOUBLE, comm_);
-  return std::accumulate(parts.begin(), parts.end(), 0.0);
+  parts_.resize(static_cast<std::size_t>(ranks_));
+  MPI_Allgather(&local, 1, MPI_DOUBLE, parts_.data(), 1, MPI_DOUBLE, comm_);
+  return std::accumulate(parts_.begin(), parts_.end(), 0.0);
 }
 
 void SplitCloth::gatherRows(std::vector<double>& rows, int width) const {

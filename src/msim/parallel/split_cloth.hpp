@@ -27,8 +27,6 @@ class SplitCloth final : public solids::ParticleSplit {
   void gaussSeidel(const std::vector<std::array<int, 4>>& items, std::vector<Vec3>& v,
                    const std::function<void(std::size_t)>& respond) const override;
 
-  const std::vector<int>& owner() const { return owner_; }
-
  private:
   SplitCloth(std::vector<int> owner, MPI_Comm comm);
 
@@ -37,7 +35,7 @@ class SplitCloth final : public solids::ParticleSplit {
   std::vector<int> owner_;
   std::vector<int> byOwner_;  // every particle, by owner then index: the order of shareOwned's buffer
   std::vector<int> counts_, offsets_;  // doubles per process in that buffer
-  mutable std::vector<double> send_, receive_;
+  mutable std::vector<double> send_, receive_, parts_;  // shareOwned's and sum()'s buffers
 };
 
 }  // namespace msim::parallel

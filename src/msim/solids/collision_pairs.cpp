@@ -183,11 +183,10 @@ void CollisionPairs::find(const std::vector<Vec3>& start, const std::vector<Vec3
   }
   ++queries_;
   const auto isMoved = [&](int v) { return moved == nullptr || (*moved)[static_cast<std::size_t>(v)] != 0; };
-  const auto queries = [&](int v) { return split == nullptr || split->owns(v); };
 
   findInChunks(vertexCount_, pointTriangleChunks_, pointTriangle, [&](std::size_t v, std::vector<PointTrianglePair>& out) {
         const int point = static_cast<int>(v);
-        if (!queries(point)) return;
+        if (split && !split->owns(point)) return;
         triangleTree_.forEachOverlap(vertexBoxes_[v], [&](int t) {
           const auto& tri = triangles_[static_cast<std::size_t>(t)];
           if (tri[0] == point || tri[1] == point || tri[2] == point) return;
@@ -200,7 +199,7 @@ void CollisionPairs::find(const std::vector<Vec3>& start, const std::vector<Vec3
 
   findInChunks(edges_.size(), edgeEdgeChunks_, edgeEdge, [&](std::size_t e, std::vector<EdgeEdgePair>& out) {
         const auto& edge = edges_[e];
-        if (!queries(edge[0])) return;
+        if (split && !split->ownsEdge(edge)) return;
         edgeTree_.forEachOverlap(edgeBoxes_[e], [&](int f) {
           if (f <= static_cast<int>(e)) return;  // each pair once
           const auto& other = edges_[static_cast<std::size_t>(f)];

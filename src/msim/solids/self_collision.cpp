@@ -45,7 +45,8 @@ void SelfCollisionResolver::detect(const CollisionPairs& pairs, const std::vecto
   // each process tests the candidates of its own points and of the edges whose first vertex it
   // owns, and the crossings found are joined.
   const auto tests = [&](const Crossing& c) {
-    return split_ == nullptr || split_->owns(c.pointTriangle ? c.first : pairs.edges()[static_cast<std::size_t>(c.first)][0]);
+    if (split_ == nullptr) return true;
+    return c.pointTriangle ? split_->owns(c.first) : split_->ownsEdge(pairs.edges()[static_cast<std::size_t>(c.first)]);
   };
   hit_.assign(n, 0);
   parallelFor(
