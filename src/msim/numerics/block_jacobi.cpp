@@ -47,6 +47,21 @@ void applyBlocks(const std::vector<double>& inverse, const Eigen::VectorXd& r, E
   }, 2048);
 }
 
+// The inverses of the diagonal blocks row(k), k < count, of a symmetric block matrix, on all cores
+// (the others keep their values, 0 at first); std::invalid_argument if one is not positive definite.
+template <typename Row>
+void invertSymmetricBlocks(const SymmetricBlockMatrix& A, std::size_t count, Row&& row, std::vector<double>& inverse) {
+  inverse.resize(9 * A.rows());
+  std::atomic<bool> indefinite = false;
+  parallelFor(0, count, [&](std::size_t k) {
+    const std::size_t r = row(k);
+    const Eigen::LLT<Eigen::Matrix3d> llt(A.diagonal(r).matrix());
+    if (llt.info() != Eigen::Success) indefinite = true;
+    else Eigen::Map<Eigen::Matrix3d>(inverse.data() + 9 * r) = llt.solve(Eigen::Matrix3d::Identity());
+  }, 2048);
+  if (indefinite) throw std::invalid_argument("block Jacobi: a diagonal block is not positive definite");
+}
+
 }  // namespace
 
 void BlockJacobi::setup(const SparseRowMatrix& A, int blockSize) {
@@ -61,15 +76,13 @@ void BlockJacobi::setup(const SparseRowMatrix& A, int blockSize) {
 }
 
 void BlockJacobi::setup(const SymmetricBlockMatrix& A) {
+  invertSymmetricBlocks(A, A.rows(), [](std::size_t k) { return k; }, inverse_);
   blockSize_ = 3;
-  inverse_.resize(9 * A.rows());
-  std::atomic<bool> indefinite = false;
-  parallelFor(0, A.rows(), [&](std::size_t r) {
-    const Eigen::LLT<Eigen::Matrix3d> llt(A.diagonal(r).matrix());
-    if (llt.info() != Eigen::Success) indefinite = true;
-    else Eigen::Map<Eigen::Matrix3d>(inverse_.data() + 9 * r) = llt.solve(Eigen::Matrix3d::Identity());
-  }, 2048);
-  if (indefinite) throw std::invalid_argument("block Jacobi: a diagonal block is not positive definite");
+}
+
+void BlockJacobi::setup(const SymmetricBlockMatrix& A, std::span<const int> rows) {
+  invertSymmetricBlocks(A, rows.size(), [&](std::size_t k) { return static_cast<std::size_t>(rows[k]); }, inverse_);
+  blockSize_ = 3;
 }
 
 SparseRowMatrix BlockJacobi::inverseMatrix() const {

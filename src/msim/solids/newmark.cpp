@@ -90,8 +90,12 @@ void NewmarkStepper::gatherTerms(const MassSpringSystem& system, const std::vect
     gatherIncidence(system.size());
     ++incidenceVersion_;
   }
-  matrix_.assemble(system, terms_, incidenceStart_, incidence_, incidenceVersion_);
-  if (settings_.preconditioner == SolvePreconditioner::Jacobi) jacobi_.setup(matrix_.matrix());
+  // Split among processes, each assembles and inverts its own rows only (its products read no other).
+  matrix_.assemble(system, terms_, incidenceStart_, incidence_, incidenceVersion_, split_);
+  if (settings_.preconditioner == SolvePreconditioner::Jacobi) {
+    if (split_) jacobi_.setup(matrix_.matrix(), split_->owned());
+    else jacobi_.setup(matrix_.matrix());
+  }
 }
 
 void NewmarkStepper::gatherIncidence(std::size_t particles) {

@@ -73,9 +73,9 @@ class NewmarkStepper {
   const NewmarkSettings& settings() const { return settings_; }
   // Splits the solves' rows among processes (particle_split.hpp; null: this process alone): each
   // computes its own particles' rows of every product and the dot products over them, summed over
-  // the processes, and the answer's rows are shared after each solve. The forces and the matrix
-  // are evaluated whole on every process. Block-Jacobi only (std::invalid_argument with multigrid,
-  // whose V-cycle mixes the rows).
+  // the processes, and the answer's rows are shared after each solve; each assembles its own rows
+  // of the matrix (the forces and the springs' linearisation are evaluated whole on every process).
+  // Block-Jacobi only (std::invalid_argument with multigrid, whose V-cycle mixes the rows).
   void setSplit(const ParticleSplit* split);
 
  private:

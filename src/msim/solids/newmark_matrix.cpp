@@ -34,7 +34,7 @@ void NewmarkMatrix::buildPattern(const MassSpringSystem& system) {
 
 void NewmarkMatrix::assemble(const MassSpringSystem& system, const std::vector<SpringTerm>& terms,
                              std::span<const int> incidenceStart, std::span<const std::pair<int, int>> incidence,
-                             long incidenceVersion) {
+                             long incidenceVersion, const ParticleSplit* split) {
   if (particles_ != system.size() || springs_ != system.springs.size() || tetrahedra_ != system.tetrahedra.size()) {
     buildPattern(system);
     incidenceVersion_ = -1;
@@ -54,7 +54,7 @@ void NewmarkMatrix::assemble(const MassSpringSystem& system, const std::vector<S
     incidenceVersion_ = incidenceVersion;
   }
   const std::span<const int> rowStart = matrix_.rowStart();
-  parallelFor(0, system.size(), [&](std::size_t p) {
+  const auto assembleRow = [&](std::size_t p) {
     // The row in double (matrix_ rounds it): the diagonal, and each neighbour's block.
     const std::span<Block> row(exact_.data() + rowStart[p], exact_.data() + rowStart[p + 1]);
     std::fill(row.begin(), row.end(), Block{});
@@ -86,7 +86,13 @@ void NewmarkMatrix::assemble(const MassSpringSystem& system, const std::vector<S
       }
     }
     matrix_.setRow(p, diagonal, row);
-  }, 1024);
+  };
+  if (split) {
+    const std::span<const int> owned = split->owned();
+    parallelFor(0, owned.size(), [&](std::size_t k) { assembleRow(static_cast<std::size_t>(owned[k])); }, 1024);
+  } else {
+    parallelFor(0, system.size(), assembleRow, 1024);
+  }
 }
 
 }  // namespace msim::solids

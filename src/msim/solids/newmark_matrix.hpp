@@ -14,6 +14,7 @@
 #include "msim/core/vec.hpp"
 #include "msim/numerics/symmetric_block_matrix.hpp"
 #include "msim/solids/mass_spring.hpp"
+#include "msim/solids/particle_split.hpp"
 
 namespace msim::solids {
 
@@ -36,8 +37,9 @@ class NewmarkMatrix {
   // incidenceStart[p + 1]) = (term, the particle's place among the term's nodes). Where each of
   // those terms' blocks goes in the particle's row is looked up once per `incidenceVersion` (the
   // caller changes it whenever the incidence changes) and kept.
+  // With a split among processes, only this process's rows (the others keep their last values).
   void assemble(const MassSpringSystem& system, const std::vector<SpringTerm>& terms, std::span<const int> incidenceStart,
-                std::span<const std::pair<int, int>> incidence, long incidenceVersion);
+                std::span<const std::pair<int, int>> incidence, long incidenceVersion, const ParticleSplit* split = nullptr);
   const numerics::SymmetricBlockMatrix& matrix() const { return matrix_; }
 
  private:
