@@ -180,6 +180,7 @@ expect_failure 2 "mpi.blocks" run "$scenes/plume_3d.json" --out "$tmp/bad" --set
 expect_failure 2 "liquid.turbulence.enabled" run "$scenes/river_rapids.json" --out "$tmp/bad" -q
 expect_failure 2 "mpi.ghost_layers" run "$scenes/drop_into_pool.json" --out "$tmp/bad" --set mpi.ghost_layers=4 -q
 expect_failure 2 "cloth.preconditioner" run "$scenes/cloth_twist.json" --out "$tmp/bad" --set cloth.preconditioner=multigrid -q
+expect_failure 2 "mpi.blocks" run "$scenes/cloth_twist.json" --out "$tmp/bad" --set 'mpi.blocks=[2,1,1]' -q
 expect_failure 2 "runs on one process" run "$scenes/solid_torus.json" --out "$tmp/bad" -q
 launch=(timeout 300 mpirun -np 3 --oversubscribe --bind-to none "$msim")
 expect_failure 2 "power of two" run "$scenes/cloth_twist.json" --out "$tmp/bad" -q

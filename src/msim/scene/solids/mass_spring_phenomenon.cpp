@@ -234,7 +234,7 @@ class MassSpringPhenomenon final : public Phenomenon {
     stepper_ = solids::NewmarkStepper(settings);
     strainLimit_ = c.at("strain_limit").get<double>();
     if (collisionLoop) buildCollisionLoop(c, settings);
-    if (parallel::worldSize() > 1) splitAmongProcesses(settings);
+    if (parallel::worldSize() > 1) splitAmongProcesses(scene, settings);
     implicitSprings_ = settings.implicitSprings;
     springMass_.resize(system_.springs.size());
     for (std::size_t i = 0; i < system_.springs.size(); ++i) {
@@ -585,8 +585,17 @@ class MassSpringPhenomenon final : public Phenomenon {
   // places, every process holding the whole cloth; the solves, the search for pairs, contacts and
   // crossings and the repulsions split (solids/particle_split.hpp), everything else run alike on
   // every process, so that all keep the same state and rank 0 writes it.
-  void splitAmongProcesses(const solids::NewmarkSettings& settings) {
+  void splitAmongProcesses(const Scene& scene, const solids::NewmarkSettings& settings) {
     const int ranks = parallel::worldSize();
+    // The grid's split keys (0: not given) have no meaning for particles.
+    const json& mpi = scene.resolved.at("mpi");
+    const bool blocksGiven = std::any_of(mpi.at("blocks").begin(), mpi.at("blocks").end(),
+                                         [](const json& n) { return n.get<double>() != 0.0; });
+    for (const auto& [key, given] : {std::pair{"blocks", blocksGiven}, std::pair{"ghost_layers", mpi.at("ghost_layers").get<int>() != 0}})
+      if (given)
+        throw InputError(fmt::format("{}: 'mpi.{}' is for grids split into blocks; a {} splits by the recursive median of its "
+                                     "particles (Selle ch. 8.2) and takes no grid layout: remove the key",
+                                     source_, key, kind_));
     if ((ranks & (ranks - 1)) != 0)
       throw InputError(fmt::format("{}: a {} splits among a power of two processes (the recursive median cuts of Selle "
                                    "ch. 8.2), not {}: run it with mpirun -np 2, 4, 8, ...",
