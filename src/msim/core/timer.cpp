@@ -22,8 +22,9 @@ void StageTimers::add(std::string_view stage, double seconds) {
 
 void StageTimers::merge(const StageTimers& other, std::string_view prefix) {
   if (&other == this) throw std::invalid_argument("StageTimers::merge: a table cannot merge itself");
-  for (const StageTime& t : other.table()) {
-    std::lock_guard lock(mutex_);
+  const std::vector<StageTime> stages = other.table();
+  std::lock_guard lock(mutex_);
+  for (const StageTime& t : stages) {
     Entry& e = entry(std::string(prefix) + t.name);
     e.seconds += t.seconds;
     e.calls += t.calls;

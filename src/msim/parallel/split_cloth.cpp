@@ -6,7 +6,6 @@
 
 #include "msim/parallel/median_partition.hpp"
 #include "msim/parallel/mpi_session.hpp"
-#include "msim/parallel/two_phase_collisions.hpp"
 
 namespace msim::parallel {
 
@@ -35,6 +34,7 @@ SplitCloth::SplitCloth(std::vector<int> owner, MPI_Comm comm)
   offsets_.assign(static_cast<std::size_t>(ranks_), 0);
   for (int r = 1; r < ranks_; ++r)
     offsets_[static_cast<std::size_t>(r)] = offsets_[static_cast<std::size_t>(r - 1)] + counts_[static_cast<std::size_t>(r - 1)];
+  schedule_ = twoPhaseSchedule(scheduledItems_, owner_, ranks_);  // for no items
   send_.resize(static_cast<std::size_t>(counts_[static_cast<std::size_t>(rank_)]));
   receive_.resize(3 * owner_.size());
 }
@@ -70,8 +70,12 @@ void SplitCloth::gatherRows(std::vector<double>& rows, int width) const {
 
 void SplitCloth::gaussSeidel(const std::vector<std::array<int, 4>>& items, std::vector<Vec3>& v,
                              const std::function<void(std::size_t)>& respond) const {
-  const TwoPhaseSchedule schedule = twoPhaseSchedule(items, owner_, ranks_);
-  respondTwoPhase(schedule, items, v, rank_, comm_, [&](int item, std::vector<Vec3>&) { respond(static_cast<std::size_t>(item)); });
+  // The repulsions' passes of one inner step run over the same contacts: their schedule serves all.
+  if (items != scheduledItems_) {
+    schedule_ = twoPhaseSchedule(items, owner_, ranks_);
+    scheduledItems_ = items;
+  }
+  respondTwoPhase(schedule_, items, v, rank_, comm_, [&](int item, std::vector<Vec3>&) { respond(static_cast<std::size_t>(item)); });
 }
 
 }  // namespace msim::parallel

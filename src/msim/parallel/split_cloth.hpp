@@ -10,6 +10,7 @@
 
 #include <vector>
 
+#include "msim/parallel/two_phase_collisions.hpp"
 #include "msim/solids/particle_split.hpp"
 
 namespace msim::parallel {
@@ -36,6 +37,8 @@ class SplitCloth final : public solids::ParticleSplit {
   std::vector<int> byOwner_;  // every particle, by owner then index: the order of shareOwned's buffer
   std::vector<int> counts_, offsets_;  // doubles per process in that buffer
   mutable std::vector<double> send_, receive_, parts_;  // shareOwned's and sum()'s buffers
+  mutable std::vector<std::array<int, 4>> scheduledItems_;  // the items schedule_ is for
+  mutable TwoPhaseSchedule schedule_;
 };
 
 }  // namespace msim::parallel

@@ -164,7 +164,10 @@ NewmarkStats NewmarkStepper::solveHalfStep(const MassSpringSystem& system, const
       residual_[p] = system.mass[p] * from[p] + h * forces_[p] + product_[p];
       rhsNorm2 += (residual_[p] - system.mass[p] * meanVelocity).squaredNorm();
     }
-    matrix_.matrix().multiply(out.data()->data(), product_.data()->data());
+    // Split among processes, only this process's rows of the residual are used (the others' rows of
+    // the matrix are not assembled here).
+    if (split_) matrix_.matrix().multiplyRows(out.data()->data(), product_.data()->data(), split_->owned());
+    else matrix_.matrix().multiply(out.data()->data(), product_.data()->data());
     for (std::size_t p = 0; p < n; ++p) residual_[p] = system.pinned[p] ? Vec3::Zero() : Vec3(residual_[p] - product_[p]);
     if (k + 1 < iterations) previous_ = out;
     const NewmarkStats solve = conjugateGradients(system, h, rhsNorm2, out);
@@ -187,7 +190,6 @@ void NewmarkStepper::setSplit(const ParticleSplit* split) {
   if (split && settings_.preconditioner != SolvePreconditioner::Jacobi)
     throw std::invalid_argument("Newmark step: a solve split among processes needs the block-Jacobi preconditioner");
   split_ = split;
-  owned_.clear();
 }
 
 // Solves A out = rhs from the residual rhs - A out already in residual_.
@@ -205,12 +207,8 @@ NewmarkStats NewmarkStepper::conjugateGradients(const MassSpringSystem& system, 
     // Selle ch. 8.2: this process's rows of r, z and the search direction (the others' stay 0:
     // block-Jacobi keeps rows apart), the search direction's rows shared before each product, the
     // dot products summed over the processes; x's other rows stay put and come from their owners.
-    if (owned_.size() != system.size()) {
-      owned_.assign(system.size(), 0);
-      for (const int p : split_->owned()) owned_[static_cast<std::size_t>(p)] = 1;
-    }
     for (std::size_t p = 0; p < system.size(); ++p)
-      if (!owned_[p]) residualVector_.segment<3>(static_cast<Eigen::Index>(3 * p)).setZero();
+      if (!split_->owns(static_cast<int>(p))) residualVector_.segment<3>(static_cast<Eigen::Index>(3 * p)).setZero();
     const auto splitProduct = [&](const Eigen::VectorXd& u, Eigen::VectorXd& y) {
       sharedSearch_ = u;
       split_->shareOwned(sharedSearch_.data());

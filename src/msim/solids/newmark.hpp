@@ -124,7 +124,6 @@ class NewmarkStepper {
   std::size_t multigridParticles_ = 0;
   Eigen::VectorXd unknowns_, residualVector_;
   const ParticleSplit* split_ = nullptr;
-  std::vector<char> owned_;     // per particle, with a split: whether this process computes its rows
   Eigen::VectorXd sharedSearch_;  // with a split: the search direction with every process's rows
   numerics::SparseCgWorkspace workspace_;
 };

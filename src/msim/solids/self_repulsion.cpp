@@ -70,6 +70,7 @@ int SelfRepulsion::repelEndVelocity(const std::vector<Vec3>& x, std::vector<Vec3
 void SelfRepulsion::gatherContacts(const std::vector<Vec3>& x) {
   if (mesh_ == nullptr) {
     contacts_.clear();
+    contactParticles_.clear();
     return;
   }
   bool incremental = gatheredValid_ && gatheredAt_.size() == x.size();
@@ -212,12 +213,12 @@ void SelfRepulsion::joinContacts() {
     c.pair = static_cast<int>(row[12]);
   }
   std::sort(contacts_.begin(), contacts_.end(), [](const Contact& a, const Contact& b) { return a.pair < b.pair; });
+  contactParticles_.resize(contacts_.size());
+  for (std::size_t i = 0; i < contacts_.size(); ++i) contactParticles_[i] = contacts_[i].stencil.node;
 }
 
 int SelfRepulsion::respond(Pass pass, std::vector<Vec3>& v, const std::vector<double>& inverseMass, double dt) const {
   if (split_) {
-    contactParticles_.resize(contacts_.size());
-    for (std::size_t i = 0; i < contacts_.size(); ++i) contactParticles_[i] = contacts_[i].stencil.node;
     split_->gaussSeidel(contactParticles_, v, [&](std::size_t i) { respond(pass, contacts_[i], v, inverseMass, dt); });
   } else {
     for (const Contact& c : contacts_) respond(pass, c, v, inverseMass, dt);

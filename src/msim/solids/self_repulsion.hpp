@@ -77,7 +77,8 @@ class SelfRepulsion {
   // ends, in the pairs' order (points first); pairs whose particles have not moved since the last
   // call keep its finding.
   void gatherContacts(const std::vector<Vec3>& x);
-  // With a split: every process's contacts on every process, in the pairs' order.
+  // With a split: every process's contacts on every process, in the pairs' order, and their particles
+  // (the two-phase passes' items).
   void joinContacts();
   // Whether this process examines pair i (points' pairs first): with a split, the pairs of its own
   // points and of the edges whose first vertex it owns.
@@ -123,7 +124,7 @@ class SelfRepulsion {
   std::vector<char> moved_;
   bool gatheredValid_ = false;
   const ParticleSplit* split_ = nullptr;
-  mutable std::vector<std::array<int, 4>> contactParticles_;  // with a split: each contact's stencil's particles
+  std::vector<std::array<int, 4>> contactParticles_;  // with a split: each joined contact's particles
   std::vector<double> contactRows_;                           // with a split: joinContacts' exchange
 };
 
