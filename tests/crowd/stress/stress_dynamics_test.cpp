@@ -27,12 +27,15 @@ const GridSpec<2> kGrid(Vec2(0.0, 0.0), 0.5, IVec<2>(40, 40));  // 20 x 20 m of 
 }  // namespace
 
 TEST(CrowdStressDynamics, FreeAgentsRelaxExponentially) {
-  // 25 agents 3 m apart (well below rho_crit) from rest towards 1.2 m/s: v(1 s) = 1.2 (1 - e^-2).
+  // 25 agents 3 m apart (well below rho_crit) from rest towards 1.2 m/s over tau = 0.5 s:
+  // v(1 s) = 1.2 (1 - e^-2).
   std::vector<Vec2f> x, v, cf;
   lattice(3.0, 2.0, 17.0, 2.0, 17.0, x);
   v.assign(x.size(), Vec2f::Zero());
   cf.assign(x.size(), Vec2f(1.2f, 0.0f));
-  StressDynamics d(kGrid, {});
+  StressSettings settings;
+  settings.relaxation = 0.5;
+  StressDynamics d(kGrid, settings);
   const Grid<float, 2> free(kGrid, 1.0f);
   for (int s = 0; s < 20; ++s) d.step(x, v, cf, free, 0.05);
   for (const Vec2f& u : v) {

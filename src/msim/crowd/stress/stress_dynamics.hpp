@@ -19,7 +19,7 @@ namespace msim::crowd::stress {
 
 struct StressSettings {
   StressLaws laws;
-  double relaxation = 0.5;       // tau [s] (not given in the seed)
+  double relaxation = 0.2;       // tau [s] (not given in the seed; docs/crowd_turbulence.md)
   double maxAcceleration = 3.0;  // a_max [m/s^2] (not given; people's 2-5)
   numerics::BoundQpSettings qp = [] {
     numerics::BoundQpSettings s;

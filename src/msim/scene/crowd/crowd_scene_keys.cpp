@@ -167,7 +167,9 @@ Schema crowdKeys() {
   turbulence.number("friction", "", 0.75, "alpha above the yield density (0: discomfort only, Fig. 4.10's control)")
       .min(0.0)
       .max(1.0);
-  turbulence.number("relaxation", "s", 0.5, "tau: how fast agents take their collision-free velocity (eq. 4.3)")
+  turbulence.number("relaxation", "s", 0.2,
+                    "tau: how fast agents take their collision-free velocity (eq. 4.3; the seed gives none: 0.2 s lets "
+                    "navigation set the speed below 5 /m^2, as Fig. 4.5a, docs/crowd_turbulence.md)")
       .min(0.0, Bound::Exclusive);
   turbulence.number("max_acceleration", "m/s^2", 3.0, "a_max of eq. 4.7").min(0.0, Bound::Exclusive);
   turbulence.number("max_step", "s", 0.01,
@@ -402,8 +404,8 @@ struct CrowdSceneBuilder {
     // 190 m/s just below the yield density, and its acceleration, clamped at a_max (eq. 4.7),
     // overshoots and turns from one step to the next, shaking agents by about a_max dt. The crowd
     // pressure and speeds depend on the step: the Hajj merge at 5.8 /m^2 (1 m cells, no lookahead)
-    // moves at a mean local speed of 0.41 m/s with 0.05 s steps, 0.21 with 0.01 s and 0.19 with
-    // 0.005 s. 0.01 s is the step of Golas' Table 3.1 (docs/crowd_turbulence.md).
+    // has a scene-mean temporal pressure of 0.39 /s^2 with 0.05 s steps, 0.097 with 0.01 s and 0.081
+    // with 0.005 s. 0.01 s is the step of Golas' Table 3.1 (docs/crowd_turbulence.md).
     if (tu.at("enabled").get<bool>()) out.maxStep = std::min(out.maxStep, tu.at("max_step").get<double>());
     out.gridCfl = c.at("grid_cfl").get<double>();
     out.colourBy = c.at("colour_by").get<std::string>();
