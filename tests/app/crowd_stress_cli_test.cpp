@@ -83,7 +83,8 @@ TEST(CrowdStressCli, LoveParadeStreamsMeetAtTheRampFoot) {
 }
 
 TEST(CrowdStressCli, BadSettingsNameTheirKey) {
-  // Densities in the wrong order, friction outside [0, 1]: exit 2 naming the key, no frames.
+  // Densities in the wrong order, friction outside [0, 1], summaries that would start after the
+  // run's end: exit 2 naming the key, no frames.
   std::string scene;
   {
     std::ifstream in(kMergeScene);
@@ -96,4 +97,6 @@ TEST(CrowdStressCli, BadSettingsNameTheirKey) {
                    {"crowd.turbulence.yield_density", "critical_density"});
   expectInputError("stress_friction", replaced(scene, turbulence, R"("turbulence": {"enabled": true, "friction": 1.5})"),
                    {"crowd.turbulence.friction"});
+  expectInputError("stress_summaries", replaced(scene, turbulence, R"("turbulence": {"enabled": true}, "summaries_from": 90)"),
+                   {"crowd.summaries_from", "time.duration"});
 }

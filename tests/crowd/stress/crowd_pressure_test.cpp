@@ -4,6 +4,7 @@
 // against a brute-force weighted variance over every stored sample, and Helbing's local speed.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -234,4 +235,48 @@ TEST(CrowdPressure, SamplesByDensityTellTheTurbulentDensitiesApart) {
   // 45 and 135 degrees from east: backward in 5 of the 10 frames.
   EXPECT_EQ(bins.backward[pushed], 5 * 120);
   EXPECT_NEAR(bins.forward2[pushed] + bins.sideways2[pushed], 10 * 120 * 0.25, 1e-4);
+}
+
+// A run's summaries leave out the frames before it asks for them (a start's transient): the
+// frames measured without summarizing add no samples and no peak, the ones after add theirs, and
+// the frame's own figures are the same either way.
+TEST(CrowdPressure, SummariesGatherOnlyTheFramesAskedFor) {
+  const GridSpec<2> grid(Vec2(0.0, 0.0), 1.0, IVec<2>(6, 6));
+  Agents a;
+  for (int j = 0; j < 6; ++j)
+    for (int i = 0; i < 6; ++i) {
+      AgentSpec s;
+      s.position = Vec2f(i + 0.5f, j + 0.5f);
+      const std::size_t n = a.add(s);
+      a.preferredVelocity[n] = Vec2f(1.0f, 0.0f);
+    }
+  TurbulenceMetrics metrics(grid), every(grid);
+  double pressureMax = 0.0;
+  for (int step = 0; step < 40; ++step) {
+    const float sign = step % 2 == 0 ? 1.0f : -1.0f;  // pushed to and fro: turbulent everywhere
+    for (std::size_t n = 0; n < a.size(); ++n) a.velocity[n] = Vec2f(sign, 0.0f);
+    metrics.sample(a, 0.05);
+    every.sample(a, 0.05);
+    if (step % 10 != 9) continue;
+    const bool summarize = step >= 20;
+    const TurbulenceFrame f = metrics.measure(a, summarize), g = every.measure(a);
+    EXPECT_EQ(f.temporalPressureMax, g.temporalPressureMax);
+    pressureMax = std::max(pressureMax, double(f.temporalPressureMax));
+    if (summarize) continue;
+    for (const long c : metrics.samplesByDensity().cells) ASSERT_EQ(c, 0);
+    EXPECT_EQ(*std::max_element(metrics.peakTemporalPressure().data().begin(), metrics.peakTemporalPressure().data().end()),
+              0.0f);
+  }
+  long cells = 0, everyCells = 0, agents = 0;
+  for (std::size_t b = 0; b < metrics.samplesByDensity().cells.size(); ++b) {
+    cells += metrics.samplesByDensity().cells[b];
+    everyCells += every.samplesByDensity().cells[b];
+    agents += metrics.samplesByDensity().agents[b];
+  }
+  EXPECT_EQ(cells, 2 * grid.cellCount());  // the frames at steps 29 and 39
+  EXPECT_EQ(everyCells, 4 * grid.cellCount());
+  EXPECT_EQ(agents, 2 * static_cast<long>(a.size()));
+  EXPECT_GT(pressureMax, TurbulenceMetrics::kTurbulentPressure);
+  EXPECT_GT(*std::max_element(metrics.peakTemporalPressure().data().begin(), metrics.peakTemporalPressure().data().end()),
+            0.0f);
 }

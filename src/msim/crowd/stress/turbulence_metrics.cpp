@@ -42,7 +42,7 @@ void TurbulenceMetrics::sample(const Agents& agents, double dt) {
   standstills_.sample(agents, dt);
 }
 
-TurbulenceFrame TurbulenceMetrics::measure(const Agents& agents) {
+TurbulenceFrame TurbulenceMetrics::measure(const Agents& agents, bool summarize) {
   TurbulenceFrame f;
   windows_.gather(agents.position, agents.velocity);
   stress::spatialPressure(windows_, spatial_);
@@ -53,13 +53,15 @@ TurbulenceFrame TurbulenceMetrics::measure(const Agents& agents) {
   f.pressureCellsOver = spatial.cellsOver;
   f.temporalPressureMax = temporal.max;
   f.temporalCellsOver = temporal.cellsOver;
-  for (std::size_t c = 0; c < temporal_.count(); ++c) peak_[c] = std::max(peak_[c], temporal_[c]);
-  for (const std::uint32_t c : windows_.cells())
-    byDensity_.addCell(windows_.density(c), temporal_[c] > kTurbulentPressure);
-  for (std::size_t i = 0; i < agents.size(); ++i)
-    if (agents.preferredVelocity[i].squaredNorm() > 0.0f)  // not arrived, nor standing by choice
-      byDensity_.addAgent(windows_.density(windows_.spec().clampedCellIndex(agents.position[i])), agents.velocity[i],
-                          agents.preferredVelocity[i]);
+  if (summarize) {
+    for (std::size_t c = 0; c < temporal_.count(); ++c) peak_[c] = std::max(peak_[c], temporal_[c]);
+    for (const std::uint32_t c : windows_.cells())
+      byDensity_.addCell(windows_.density(c), temporal_[c] > kTurbulentPressure);
+    for (std::size_t i = 0; i < agents.size(); ++i)
+      if (agents.preferredVelocity[i].squaredNorm() > 0.0f)  // not arrived, nor standing by choice
+        byDensity_.addAgent(windows_.density(windows_.spec().clampedCellIndex(agents.position[i])), agents.velocity[i],
+                            agents.preferredVelocity[i]);
+  }
   f.temporalPressureMean = sampler_.meanWhereOccupied(temporal_);
   f.strainRate = stress::strainRate(windows_, strain_);
   f.localSpeed = stress::meanLocalSpeed(windows_);

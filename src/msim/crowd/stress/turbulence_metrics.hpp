@@ -61,16 +61,18 @@ class TurbulenceMetrics {
 
   explicit TurbulenceMetrics(const GridSpec<2>& grid);
   void sample(const Agents& agents, double dt);
-  TurbulenceFrame measure(const Agents& agents);
+  // This frame's figures; with `summarize` the frame also joins the run-long summaries below (a
+  // run leaves out its start's transient by passing false until then).
+  TurbulenceFrame measure(const Agents& agents, bool summarize = true);
 
   // The last measure()'s fields.
   const Grid<float, 2>& spatialPressure() const { return spatial_; }
   const Grid<float, 2>& temporalPressure() const { return temporal_; }
   const Grid<float, 2>& strainRate() const { return strain_; }
-  // Each cell's largest temporal pressure over the measured frames: where the crowd turned
+  // Each cell's largest temporal pressure over the summarized frames: where the crowd turned
   // turbulent during the run.
   const Grid<float, 2>& peakTemporalPressure() const { return peak_; }
-  // The measured frames' samples by density.
+  // The summarized frames' samples by density.
   const SamplesByDensity& samplesByDensity() const { return byDensity_; }
 
  private:

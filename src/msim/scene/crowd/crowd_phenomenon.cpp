@@ -413,7 +413,9 @@ class CrowdPhenomenon final : public Phenomenon {
     ScopedStage stage(timers_, "crowd: metrics");
     const crowd::Agents& a = sim_->agents();
     speed_ = crowd::speedStats(a.velocity);
-    turbulenceFrame_ = turbulence_.measure(a);
+    // Frame times are multiples of the frame interval: the tolerance keeps round-off from
+    // leaving out the frame at summaries_from itself.
+    turbulenceFrame_ = turbulence_.measure(a, sim_->time() >= setup_.summariesFrom - 1e-9);
     checkStall();
     agentDensity_.clear();
     nn_ = crowd::NearestNeighbourFrame{};
@@ -500,6 +502,7 @@ class CrowdPhenomenon final : public Phenomenon {
             {"peak_at_m", {peakAt.x(), peakAt.y()}},
             {"cells_ever_turbulent", summary.cellsOver},
             {"window_s", TurbulenceMetrics::kWindowSeconds},
+            {"summaries_from_s", setup_.summariesFrom},
             {"by_density", crowd::toJson(turbulence_.samplesByDensity())}};
   }
 

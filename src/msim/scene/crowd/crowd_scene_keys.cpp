@@ -195,6 +195,10 @@ Schema crowdKeys() {
   c.number("dense_fraction", "", 0.8, "'densest regions' of the nearest-neighbour metric: density >= this x rho_max")
       .min(0.0)
       .max(1.0);
+  c.number("summaries_from", "s", 0.0,
+           "the run-long turbulence summaries (pressure_map.png and results.turbulence: each cell's peak pressure, "
+           "the samples by density) gather the frames from this time on, after the start's transient")
+      .min(0.0);
   return c;
 }
 
@@ -411,6 +415,11 @@ struct CrowdSceneBuilder {
     out.colourBy = c.at("colour_by").get<std::string>();
     out.trajectories = c.at("trajectories").get<bool>();
     out.denseFraction = c.at("dense_fraction").get<double>();
+    out.summariesFrom = c.at("summaries_from").get<double>();
+    const double duration = r.at("time").at("duration").get<double>();
+    if (out.summariesFrom >= duration)
+      fail("crowd.summaries_from", fmt::format("= {} s is not before the run's end (time.duration = {} s): the "
+                                               "turbulence summaries would gather no frame", out.summariesFrom, duration));
   }
 
   // The UIC's grid over the walkable box, from the box's lower corner; where its cells overhang

@@ -36,6 +36,7 @@ struct CrowdSceneSetup {
   bool trajectories = true;
   std::size_t groupCount = 0;  // groups + inflows (agent colours by group)
   double denseFraction = 0.8;  // "densest regions" of the nearest-neighbour metric: rho >= this x rho_max
+  double summariesFrom = 0.0;  // [s] the turbulence metrics' run-long summaries gather frames from here
 };
 
 void declareCrowdKeys(Schema& root);
