@@ -199,7 +199,7 @@ void CollisionPairs::find(const std::vector<Vec3>& start, const std::vector<Vec3
 
   findInChunks(edges_.size(), edgeEdgeChunks_, edgeEdge, [&](std::size_t e, std::vector<EdgeEdgePair>& out) {
         const auto& edge = edges_[e];
-        if (split && !split->ownsEdge(edge)) return;
+        if (split && !ownsEdge(*split, edge)) return;
         edgeTree_.forEachOverlap(edgeBoxes_[e], [&](int f) {
           if (f <= static_cast<int>(e)) return;  // each pair once
           const auto& other = edges_[static_cast<std::size_t>(f)];

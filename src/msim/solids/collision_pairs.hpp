@@ -43,6 +43,12 @@ class CollisionPairs {
 
   const std::vector<std::array<int, 3>>& triangles() const { return triangles_; }
   const std::vector<std::array<int, 2>>& edges() const { return edges_; }
+  // Split among processes (particle_split.hpp): whether a pair is this process's to look for and
+  // examine, as the owner of its point or of its first edge's first vertex.
+  static bool isOwnPair(const ParticleSplit& split, const PointTrianglePair& p) { return split.owns(p.point); }
+  bool isOwnPair(const ParticleSplit& split, const EdgeEdgePair& p) const {
+    return ownsEdge(split, edges_[static_cast<std::size_t>(p.first)]);
+  }
 
   // Pairs whose boxes over `start` and `end` (the same vector for a mesh at rest), each grown by
   // `margin`, overlap; by point (edge), then in the trees' order: the same whatever the thread count. `moved`, when
@@ -55,6 +61,8 @@ class CollisionPairs {
             const std::vector<char>* moved = nullptr, const ParticleSplit* split = nullptr);
 
  private:
+  // An edge's pairs are looked for by the owner of its first vertex.
+  static bool ownsEdge(const ParticleSplit& split, const std::array<int, 2>& edge) { return split.owns(edge[0]); }
   // The vertices' boxes in the frame of their group's mean displacement, and the groups.
   void groupPieces(const std::vector<Vec3>& start, const std::vector<Vec3>& end, double margin);
 

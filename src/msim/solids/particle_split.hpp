@@ -25,8 +25,6 @@ class ParticleSplit {
   virtual std::span<const int> owned() const = 0;
   // Whether particle p is this process's (asked per collision pair: no virtual call).
   bool owns(int particle) const { return mine_[static_cast<std::size_t>(particle)] != 0; }
-  // An edge's collision pairs are looked for by the owner of its first vertex (a point's by its own).
-  bool ownsEdge(const std::array<int, 2>& edge) const { return owns(edge[0]); }
   // Overwrites the other processes' particles' entries of `values` (3 doubles per particle) with
   // their owners' values, on every process.
   virtual void shareOwned(double* values) const = 0;

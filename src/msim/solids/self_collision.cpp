@@ -44,16 +44,17 @@ void SelfCollisionResolver::detect(const CollisionPairs& pairs, const std::vecto
   // One flag per candidate, filled in parallel, then read in order: deterministic. With a split,
   // each process tests the candidates of its own points and of the edges whose first vertex it
   // owns, and the crossings found are joined.
-  const auto tests = [&](const Crossing& c) {
+  const auto tests = [&](std::size_t k) {
     if (split_ == nullptr) return true;
-    return c.pointTriangle ? split_->owns(c.first) : split_->ownsEdge(pairs.edges()[static_cast<std::size_t>(c.first)]);
+    return k < nPoint ? CollisionPairs::isOwnPair(*split_, candidatesPointTriangle_[k])
+                      : pairs.isOwnPair(*split_, candidatesEdgeEdge_[k - nPoint]);
   };
   hit_.assign(n, 0);
   parallelFor(
       0, n,
       [&](std::size_t k) {
+        if (!tests(k)) return;
         const Crossing c = candidate(k);
-        if (!tests(c)) return;
         const std::array<int, 4> nodes = particles(pairs, c);
         const auto a0 = gatherPositions(nodes, x0), a1 = gatherPositions(nodes, x1);
         const auto t = c.pointTriangle ? pointTriangleCollisionTime(a0, a1, settings_.tolerance)

@@ -42,8 +42,8 @@ void SelfRepulsion::findPairs(CollisionPairs& pairs, const std::vector<Vec3>& x,
 
 bool SelfRepulsion::examines(std::size_t pair) const {
   if (split_ == nullptr) return true;
-  if (pair < pointTriangle_.size()) return split_->owns(pointTriangle_[pair].pair.point);
-  return split_->ownsEdge(mesh_->edges()[static_cast<std::size_t>(edgeEdge_[pair - pointTriangle_.size()].pair.first)]);
+  if (pair < pointTriangle_.size()) return CollisionPairs::isOwnPair(*split_, pointTriangle_[pair].pair);
+  return mesh_->isOwnPair(*split_, edgeEdge_[pair - pointTriangle_.size()].pair);
 }
 
 int SelfRepulsion::repelPositionVelocity(const std::vector<Vec3>& x, std::vector<Vec3>& v,
