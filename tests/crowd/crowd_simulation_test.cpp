@@ -110,6 +110,47 @@ TEST(CrowdSimulation, DensityStaysCappedAtTheFreeAreaLimitEveryStep) {
   EXPECT_GT(closestPairRatio(sim.agents()), 0.9);
 }
 
+TEST(CrowdSimulation, InflowAgentsJoinTheStreamInTheirRegion) {
+  // A stream of 150 agents walks east through the inflow's region; the agents it admits from
+  // t = 1 s start with the mean velocity of the agents in the region, not at rest.
+  const Vec2 hi(30, 10);
+  const Goal east = eastExit();
+  Inflow in;
+  in.region = rectangle(Vec2(0.5, 0.5), Vec2(8, 9.5));
+  in.rate = 4.0;
+  in.start = 1.0;
+  in.stop = 3.0;
+  in.agent.goal = 0;
+  in.agent.radius = kRadius;
+  auto planner = std::make_shared<DirectPlanner>(std::vector<Goal>{east});
+  CrowdSimulation sim(settings(hi, 30), {}, {east}, planner, randomAgents(150, Vec2(0.5, 0.5), Vec2(8, 9.5), 0, AgentModel::Uic, 5),
+                      {in});
+  std::size_t checked = 0;
+  for (int step = 0; step < 60; ++step) {
+    sim.step(0.05);
+    const std::size_t spawned = sim.lastStep().spawned;
+    if (spawned == 0) continue;
+    const Agents& a = sim.agents();
+    const std::size_t first = a.size() - spawned;  // the new agents are the last ones
+    Vec2f sum = Vec2f::Zero();
+    std::size_t inRegion = 0;
+    for (std::size_t i = 0; i < first; ++i)
+      if (contains(in.region, a.position[i].cast<double>())) {
+        sum += a.velocity[i];
+        ++inRegion;
+      }
+    ASSERT_GT(inRegion, 0u);
+    const Vec2f stream = sum / float(inRegion);
+    ASSERT_GT(stream.x(), 0.3f) << "t = " << sim.time();  // the stream walks east
+    for (std::size_t i = first; i < a.size(); ++i) {
+      EXPECT_NEAR(a.velocity[i].x(), stream.x(), 1e-5f);
+      EXPECT_NEAR(a.velocity[i].y(), stream.y(), 1e-5f);
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 8u);
+}
+
 TEST(CrowdSimulation, InflowsSpawnAtTheirRateAndExitsRemoveAgents) {
   const Vec2 hi(30, 10);
   const Goal east = eastExit();

@@ -504,6 +504,24 @@ CrowdSimulation::FreeWalkers CrowdSimulation::freeWalkers() {
   return out;
 }
 
+// A person entering through an inflow joins the stream already there: the new agent starts with
+// the mean velocity of the agents in the inflow's region (at rest where it is empty). Entering at
+// rest into a moving crowd would be a velocity jump that the stress model (Golas ch. 4, eq. 4.3)
+// relaxes over tau, showing as temporal pressure at the inlets that the crowd itself does not make.
+Vec2f CrowdSimulation::streamVelocity(const Polygon& region) const {
+  Vec2 lo, hi;
+  bounds(region, lo, hi);
+  Vec2f sum = Vec2f::Zero();
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < agents_.size(); ++i) {
+    const Vec2 x = agents_.position[i].cast<double>();
+    if ((x.array() < lo.array()).any() || (x.array() > hi.array()).any() || !contains(region, x)) continue;
+    sum += agents_.velocity[i];
+    ++count;
+  }
+  return count > 0 ? Vec2f(sum / static_cast<float>(count)) : Vec2f::Zero();
+}
+
 void CrowdSimulation::arriveAndSpawn(double dt) {
   remove_.assign(agents_.size(), 0);
   // Scenes without exits (the circle: a goal per agent) skip the pass over every agent's goal.
@@ -539,6 +557,8 @@ void CrowdSimulation::arriveAndSpawn(double dt) {
     const Inflow& f = inflows_[k];
     const double open = std::max(0.0, std::min(time_, f.stop) - std::max(time_ - dt, f.start));
     inflowCredit_[k] += f.rate * open;
+    if (inflowCredit_[k] < 1.0 - 1e-6) continue;
+    const Vec2f joining = streamVelocity(f.region);
     // The tolerance keeps round-off (rate x dt summed over many steps, or a credit saved as float
     // for --resume) from delaying an agent by a step.
     while (inflowCredit_[k] >= 1.0 - 1e-6) {
@@ -552,7 +572,7 @@ void CrowdSimulation::arriveAndSpawn(double dt) {
       AgentSpec spec = f.agent;
       spec.position = x.cast<float>();
       if (f.speeds.kind != SpeedDistribution::Kind::Fixed) spec.maxSpeed = static_cast<float>(f.speeds.sample(rng));
-      agents_.add(spec);
+      agents_.velocity[agents_.add(spec)] = joining;
       ++stats_.spawned;
     }
   }
