@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace msim::crowd::lookahead {
@@ -23,14 +24,11 @@ void DiscreteLookahead::tabulate() {
   if (schedule.levels > kMaxLevels) throw std::invalid_argument("lookahead: at most 16 levels");
   for (int i = 0; i <= schedule.levels + 1; ++i) {
     horizon[static_cast<std::size_t>(i)] = static_cast<float>(schedule.horizon(i));
-    bandStart[static_cast<std::size_t>(i)] = static_cast<float>(schedule.bandStart(i));
     bandStart2[static_cast<std::size_t>(i)] = static_cast<float>(schedule.bandStart(i) * schedule.bandStart(i));
     shrink[static_cast<std::size_t>(i)] = static_cast<float>(schedule.effectiveRadius(1.0, i));
   }
-}
-
-int DiscreteLookahead::levelOfSquaredDistance(float distance2) const {
-  return levelInBands(distance2, schedule.levels, [this](int i) { return bandStart2[static_cast<std::size_t>(i)]; });
+  bandEnds2.fill(std::numeric_limits<float>::infinity());
+  for (int i = 1; i <= schedule.levels + 1; ++i) bandEnds2[static_cast<std::size_t>(i - 1)] = bandStart2[static_cast<std::size_t>(i)];
 }
 
 void appendLookaheadPlanes(const DiscreteLookahead& l, std::uint32_t self, const Vec2f& x, const Vec2f& v, float r,
@@ -52,15 +50,19 @@ void appendLookaheadPlanes(const DiscreteLookahead& l, std::uint32_t self, const
   while (top > 0) {
     const AgentTree::Node& n = l.tree.node(stack[--top]);
     const float nearest2 = nearestInBox2(x, n.lo, n.hi);
-    if (nearest2 >= reach2 || farthestInBox2(x, n.lo, n.hi) < near2) continue;  // beyond every band, or all at level 0
-    const int level = l.levelOfSquaredDistance(nearest2);
-    const bool containsSelf = x.x() >= n.lo.x() && x.x() <= n.hi.x() && x.y() >= n.lo.y() && x.y() <= n.hi.y();
-    if (level >= 1 && level <= depth && !containsSelf && n.count <= (1u << (level - 1))) {
-      const float horizon = l.horizon[static_cast<std::size_t>(level)];
-      const float walked = static_cast<float>(s.maxSpeed) * horizon, drift = n.velocitySpread * horizon;
-      if (n.separation <= std::max(walked, 4.0f * n.radius) && drift <= 2.0f * n.radius) {
-        avoid(n.mean, n.velocity, clusterRadius(n, n.radius * l.shrink[static_cast<std::size_t>(level)], horizon), level);
-        continue;
+    if (nearest2 >= reach2) continue;  // beyond every band
+    if (nearest2 < near2) {
+      // Reaches into level 0 (or holds the agent itself): open it, unless all of it lies there.
+      if (farthestInBox2(x, n.lo, n.hi) < near2) continue;
+    } else {
+      const int level = l.levelOfSquaredDistance(nearest2);  // 1..depth: nearest2 < reach2
+      if (n.count <= (1u << (level - 1))) {
+        const float horizon = l.horizon[static_cast<std::size_t>(level)];
+        const float walked = static_cast<float>(s.maxSpeed) * horizon, drift = n.velocitySpread * horizon;
+        if (n.separation <= std::max(walked, 4.0f * n.radius) && drift <= 2.0f * n.radius) {
+          avoid(n.mean, n.velocity, clusterRadius(n, n.radius * l.shrink[static_cast<std::size_t>(level)], horizon), level);
+          continue;
+        }
       }
     }
     if (n.left >= 0) {
@@ -69,9 +71,10 @@ void appendLookaheadPlanes(const DiscreteLookahead& l, std::uint32_t self, const
       continue;
     }
     for (const std::uint32_t j : l.tree.agents().subspan(n.first, n.count)) {
-      if (j == self) continue;
-      const int own = l.levelOfSquaredDistance((l.positions[j] - x).squaredNorm());
-      if (own >= 1 && own <= depth) avoid(l.positions[j], l.velocities[j], l.radii[j] * l.shrink[static_cast<std::size_t>(own)], own);
+      const float d2 = (l.positions[j] - x).squaredNorm();
+      if (d2 < near2 || d2 >= reach2) continue;  // level 0 (the agent itself too), or beyond the bands
+      const int own = l.levelOfSquaredDistance(d2);
+      avoid(l.positions[j], l.velocities[j], l.radii[j] * l.shrink[static_cast<std::size_t>(own)], own);
     }
   }
 }

@@ -27,14 +27,22 @@ namespace msim::crowd::lookahead {
 
 struct DiscreteLookahead {
   // The schedule and, tabulated from it by tabulate() for the per-agent traversals, each level's
-  // horizon dt_i, band start and radius factor 1 / c^i (levels <= kMaxLevels).
+  // horizon dt_i, squared band start and radius factor 1 / c^i (levels <= kMaxLevels).
   static constexpr int kMaxLevels = 16;
   HorizonSchedule schedule;
-  std::array<float, kMaxLevels + 2> horizon{}, bandStart{}, bandStart2{}, shrink{};  // bandStart2: squared
+  std::array<float, kMaxLevels + 2> horizon{}, bandStart2{}, shrink{};
   void tabulate();
   // The level whose band holds a distance, given squared (0 within R; HorizonSchedule's
   // levelOfDistance tabulated; the traversal compares squares, without square roots), -1 beyond.
-  int levelOfSquaredDistance(float distance2) const;
+  // Counts the band starts 1..levels + 1 at or below it in whole vectors, without a branch per band
+  // (the traversal asks for every node and member it meets).
+  int levelOfSquaredDistance(float distance2) const {
+    int below = 0;
+    for (const float start2 : bandEnds2) below += distance2 >= start2;
+    return below <= schedule.levels ? below : -1;
+  }
+  // bandStart2[1..levels + 1], then infinity: three vectors of eight, for levelOfSquaredDistance.
+  std::array<float, 24> bandEnds2{};
 
   AgentTree tree;  // over `positions`
   std::span<const Vec2f> positions, velocities;
