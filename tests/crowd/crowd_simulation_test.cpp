@@ -111,21 +111,26 @@ TEST(CrowdSimulation, DensityStaysCappedAtTheFreeAreaLimitEveryStep) {
 }
 
 TEST(CrowdSimulation, InflowAgentsJoinTheStreamInTheirRegion) {
-  // A stream of 150 agents walks east through the inflow's region; the agents it admits from
-  // t = 1 s start with the mean velocity of the agents in the region, not at rest.
+  // A stream of 150 agents walks east through the inflow's region against 40 walking west; the
+  // agents the inflow admits from t = 1 s (walking east) start with the mean velocity of the
+  // eastbound agents in the region, not at rest and not with the counter-flow's.
   const Vec2 hi(30, 10);
   const Goal east = eastExit();
+  Goal west = east;
+  west.regions = {rectangle(Vec2(0, 0), Vec2(2, 10))};
   Inflow in;
-  in.region = rectangle(Vec2(0.5, 0.5), Vec2(8, 9.5));
+  in.region = rectangle(Vec2(3, 0.5), Vec2(10, 9.5));
   in.rate = 4.0;
   in.start = 1.0;
   in.stop = 3.0;
   in.agent.goal = 0;
   in.agent.radius = kRadius;
-  auto planner = std::make_shared<DirectPlanner>(std::vector<Goal>{east});
-  CrowdSimulation sim(settings(hi, 30), {}, {east}, planner, randomAgents(150, Vec2(0.5, 0.5), Vec2(8, 9.5), 0, AgentModel::Uic, 5),
-                      {in});
-  std::size_t checked = 0;
+  Agents crowd = randomAgents(150, Vec2(3, 0.5), Vec2(10, 9.5), 0, AgentModel::Uic, 5);
+  const Agents counterFlow = randomAgents(40, Vec2(8, 0.5), Vec2(14, 9.5), 1, AgentModel::Uic, 6);
+  for (std::size_t i = 0; i < counterFlow.size(); ++i) crowd.add(counterFlow.spec(i));
+  auto planner = std::make_shared<DirectPlanner>(std::vector<Goal>{east, west});
+  CrowdSimulation sim(settings(hi, 30), {}, {east, west}, planner, crowd, {in});
+  std::size_t checked = 0, againstSeen = 0;
   for (int step = 0; step < 60; ++step) {
     sim.step(0.05);
     const std::size_t spawned = sim.lastStep().spawned;
@@ -134,11 +139,15 @@ TEST(CrowdSimulation, InflowAgentsJoinTheStreamInTheirRegion) {
     const std::size_t first = a.size() - spawned;  // the new agents are the last ones
     Vec2f sum = Vec2f::Zero();
     std::size_t inRegion = 0;
-    for (std::size_t i = 0; i < first; ++i)
-      if (contains(in.region, a.position[i].cast<double>())) {
-        sum += a.velocity[i];
-        ++inRegion;
+    for (std::size_t i = 0; i < first; ++i) {
+      if (!contains(in.region, a.position[i].cast<double>())) continue;
+      if (a.goal[i] != 0) {
+        againstSeen += a.velocity[i].x() < 0.0f;
+        continue;
       }
+      sum += a.velocity[i];
+      ++inRegion;
+    }
     ASSERT_GT(inRegion, 0u);
     const Vec2f stream = sum / float(inRegion);
     ASSERT_GT(stream.x(), 0.3f) << "t = " << sim.time();  // the stream walks east
@@ -149,6 +158,7 @@ TEST(CrowdSimulation, InflowAgentsJoinTheStreamInTheirRegion) {
     }
   }
   EXPECT_EQ(checked, 8u);
+  EXPECT_GT(againstSeen, 0u);  // the counter-flow walked through the region meanwhile
 }
 
 TEST(CrowdSimulation, InflowsSpawnAtTheirRateAndExitsRemoveAgents) {

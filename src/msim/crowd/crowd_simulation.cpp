@@ -505,15 +505,17 @@ CrowdSimulation::FreeWalkers CrowdSimulation::freeWalkers() {
 }
 
 // A person entering through an inflow joins the stream already there: the new agent starts with
-// the mean velocity of the agents in the inflow's region (at rest where it is empty). Entering at
-// rest into a moving crowd would be a velocity jump that the stress model (Golas ch. 4, eq. 4.3)
+// the mean velocity of the agents in the inflow's region that walk to its goal (at rest where there
+// are none; people in the region walking elsewhere, a counter-flow, are not its stream). Entering
+// at rest into a moving crowd would be a velocity jump that the stress model (Golas ch. 4, eq. 4.3)
 // relaxes over tau, showing as temporal pressure at the inlets that the crowd itself does not make.
-Vec2f CrowdSimulation::streamVelocity(const Polygon& region) const {
+Vec2f CrowdSimulation::streamVelocity(const Polygon& region, std::uint32_t goal) const {
   Vec2 lo, hi;
   bounds(region, lo, hi);
   Vec2f sum = Vec2f::Zero();
   std::size_t count = 0;
   for (std::size_t i = 0; i < agents_.size(); ++i) {
+    if (agents_.goal[i] != goal) continue;
     const Vec2 x = agents_.position[i].cast<double>();
     if ((x.array() < lo.array()).any() || (x.array() > hi.array()).any() || !contains(region, x)) continue;
     sum += agents_.velocity[i];
@@ -558,7 +560,7 @@ void CrowdSimulation::arriveAndSpawn(double dt) {
     const double open = std::max(0.0, std::min(time_, f.stop) - std::max(time_ - dt, f.start));
     inflowCredit_[k] += f.rate * open;
     if (inflowCredit_[k] < 1.0 - 1e-6) continue;
-    const Vec2f joining = streamVelocity(f.region);
+    const Vec2f joining = streamVelocity(f.region, f.agent.goal);
     // The tolerance keeps round-off (rate x dt summed over many steps, or a credit saved as float
     // for --resume) from delaying an agent by a step.
     while (inflowCredit_[k] >= 1.0 - 1e-6) {

@@ -178,7 +178,7 @@ class CrowdSimulation {
   void moveUic(double dt);
   void moveStressed(double dt);
   void arriveAndSpawn(double dt);
-  Vec2f streamVelocity(const Polygon& region) const;
+  Vec2f streamVelocity(const Polygon& region, std::uint32_t goal) const;
   // Static and moving obstacles at time t, indexed for the local passes (only rebuilt when some move).
   void placeMovingObstacles(double t);
   const StaticObstacles& obstacleIndex() const { return moving_.empty() ? staticObstacles_ : allObstacles_; }
