@@ -219,7 +219,7 @@ Schema groupSchema() {
 
 Schema inflowSchema() {
   Schema f = Schema::object("agents entering at a steady rate");
-  f.field("region", regionSchema("where they appear", false).required());
+  f.field("region", regionSchema("where they appear, with the mean velocity of the agents there bound for the same goal", false).required());
   f.number("rate", "1/s", "agents per second (0 with 'recycle')").min(0.0).required();
   f.boolean("recycle", false,
             "re-admits agents that leave through exits besides its rate: the crowd keeps its count "
