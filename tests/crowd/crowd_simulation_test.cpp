@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "msim/core/error.hpp"
 #include "msim/core/rng.hpp"
@@ -159,6 +160,50 @@ TEST(CrowdSimulation, InflowAgentsJoinTheStreamInTheirRegion) {
   }
   EXPECT_EQ(checked, 8u);
   EXPECT_GT(againstSeen, 0u);  // the counter-flow walked through the region meanwhile
+}
+
+TEST(CrowdSimulation, InflowAgentsStepIntoGapsOfTheCrowd) {
+  // An inflow admits 20 agents into a region a crowd of 150 walks through (2.4 /m^2): each takes
+  // the roomiest of a few random spots, so its nearest neighbour is farther than a random spot's.
+  const Vec2 hi(30, 10);
+  const Goal east = eastExit();
+  Inflow in;
+  in.region = rectangle(Vec2(3, 0.5), Vec2(10, 9.5));
+  in.rate = 10.0;
+  in.start = 1.0;
+  in.stop = 3.0;
+  in.agent.goal = 0;
+  in.agent.radius = kRadius;
+  auto planner = std::make_shared<DirectPlanner>(std::vector<Goal>{east});
+  CrowdSimulation sim(settings(hi, 30), {}, {east}, planner, randomAgents(150, Vec2(3, 0.5), Vec2(10, 9.5), 0, AgentModel::Uic, 7),
+                      {in});
+  // The distance from x to the nearest of the agents [0, count).
+  const auto nearest = [](const Agents& a, std::size_t count, const Vec2f& x) {
+    float d2 = std::numeric_limits<float>::infinity();
+    for (std::size_t i = 0; i < count; ++i) d2 = std::min(d2, (a.position[i] - x).squaredNorm());
+    return std::sqrt(d2);
+  };
+  Rng probe(11);
+  double spawnedRoom = 0.0, randomRoom = 0.0;
+  std::size_t spawned = 0, probes = 0;
+  for (int step = 0; step < 60; ++step) {
+    sim.step(0.05);
+    const std::size_t n = sim.lastStep().spawned;
+    if (n == 0) continue;
+    const Agents& a = sim.agents();
+    const std::size_t before = a.size() - n;  // the crowd the new agents stepped into
+    for (std::size_t i = before; i < a.size(); ++i) {
+      spawnedRoom += nearest(a, before, a.position[i]);
+      ++spawned;
+    }
+    for (int k = 0; k < 50; ++k, ++probes)
+      randomRoom += nearest(a, before, Vec2f(float(probe.uniform(3.0, 10.0)), float(probe.uniform(0.5, 9.5))));
+  }
+  ASSERT_EQ(spawned, 20u);
+  spawnedRoom /= double(spawned);
+  randomRoom /= double(probes);
+  std::printf("nearest neighbour of a new agent %.3f m, of a random spot %.3f m\n", spawnedRoom, randomRoom);
+  EXPECT_GT(spawnedRoom, 1.5 * randomRoom);
 }
 
 TEST(CrowdSimulation, InflowsSpawnAtTheirRateAndExitsRemoveAgents) {
