@@ -44,6 +44,28 @@ Goal eastExit() {
   return east;
 }
 
+// An inflow of agents bound for goal 0 into `region` at `rate` agents/s from `start` to `stop`.
+Inflow inflowInto(const Polygon& region, double rate, double start, double stop) {
+  Inflow in;
+  in.region = region;
+  in.rate = rate;
+  in.start = start;
+  in.stop = stop;
+  in.agent.goal = 0;
+  in.agent.radius = kRadius;
+  return in;
+}
+
+// Steps `sim` `steps` times by dt; after each step that admitted agents, visit(agents, first new).
+template <typename Visit>
+void forEachSpawningStep(CrowdSimulation& sim, int steps, double dt, Visit&& visit) {
+  for (int step = 0; step < steps; ++step) {
+    sim.step(dt);
+    const std::size_t spawned = sim.lastStep().spawned;
+    if (spawned > 0) visit(sim.agents(), sim.agents().size() - spawned);  // the new agents are the last ones
+  }
+}
+
 // Agents uniformly at random in [lo, hi] (relaxed apart by the simulation's constructor).
 Agents randomAgents(std::size_t n, const Vec2& lo, const Vec2& hi, std::uint32_t goal, AgentModel model,
                     std::uint64_t seed) {
@@ -119,25 +141,14 @@ TEST(CrowdSimulation, InflowAgentsJoinTheStreamInTheirRegion) {
   const Goal east = eastExit();
   Goal west = east;
   west.regions = {rectangle(Vec2(0, 0), Vec2(2, 10))};
-  Inflow in;
-  in.region = rectangle(Vec2(3, 0.5), Vec2(10, 9.5));
-  in.rate = 4.0;
-  in.start = 1.0;
-  in.stop = 3.0;
-  in.agent.goal = 0;
-  in.agent.radius = kRadius;
+  const Inflow in = inflowInto(rectangle(Vec2(3, 0.5), Vec2(10, 9.5)), 4.0, 1.0, 3.0);
   Agents crowd = randomAgents(150, Vec2(3, 0.5), Vec2(10, 9.5), 0, AgentModel::Uic, 5);
   const Agents counterFlow = randomAgents(40, Vec2(8, 0.5), Vec2(14, 9.5), 1, AgentModel::Uic, 6);
   for (std::size_t i = 0; i < counterFlow.size(); ++i) crowd.add(counterFlow.spec(i));
   auto planner = std::make_shared<DirectPlanner>(std::vector<Goal>{east, west});
   CrowdSimulation sim(settings(hi, 30), {}, {east, west}, planner, crowd, {in});
   std::size_t checked = 0, againstSeen = 0;
-  for (int step = 0; step < 60; ++step) {
-    sim.step(0.05);
-    const std::size_t spawned = sim.lastStep().spawned;
-    if (spawned == 0) continue;
-    const Agents& a = sim.agents();
-    const std::size_t first = a.size() - spawned;  // the new agents are the last ones
+  forEachSpawningStep(sim, 60, 0.05, [&](const Agents& a, std::size_t first) {
     Vec2f sum = Vec2f::Zero();
     std::size_t inRegion = 0;
     for (std::size_t i = 0; i < first; ++i) {
@@ -157,7 +168,7 @@ TEST(CrowdSimulation, InflowAgentsJoinTheStreamInTheirRegion) {
       EXPECT_NEAR(a.velocity[i].y(), stream.y(), 1e-5f);
       ++checked;
     }
-  }
+  });
   EXPECT_EQ(checked, 8u);
   EXPECT_GT(againstSeen, 0u);  // the counter-flow walked through the region meanwhile
 }
@@ -167,13 +178,7 @@ TEST(CrowdSimulation, InflowAgentsStepIntoGapsOfTheCrowd) {
   // the roomiest of a few random spots, so its nearest neighbour is farther than a random spot's.
   const Vec2 hi(30, 10);
   const Goal east = eastExit();
-  Inflow in;
-  in.region = rectangle(Vec2(3, 0.5), Vec2(10, 9.5));
-  in.rate = 10.0;
-  in.start = 1.0;
-  in.stop = 3.0;
-  in.agent.goal = 0;
-  in.agent.radius = kRadius;
+  const Inflow in = inflowInto(rectangle(Vec2(3, 0.5), Vec2(10, 9.5)), 10.0, 1.0, 3.0);
   auto planner = std::make_shared<DirectPlanner>(std::vector<Goal>{east});
   CrowdSimulation sim(settings(hi, 30), {}, {east}, planner, randomAgents(150, Vec2(3, 0.5), Vec2(10, 9.5), 0, AgentModel::Uic, 7),
                       {in});
@@ -186,19 +191,14 @@ TEST(CrowdSimulation, InflowAgentsStepIntoGapsOfTheCrowd) {
   Rng probe(11);
   double spawnedRoom = 0.0, randomRoom = 0.0;
   std::size_t spawned = 0, probes = 0;
-  for (int step = 0; step < 60; ++step) {
-    sim.step(0.05);
-    const std::size_t n = sim.lastStep().spawned;
-    if (n == 0) continue;
-    const Agents& a = sim.agents();
-    const std::size_t before = a.size() - n;  // the crowd the new agents stepped into
+  forEachSpawningStep(sim, 60, 0.05, [&](const Agents& a, std::size_t before) {  // before: the crowd they stepped into
     for (std::size_t i = before; i < a.size(); ++i) {
       spawnedRoom += nearest(a, before, a.position[i]);
       ++spawned;
     }
     for (int k = 0; k < 50; ++k, ++probes)
       randomRoom += nearest(a, before, Vec2f(float(probe.uniform(3.0, 10.0)), float(probe.uniform(0.5, 9.5))));
-  }
+  });
   ASSERT_EQ(spawned, 20u);
   spawnedRoom /= double(spawned);
   randomRoom /= double(probes);
@@ -209,13 +209,7 @@ TEST(CrowdSimulation, InflowAgentsStepIntoGapsOfTheCrowd) {
 TEST(CrowdSimulation, InflowsSpawnAtTheirRateAndExitsRemoveAgents) {
   const Vec2 hi(30, 10);
   const Goal east = eastExit();
-  Inflow in;
-  in.region = rectangle(Vec2(0.5, 0.5), Vec2(2, 9.5));
-  in.rate = 7.0;
-  in.start = 1.0;
-  in.stop = 11.0;
-  in.agent.goal = 0;
-  in.agent.radius = kRadius;
+  const Inflow in = inflowInto(rectangle(Vec2(0.5, 0.5), Vec2(2, 9.5)), 7.0, 1.0, 11.0);
   auto planner = std::make_shared<DirectPlanner>(std::vector<Goal>{east});
   CrowdSimulation sim(settings(hi, 30), {}, {east}, planner, Agents{}, {in});
   std::size_t spawned = 0;
