@@ -173,39 +173,6 @@ TEST(CrowdSimulation, InflowAgentsJoinTheStreamInTheirRegion) {
   EXPECT_GT(againstSeen, 0u);  // the counter-flow walked through the region meanwhile
 }
 
-TEST(CrowdSimulation, InflowAgentsStepIntoGapsOfTheCrowd) {
-  // An inflow admits 20 agents into a region a crowd of 150 walks through (2.4 /m^2): each takes
-  // the roomiest of a few random spots, so its nearest neighbour is farther than a random spot's.
-  const Vec2 hi(30, 10);
-  const Goal east = eastExit();
-  const Inflow in = inflowInto(rectangle(Vec2(3, 0.5), Vec2(10, 9.5)), 10.0, 1.0, 3.0);
-  auto planner = std::make_shared<DirectPlanner>(std::vector<Goal>{east});
-  CrowdSimulation sim(settings(hi, 30), {}, {east}, planner, randomAgents(150, Vec2(3, 0.5), Vec2(10, 9.5), 0, AgentModel::Uic, 7),
-                      {in});
-  // The distance from x to the nearest of the agents [0, count).
-  const auto nearest = [](const Agents& a, std::size_t count, const Vec2f& x) {
-    float d2 = std::numeric_limits<float>::infinity();
-    for (std::size_t i = 0; i < count; ++i) d2 = std::min(d2, (a.position[i] - x).squaredNorm());
-    return std::sqrt(d2);
-  };
-  Rng probe(11);
-  double spawnedRoom = 0.0, randomRoom = 0.0;
-  std::size_t spawned = 0, probes = 0;
-  forEachSpawningStep(sim, 60, 0.05, [&](const Agents& a, std::size_t before) {  // before: the crowd they stepped into
-    for (std::size_t i = before; i < a.size(); ++i) {
-      spawnedRoom += nearest(a, before, a.position[i]);
-      ++spawned;
-    }
-    for (int k = 0; k < 50; ++k, ++probes)
-      randomRoom += nearest(a, before, Vec2f(float(probe.uniform(3.0, 10.0)), float(probe.uniform(0.5, 9.5))));
-  });
-  ASSERT_EQ(spawned, 20u);
-  spawnedRoom /= double(spawned);
-  randomRoom /= double(probes);
-  std::printf("nearest neighbour of a new agent %.3f m, of a random spot %.3f m\n", spawnedRoom, randomRoom);
-  EXPECT_GT(spawnedRoom, 1.5 * randomRoom);
-}
-
 TEST(CrowdSimulation, InflowsSpawnAtTheirRateAndExitsRemoveAgents) {
   const Vec2 hi(30, 10);
   const Goal east = eastExit();

@@ -504,51 +504,24 @@ CrowdSimulation::FreeWalkers CrowdSimulation::freeWalkers() {
   return out;
 }
 
-// A person entering through an inflow steps into the crowd already there: into a gap, the
-// roomiest of kEntryCandidates random spots in the region (farthest from the agents near it; a
-// spot drawn at random would often land on someone, and collision resolution's push apart is a
-// jolt the stress model of Golas ch. 4 feels as temporal pressure at the inlets), and walking with
-// its stream, the mean velocity of the agents in the region bound for its goal (at rest where there
-// are none; a counter-flow through the region is not its stream; entering at rest into a moving
-// crowd would be a velocity jump relaxed over tau, eq. 4.3). The agents within kEntryReach of the
-// region's bounds are gathered once per step that admits someone.
-namespace {
-constexpr int kEntryCandidates = 8;
-constexpr float kEntryReach = 2.0f;  // [m]; a spot's room counts up to this
-}  // namespace
-
-Vec2f CrowdSimulation::gatherEntry(const Inflow& inflow) {
+// A person entering through an inflow joins the stream already there: the new agent starts with
+// the mean velocity of the agents in the inflow's region that walk to its goal (at rest where there
+// are none; people in the region walking elsewhere, a counter-flow, are not its stream). Entering
+// at rest into a moving crowd would be a velocity jump that the stress model (Golas ch. 4, eq. 4.3)
+// relaxes over tau, showing as temporal pressure at the inlets that the crowd itself does not make.
+Vec2f CrowdSimulation::streamVelocity(const Polygon& region, std::uint32_t goal) const {
   Vec2 lo, hi;
-  bounds(inflow.region, lo, hi);
-  const Vec2f nearLo = lo.cast<float>() - Vec2f::Constant(kEntryReach), nearHi = hi.cast<float>() + Vec2f::Constant(kEntryReach);
-  entryNeighbours_.clear();
+  bounds(region, lo, hi);
   Vec2f sum = Vec2f::Zero();
   std::size_t count = 0;
   for (std::size_t i = 0; i < agents_.size(); ++i) {
-    const Vec2f& x = agents_.position[i];
-    if ((x.array() < nearLo.array()).any() || (x.array() > nearHi.array()).any()) continue;
-    entryNeighbours_.push_back(x);
-    if (agents_.goal[i] != inflow.agent.goal || !contains(inflow.region, x.cast<double>())) continue;
+    if (agents_.goal[i] != goal) continue;
+    const Vec2 x = agents_.position[i].cast<double>();
+    if ((x.array() < lo.array()).any() || (x.array() > hi.array()).any() || !contains(region, x)) continue;
     sum += agents_.velocity[i];
     ++count;
   }
   return count > 0 ? Vec2f(sum / static_cast<float>(count)) : Vec2f::Zero();
-}
-
-Vec2 CrowdSimulation::entrySpot(Rng& rng, const Inflow& inflow) const {
-  Vec2 best = Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
-  float bestRoom = -1.0f;
-  for (int c = 0; c < kEntryCandidates; ++c) {
-    const Vec2 x = randomFreePoint(rng, inflow.region, inflow.agent.radius, obstacleIndex());
-    if (!x.allFinite()) break;  // the region lies inside obstacles: the first draw tells
-    float room2 = kEntryReach * kEntryReach;
-    for (const Vec2f& q : entryNeighbours_) room2 = std::min(room2, (q - x.cast<float>()).squaredNorm());
-    if (room2 > bestRoom) {
-      bestRoom = room2;
-      best = x;
-    }
-  }
-  return best;
 }
 
 void CrowdSimulation::arriveAndSpawn(double dt) {
@@ -587,19 +560,17 @@ void CrowdSimulation::arriveAndSpawn(double dt) {
     const double open = std::max(0.0, std::min(time_, f.stop) - std::max(time_ - dt, f.start));
     inflowCredit_[k] += f.rate * open;
     if (inflowCredit_[k] < 1.0 - 1e-6) continue;
-    const Vec2f joining = gatherEntry(f);
+    const Vec2f joining = streamVelocity(f.region, f.agent.goal);
     // The tolerance keeps round-off (rate x dt summed over many steps, or a credit saved as float
     // for --resume) from delaying an agent by a step.
     while (inflowCredit_[k] >= 1.0 - 1e-6) {
       inflowCredit_[k] -= 1.0;
-      // Its candidate spots are uniform in the region, by rejection from its bounds (regions are
-      // checked to have area); their random stream depends only on the seed and the new agent's
-      // id, so a resumed run (the same agents where they were) spawns the same.
+      // Uniform in the region by rejection from its bounds (regions are checked to have area). The
+      // stream depends only on the seed and the new agent's id, so a resumed run spawns the same.
       Rng rng = rng_.split(agents_.nextId);
-      const Vec2 x = entrySpot(rng, f);
+      const Vec2 x = randomFreePoint(rng, f.region, f.agent.radius, obstacleIndex());
       if (!x.allFinite())
         throw SimulationError(fmt::format("inflows[{}]: no free room for a new agent in the region", k));
-      entryNeighbours_.push_back(x.cast<float>());  // the next one this step keeps clear of it
       AgentSpec spec = f.agent;
       spec.position = x.cast<float>();
       if (f.speeds.kind != SpeedDistribution::Kind::Fixed) spec.maxSpeed = static_cast<float>(f.speeds.sample(rng));

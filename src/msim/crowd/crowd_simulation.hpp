@@ -178,9 +178,7 @@ class CrowdSimulation {
   void moveUic(double dt);
   void moveStressed(double dt);
   void arriveAndSpawn(double dt);
-  // Where and how an inflow's agents enter (arriveAndSpawn).
-  Vec2f gatherEntry(const Inflow& inflow);
-  Vec2 entrySpot(Rng& rng, const Inflow& inflow) const;
+  Vec2f streamVelocity(const Polygon& region, std::uint32_t goal) const;
   // Static and moving obstacles at time t, indexed for the local passes (only rebuilt when some move).
   void placeMovingObstacles(double t);
   const StaticObstacles& obstacleIndex() const { return moving_.empty() ? staticObstacles_ : allObstacles_; }
@@ -203,7 +201,6 @@ class CrowdSimulation {
   std::vector<Inflow> inflows_;
   std::vector<double> inflowCredit_;
   std::vector<std::size_t> recycling_;  // scratch: the recycling inflows open now
-  std::vector<Vec2f> entryNeighbours_;   // scratch: the agents near an inflow's region
   std::vector<Script> scripts_;
   std::vector<std::size_t> scriptProgress_;  // next waypoint per script
   double time_ = 0.0;
