@@ -559,11 +559,12 @@ void CrowdSimulation::arriveAndSpawn(double dt) {
     const Inflow& f = inflows_[k];
     const double open = std::max(0.0, std::min(time_, f.stop) - std::max(time_ - dt, f.start));
     inflowCredit_[k] += f.rate * open;
-    if (inflowCredit_[k] < 1.0 - 1e-6) continue;
-    const Vec2f joining = streamVelocity(f.region, f.agent.goal);
-    // The tolerance keeps round-off (rate x dt summed over many steps, or a credit saved as float
-    // for --resume) from delaying an agent by a step.
-    while (inflowCredit_[k] >= 1.0 - 1e-6) {
+    // An agent is due at a whole credit; the tolerance keeps round-off (rate x dt summed over many
+    // steps, or a credit saved as float for --resume) from delaying it by a step.
+    const auto due = [&] { return inflowCredit_[k] >= 1.0 - 1e-6; };
+    if (!due()) continue;
+    const Vec2f joining = streamVelocity(f.region, f.agent.goal);  // once for this step's agents
+    while (due()) {
       inflowCredit_[k] -= 1.0;
       // Uniform in the region by rejection from its bounds (regions are checked to have area). The
       // stream depends only on the seed and the new agent's id, so a resumed run spawns the same.

@@ -407,9 +407,8 @@ struct CrowdSceneBuilder {
     // The stress model's discomfort is stiff: its waves run at sqrt(g'(rho)), 10 m/s at 5 /m^2 and
     // 190 m/s just below the yield density, and its acceleration, clamped at a_max (eq. 4.7),
     // overshoots and turns from one step to the next, shaking agents by about a_max dt. The crowd
-    // pressure and speeds depend on the step: the Hajj merge at 5.8 /m^2 (1 m cells, no lookahead)
-    // has a scene-mean temporal pressure of 0.39 /s^2 with 0.05 s steps, 0.097 with 0.01 s and 0.081
-    // with 0.005 s. 0.01 s is the step of Golas' Table 3.1 (docs/crowd_turbulence.md).
+    // pressure and speeds depend on the step until it is short (docs/crowd_turbulence.md measures
+    // the Hajj merge at 0.05, 0.01 and 0.005 s). 0.01 s is the step of Golas' Table 3.1.
     if (tu.at("enabled").get<bool>()) out.maxStep = std::min(out.maxStep, tu.at("max_step").get<double>());
     out.gridCfl = c.at("grid_cfl").get<double>();
     out.colourBy = c.at("colour_by").get<std::string>();
