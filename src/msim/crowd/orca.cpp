@@ -1,6 +1,7 @@
 #include "msim/crowd/orca.hpp"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <limits>
@@ -174,10 +175,9 @@ void OrcaSolver::computeVelocities(const Agents& agents, const StaticObstacles& 
     Scratch& s = scratch_.local();
     grid_.forEachCellInRows(
         rows.begin(), rows.end(), [&](std::uint32_t first, std::uint32_t last, const NeighbourGrid::Stencil& st) {
-          for (std::uint32_t k = first; k < last; ++k) {
-            if (slot[k].share != 0.5f) continue;  // not an ORCA agent
+          // Agent k's velocity, with `far` its lookahead constraints (null: none).
+          const auto solve = [&](std::uint32_t k, const std::vector<HalfPlane>* far) {
             const std::size_t i = order[k];
-            if (!skip.empty() && skip[i]) continue;
             const Vec2f xi = pos[k], vi = slot[k].velocity;
             const float ri = slot[k].radius, maxSpeed = agents.maxSpeed[i];
             s.planes.clear();
@@ -255,11 +255,34 @@ void OrcaSolver::computeVelocities(const Agents& agents, const StaticObstacles& 
               s.planes.push_back(orcaHalfPlane(pos[nb.slot] - xi, vi - slot[nb.slot].velocity, ri + slot[nb.slot].radius,
                                                invTau, invDt, vi, slot[nb.slot].share, i < nb.id ? -1.0f : 1.0f));
             }
-            if (lookahead != nullptr && lookahead->depth[i] > 0)
-              lookahead::appendLookaheadPlanes(*lookahead, static_cast<std::uint32_t>(i), xi, vi, ri, invTau, s.planes);
-
+            if (far != nullptr) s.planes.insert(s.planes.end(), far->begin(), far->end());
             out[i] = solveOrcaProgram(s.planes, hard, agents.preferredVelocity[i], maxSpeed, s.projected);
+          };
+          // Agents that look ahead go in batches of the cell's neighbours, which share one
+          // traversal of the lookahead's tree (discrete_lookahead.hpp).
+          std::array<lookahead::LookaheadAgent, lookahead::kLookaheadBatch> batch;
+          std::array<std::uint32_t, lookahead::kLookaheadBatch> batchSlot;
+          std::size_t batched = 0;
+          s.far.resize(lookahead::kLookaheadBatch);
+          const auto flush = [&] {
+            for (std::size_t a = 0; a < batched; ++a) s.far[a].clear();
+            lookahead::appendLookaheadPlanes(*lookahead, std::span(batch.data(), batched), invTau, s.far);
+            for (std::size_t a = 0; a < batched; ++a) solve(batchSlot[a], &s.far[a]);
+            batched = 0;
+          };
+          for (std::uint32_t k = first; k < last; ++k) {
+            if (slot[k].share != 0.5f) continue;  // not an ORCA agent
+            const std::size_t i = order[k];
+            if (!skip.empty() && skip[i]) continue;
+            if (lookahead == nullptr || lookahead->depth[i] == 0) {
+              solve(k, nullptr);
+              continue;
+            }
+            batch[batched] = {static_cast<std::uint32_t>(i), pos[k], slot[k].velocity, slot[k].radius};
+            batchSlot[batched++] = k;
+            if (batched == batch.size()) flush();
           }
+          if (batched > 0) flush();
         });
   });
 }

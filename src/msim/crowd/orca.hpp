@@ -72,6 +72,7 @@ class OrcaSolver {
     std::vector<float> distances;    // squared distances to one row of stencil candidates
     std::vector<HalfPlane> planes;
     std::vector<HalfPlane> projected;
+    std::vector<std::vector<HalfPlane>> far;  // a lookahead batch's far constraints, per agent
   };
   NeighbourGrid grid_;
   // Per-agent data gathered in the grid's cell order once per call, so neighbour reads are

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "msim/crowd/lookahead/agent_lookahead.hpp"
+#include "msim/crowd/lookahead/discrete_lookahead.hpp"
 #include "msim/crowd/orca.hpp"
 
 namespace {
@@ -143,4 +144,66 @@ TEST(DiscreteLookahead, AgentsWalkingAtEachOtherTurnAsideFromFurtherAway) {
     testing::Test::RecordProperty(name + "_turn_distance_m", std::to_string(early));
     EXPECT_GT(early, 1.5f * plain) << name << ": plain " << plain << " m";
   }
+}
+
+// One traversal serving a batch of agents gives each the constraints, in the order, that a
+// traversal of its own gives it: agents of a crowd with crossing streams (so clusters open), each
+// at its own depth (0: none), in batches of neighbours and of agents far apart.
+TEST(DiscreteLookahead, ABatchTraversalGivesEachAgentItsOwnConstraints) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> at(0.0f, 30.0f), heading(0.0f, 6.2831853f);
+  std::vector<Vec2f> starts;
+  for (int i = 0; i < 600; ++i) starts.emplace_back(at(rng), at(rng));
+  Agents a = orcaAgents(starts, 0.25f);
+  std::vector<std::uint8_t> depth(a.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const float h = heading(rng);
+    a.velocity[i] = Vec2f(std::cos(h), std::sin(h)) * (i % 2 == 0 ? 1.3f : 0.4f);  // two speeds: not all alike
+    depth[i] = static_cast<std::uint8_t>(i % 9);
+  }
+  lookahead::DiscreteLookahead la;
+  la.schedule = lookahead::HorizonSchedule{0.05, 8, 2.0, 3.0, 1.4};
+  la.tabulate();
+  la.tree.build(a.position, a.velocity, a.radius);
+  la.positions = a.position;
+  la.velocities = a.velocity;
+  la.radii = a.radius;
+  la.depth = depth;
+  const float invTau = 0.5f;
+  const auto alone = [&](std::uint32_t i) {
+    std::vector<HalfPlane> planes;
+    const lookahead::LookaheadAgent agent{i, a.position[i], a.velocity[i], a.radius[i]};
+    lookahead::appendLookaheadPlanes(la, std::span(&agent, 1), invTau, std::span(&planes, 1));
+    return planes;
+  };
+  // Neighbours: the tree's order keeps agents near each other together; strangers: every 75th.
+  const std::span<const std::uint32_t> treeOrder = la.tree.agents();
+  std::vector<std::vector<std::uint32_t>> batches;
+  for (std::size_t b = 0; b + lookahead::kLookaheadBatch <= treeOrder.size(); b += 40)
+    batches.emplace_back(treeOrder.begin() + static_cast<std::ptrdiff_t>(b),
+                         treeOrder.begin() + static_cast<std::ptrdiff_t>(b + lookahead::kLookaheadBatch));
+  for (std::uint32_t b = 0; b < 5; ++b) {
+    batches.emplace_back();
+    for (std::uint32_t k = 0; k < lookahead::kLookaheadBatch; ++k) batches.back().push_back(b + 75 * k);
+  }
+  std::size_t compared = 0, planesSeen = 0;
+  for (const std::vector<std::uint32_t>& members : batches) {
+    std::vector<lookahead::LookaheadAgent> batch;
+    for (const std::uint32_t i : members) batch.push_back({i, a.position[i], a.velocity[i], a.radius[i]});
+    std::vector<std::vector<HalfPlane>> planes(batch.size());
+    lookahead::appendLookaheadPlanes(la, batch, invTau, planes);
+    for (std::size_t k = 0; k < batch.size(); ++k) {
+      const std::vector<HalfPlane> own = alone(members[k]);
+      ASSERT_EQ(planes[k].size(), own.size()) << "agent " << members[k];
+      if (depth[members[k]] == 0) EXPECT_TRUE(own.empty());
+      for (std::size_t p = 0; p < own.size(); ++p) {
+        EXPECT_EQ(planes[k][p].point, own[p].point) << "agent " << members[k] << ", constraint " << p;
+        EXPECT_EQ(planes[k][p].normal, own[p].normal) << "agent " << members[k] << ", constraint " << p;
+      }
+      ++compared;
+      planesSeen += own.size();
+    }
+  }
+  EXPECT_GT(compared, 100u);
+  EXPECT_GT(planesSeen, 20 * compared);  // far levels that hold agents and clusters
 }

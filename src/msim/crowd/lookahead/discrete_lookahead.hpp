@@ -56,10 +56,23 @@ inline float clusterRadius(const AgentTree::Node& node, float effectiveRadius, f
   return effectiveRadius + node.spread + node.velocitySpread * horizon;
 }
 
-// Appends to `planes` the lookahead constraints of agent `self` at x with velocity v and radius r,
-// for its levels 1..depth[self], ORCA's time horizon 1 / invTau.
-void appendLookaheadPlanes(const DiscreteLookahead& lookahead, std::uint32_t self, const Vec2f& x, const Vec2f& v, float r,
-                           float invTau, std::vector<HalfPlane>& planes);
+// An agent whose far levels a traversal collects: its index, position, velocity and radius.
+struct LookaheadAgent {
+  std::uint32_t self;
+  Vec2f x, v;
+  float r;
+};
+// The most agents one traversal serves.
+inline constexpr std::size_t kLookaheadBatch = 8;
+
+// Appends to planes[a] the lookahead constraints of batch[a] (at most kLookaheadBatch agents) for
+// its levels 1..depth[self], ORCA's time horizon 1 / invTau. One depth-first traversal of the tree
+// serves the batch: each node is loaded once, the agents' distance tests run side by side, and a
+// node is opened for those agents that open it, so every agent gets the constraints, in the order,
+// that a traversal of its own would give it. Nearby agents open mostly the same nodes, so a batch
+// of neighbours costs little more than one of them.
+void appendLookaheadPlanes(const DiscreteLookahead& lookahead, std::span<const LookaheadAgent> batch, float invTau,
+                           std::span<std::vector<HalfPlane>> planes);
 
 // The far levels on their own (the cascade of Fig. 3.4 with levels depth..1 taken in one linear
 // program): the velocity nearest `preferred`, within maxSpeed, that avoids the agents and clusters
