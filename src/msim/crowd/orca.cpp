@@ -102,40 +102,6 @@ void solveLeastPenetration(std::span<const HalfPlane> planes, std::size_t hard, 
 
 }  // namespace
 
-HalfPlane orcaHalfPlane(const Vec2f& p, const Vec2f& v, float r, float invTau, float invOverlap, const Vec2f& vi,
-                        float share, float tie) {
-  const float d2 = p.squaredNorm();
-  Vec2f u, normal;  // u: from v to the closest point of the VO boundary; normal: outward there
-  if (d2 > r * r) {
-    // VO^tau: the cone from the origin tangent to the disc D(p, r), cut off by D(p/tau, r/tau).
-    const Vec2f w = v - p * invTau;
-    const float wp = w.dot(p);
-    if (wp < 0.0f && wp * wp > r * r * w.squaredNorm()) {
-      const float wLen = w.norm();  // closest boundary point on the cut-off arc
-      normal = w / wLen;
-      u = (r * invTau - wLen) * normal;
-    } else {
-      const float leg = std::sqrt(d2 - r * r);  // closest point on a leg of the cone
-      if (det(p, w) > 0.0f) {
-        const Vec2f dir = Vec2f(p.x() * leg - p.y() * r, p.x() * r + p.y() * leg) / d2;
-        normal = Vec2f(-dir.y(), dir.x());
-        u = v.dot(dir) * dir - v;
-      } else {
-        const Vec2f dir = Vec2f(p.x() * leg + p.y() * r, -p.x() * r + p.y() * leg) / d2;
-        normal = Vec2f(dir.y(), -dir.x());
-        u = v.dot(dir) * dir - v;
-      }
-    }
-  } else {
-    // Overlapping: the VO for the horizon 1 / invOverlap, D(p invOverlap, r invOverlap) (sec. 5.1).
-    const Vec2f w = v - p * invOverlap;
-    const float wLen = w.norm();
-    normal = wLen > 1e-7f ? Vec2f(w / wLen) : Vec2f(tie, 0.0f);
-    u = (r * invOverlap - wLen) * normal;
-  }
-  return {vi + share * u, normal};
-}
-
 Vec2f solveOrcaProgram(std::span<const HalfPlane> planes, std::size_t hard, const Vec2f& preferred, float maxSpeed,
                        std::vector<HalfPlane>& scratch) {
   Vec2f v;
