@@ -338,3 +338,46 @@ TEST(CrowdSimulation, RefusesAgentsOutsideTheDomainOrWithUnreachableGoals) {
     EXPECT_NE(std::string(e.what()).find("cannot be reached"), std::string::npos) << e.what();
   }
 }
+
+TEST(CrowdSimulation, AnAgentThatStopsAtItsPointGoalHasArrived) {
+  // Agents far from the origin (4 km: single precision rounds a point there by up to 2.4e-4 m) walk
+  // 2 m each to a goal of their own with a 0.1 m arrival radius, as the circle scene's, and stop
+  // there: every agent that planning stops must be one that Goal::reached counts, else the last
+  // fraction of a millimetre leaves it standing still short of its goal for good.
+  const Vec2 lo(4096, 4096), hi(4516, 4516);
+  CrowdSettings s = settings(hi - lo, 42);
+  s.lo = lo;
+  s.hi = hi;
+  s.grid = GridSpec<2>(lo, 10.0, IVec2(42, 42));
+  Rng rng(3);
+  std::vector<Goal> goals;
+  Agents agents;
+  for (int gx = 0; gx < 66; ++gx)
+    for (int gy = 0; gy < 66; ++gy) {
+      const Vec2 start = lo + Vec2(12.0 + 6.0 * gx + rng.uniform(-0.5, 0.5), 12.0 + 6.0 * gy + rng.uniform(-0.5, 0.5));
+      const double heading = rng.uniform(0.0, 6.283185307179586);
+      Goal g;
+      g.point = start + 2.0 * Vec2(std::cos(heading), std::sin(heading));
+      g.arrivalRadius = 0.1;
+      AgentSpec spec;
+      spec.position = start.cast<float>();
+      spec.radius = kRadius;
+      spec.model = AgentModel::Orca;
+      spec.goal = static_cast<std::uint32_t>(goals.size());
+      goals.push_back(g);
+      agents.add(spec);
+    }
+  auto planner = std::make_shared<DirectPlanner>(goals);
+  CrowdSimulation sim(s, {}, goals, planner, std::move(agents));
+  for (int step = 0; step < 200; ++step) sim.step(0.05);
+  std::size_t standing = 0, short_ = 0;
+  const Agents& a = sim.agents();
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (a.preferredVelocity[i].norm() > 0.0f) continue;
+    ++standing;
+    if (!goals[a.goal[i]].reached(a.position[i].cast<double>())) ++short_;
+  }
+  std::printf("%zu agents: %zu stopped, %zu of them short of their goals\n", a.size(), standing, short_);
+  EXPECT_EQ(standing, a.size());  // 10 s: everyone has arrived and stopped
+  EXPECT_EQ(short_, 0u);
+}

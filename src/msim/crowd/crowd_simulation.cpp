@@ -73,7 +73,7 @@ CrowdSimulation::CrowdSimulation(const CrowdSettings& settings, std::vector<Poly
   goalSummaries_.reserve(goals_.size());
   for (const Goal& g : goals_)
     goalSummaries_.push_back(
-        GoalSummary{g.point.cast<float>(), static_cast<float>(g.arrivalRadius * g.arrivalRadius),
+        GoalSummary{g.point, g.arrivalRadius * g.arrivalRadius,
                     g.kind == Goal::Kind::Point, g.exit});
   if (!planner_ || planner_->goalCount() != goals_.size())
     throw InputError("crowd: the planner does not answer for the scene's goals");
@@ -200,13 +200,12 @@ void CrowdSimulation::plan() {
       agents_.preferredVelocity[i] = (speed * planner_->direction(g, x)).cast<float>();
       return;
     }
-    const Vec2 d = goal.point.cast<double>() - x;
-    const double dist2 = d.squaredNorm();
-    if (!goal.exit && dist2 <= double(goal.arrival2)) {  // Goal::reached
+    if (!goal.exit && withinArrival(x, goal.point, goal.arrival2)) {  // Goal::reached
       agents_.preferredVelocity[i].setZero();
       return;
     }
-    if (!goal.exit) speed = std::min(speed, std::sqrt(dist2));
+    const Vec2 d = goal.point - x;
+    if (!goal.exit) speed = std::min(speed, d.norm());
     // The straight direction formed here from the compact copy, without a call per agent.
     const Vec2 direction = straight ? DirectPlanner::unitTowards(d) : planner_->direction(g, x);
     agents_.preferredVelocity[i] = (speed * direction).cast<float>();

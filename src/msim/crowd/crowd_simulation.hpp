@@ -186,12 +186,13 @@ class CrowdSimulation {
   CrowdSettings settings_;
   std::vector<Polygon> obstacles_;
   std::vector<Goal> goals_;
-  // What plan() reads of each goal, 16 bytes instead of a Goal's 64 (the circle scene has a goal
+  // What plan() reads of each goal, 32 bytes instead of a Goal's 64 (the circle scene has a goal
   // per agent, so planning streams these; 100k Goals would crowd the agents out of the cache): the
-  // point and the squared arrival radius in single precision (as the agents' positions), the kind.
+  // point and the squared arrival radius, in double precision as Goal::reached tests them (an agent
+  // that plan() stops must count as arrived), the kind.
   struct GoalSummary {
-    Vecf<2> point;
-    float arrival2;
+    Vec2 point;
+    double arrival2;
     bool isPoint, exit;
   };
   std::vector<GoalSummary> goalSummaries_;

@@ -10,6 +10,10 @@
 
 namespace msim::crowd {
 
+// Whether x lies within a point goal's arrival radius (given squared): the one test of arrival,
+// shared by the goal and the planning step's compact copy of it.
+inline bool withinArrival(const Vec2& x, const Vec2& point, double radius2) { return (x - point).squaredNorm() <= radius2; }
+
 struct Goal {
   enum class Kind { Point, Region };
   Kind kind = Kind::Point;
@@ -25,7 +29,7 @@ struct Goal {
     return false;
   }
   bool reached(const Vec2& x) const {
-    return kind == Kind::Point ? (x - point).squaredNorm() <= arrivalRadius * arrivalRadius : inside(x);
+    return kind == Kind::Point ? withinArrival(x, point, arrivalRadius * arrivalRadius) : inside(x);
   }
 };
 
