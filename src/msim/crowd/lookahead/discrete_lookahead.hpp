@@ -26,7 +26,7 @@
 namespace msim::crowd::lookahead {
 
 struct DiscreteLookahead {
-  // The schedule and, tabulated from it by tabulate() for the per-agent traversals, each level's
+  // The schedule and, tabulated from it by tabulate() for the traversals, each level's
   // horizon dt_i, squared band start and radius factor 1 / c^i (levels <= kMaxLevels).
   static constexpr int kMaxLevels = 16;
   HorizonSchedule schedule;
@@ -35,7 +35,7 @@ struct DiscreteLookahead {
   // The level whose band holds a distance, given squared (0 within R; HorizonSchedule's
   // levelOfDistance tabulated; the traversal compares squares, without square roots), -1 beyond.
   // Counts the band starts 1..levels + 1 at or below it in whole vectors, without a branch per band
-  // (the traversal asks for every node and member it meets).
+  // (the traversal asks for every leaf member it meets; for nodes it counts a batch side by side).
   int levelOfSquaredDistance(float distance2) const {
     int below = 0;
     for (const float start2 : bandEnds2) below += distance2 >= start2;
