@@ -195,7 +195,9 @@ TEST(DiscreteLookahead, ABatchTraversalGivesEachAgentItsOwnConstraints) {
     for (std::size_t k = 0; k < batch.size(); ++k) {
       const std::vector<HalfPlane> own = alone(members[k]);
       ASSERT_EQ(planes[k].size(), own.size()) << "agent " << members[k];
-      if (depth[members[k]] == 0) EXPECT_TRUE(own.empty());
+      if (depth[members[k]] == 0) {
+        EXPECT_TRUE(own.empty());
+      }
       for (std::size_t p = 0; p < own.size(); ++p) {
         EXPECT_EQ(planes[k][p].point, own[p].point) << "agent " << members[k] << ", constraint " << p;
         EXPECT_EQ(planes[k][p].normal, own[p].normal) << "agent " << members[k] << ", constraint " << p;
