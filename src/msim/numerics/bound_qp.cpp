@@ -191,9 +191,10 @@ BoundQpResult BoundQpSolver::solveBox(const QpOperator& A, const Eigen::VectorXd
   const auto diagonallyPreconditioned = [&](Eigen::Index i) { return F[i] ? (J ? G[i] * J[i] : G[i]) : 0.0; };
   // The step along -d at which entry i reaches the bound d moves it towards (none when d_i = 0).
   constexpr double inf = std::numeric_limits<double>::infinity();
-  const auto reach = [&](Eigen::Index i) {
-    const double di = Dv[i];
-    return di > 0.0 ? (P[i] - L[i]) / di : di < 0.0 ? (P[i] - U[i]) / di : inf;
+  // Both quotients are formed and one selected (no branch, as gradientSums below).
+  const auto reach = [P, L, U, Dv](Eigen::Index i) {
+    const double di = Dv[i], toLower = (P[i] - L[i]) / di, toUpper = (P[i] - U[i]) / di;
+    return di > 0.0 ? toLower : di < 0.0 ? toUpper : inf;
   };
 
   // Warm start projected onto the feasible set.
@@ -234,15 +235,15 @@ BoundQpResult BoundQpSolver::solveBox(const QpOperator& A, const Eigen::VectorXd
   // (max((p_i - u_i) / alphaBar, phi_i) when phi_i < 0), whose product with phi measures how far
   // a fixed-length projected step along phi can go before it is cut by the bounds: entry i's
   // share of ||phi||^2, ||beta||^2 and phi~^T phi.
-  auto gradientSums = [&](Eigen::Index i) {
+  // Both cases are computed and one is selected, without a branch, so that the block loops
+  // vectorise; the selected values are those of the case alone.
+  auto gradientSums = [G, F, P, L, U, invAlphaBar](Eigen::Index i) {
     const double gi = G[i];
-    if (F[i]) {
-      const double reducedGi =
-          gi > 0.0 ? std::min((P[i] - L[i]) * invAlphaBar, gi) : std::max((P[i] - U[i]) * invAlphaBar, gi);
-      return std::array<double, 3>{gi * gi, 0.0, reducedGi * gi};
-    }
-    const double beta = choppedGradient(L[i], U[i], P[i], gi);
-    return std::array<double, 3>{0.0, beta * beta, 0.0};
+    const bool onFace = F[i] != 0;
+    const double reducedGi =
+        gi > 0.0 ? std::min((P[i] - L[i]) * invAlphaBar, gi) : std::max((P[i] - U[i]) * invAlphaBar, gi);
+    const double phi = onFace ? gi : 0.0, beta = onFace ? 0.0 : choppedGradient(L[i], U[i], P[i], gi);
+    return std::array<double, 3>{phi * phi, beta * beta, onFace ? reducedGi * gi : 0.0};
   };
   // The sums of the current iterate, when the last step computed them in one of its own passes.
   std::optional<std::array<double, 3>> nextSums;
@@ -265,7 +266,7 @@ BoundQpResult BoundQpSolver::solveBox(const QpOperator& A, const Eigen::VectorXd
       // Proportional iterate: a CG step on the face, unless it would leave the box.
       A.apply(d_, Ad_);
       ++result.operatorApplications;
-      const auto step = reduceBlocks<3>(n, partial_, {0.0, 0.0, inf}, [&](Eigen::Index i) {
+      const auto step = reduceBlocks<3>(n, partial_, {0.0, 0.0, inf}, [Dv, AD, G, reach](Eigen::Index i) {
         return std::array<double, 3>{Dv[i] * AD[i], G[i] * Dv[i], reach(i)};
       }, [](int k, double a, double v) { return k == 2 ? std::min(a, v) : a + v; });
       const double dAd = step[0];
@@ -297,7 +298,7 @@ BoundQpResult BoundQpSolver::solveBox(const QpOperator& A, const Eigen::VectorXd
           }, kAdd)[0];
         }
         const double conj = zAd / dAd;
-        nextSums = reduceBlocks<3>(n, partial_, {0.0, 0.0, 0.0}, [&](Eigen::Index i) {
+        nextSums = reduceBlocks<3>(n, partial_, {0.0, 0.0, 0.0}, [Dv, Z, conj, gradientSums](Eigen::Index i) {
           Dv[i] = Z[i] - conj * Dv[i];
           return gradientSums(i);
         }, kAdd);
