@@ -235,8 +235,10 @@ BoundQpResult BoundQpSolver::solveBox(const QpOperator& A, const Eigen::VectorXd
   // (max((p_i - u_i) / alphaBar, phi_i) when phi_i < 0), whose product with phi measures how far
   // a fixed-length projected step along phi can go before it is cut by the bounds: entry i's
   // share of ||phi||^2, ||beta||^2 and phi~^T phi.
-  // Both cases are computed and one is selected, without a branch, so that the block loops
-  // vectorise; the selected values are those of the case alone.
+  // Both cases are computed and one is selected, without a branch per entry (free and bound
+  // entries alternate unpredictably); the selected values are those of the case alone. The hot
+  // closures hold the pointers by value, so that the loops keep them in registers (captured by
+  // reference they were loaded again for every entry).
   auto gradientSums = [G, F, P, L, U, invAlphaBar](Eigen::Index i) {
     const double gi = G[i];
     const bool onFace = F[i] != 0;
