@@ -22,12 +22,12 @@ namespace {
 
 constexpr float kRadius = 0.25f;
 
-CrowdSettings settings(const Vec2& hi, int resolutionX) {
+CrowdSettings settings(const Vec2& hi, int resolutionX, const Vec2& lo = Vec2::Zero()) {
   CrowdSettings s;
-  s.lo = Vec2::Zero();
+  s.lo = lo;
   s.hi = hi;
-  const double dx = hi.x() / resolutionX;
-  s.grid = GridSpec<2>(Vec2::Zero(), dx, IVec2(resolutionX, static_cast<int>(std::lround(hi.y() / dx))));
+  const double dx = (hi.x() - lo.x()) / resolutionX;
+  s.grid = GridSpec<2>(lo, dx, IVec2(resolutionX, static_cast<int>(std::lround((hi.y() - lo.y()) / dx))));
   s.uicSettings.rhoMax = 0.64 * 2.0 / (std::sqrt(3.0) * 4 * kRadius * kRadius);  // eq. 4.4, alpha 0.64
   s.collision.separation = 1.2f;
   s.collision.iterations = 12;
@@ -345,10 +345,7 @@ TEST(CrowdSimulation, AnAgentThatStopsAtItsPointGoalHasArrived) {
   // there: every agent that planning stops must be one that Goal::reached counts, else the last
   // fraction of a millimetre leaves it standing still short of its goal for good.
   const Vec2 lo(4096, 4096), hi(4516, 4516);
-  CrowdSettings s = settings(hi - lo, 42);
-  s.lo = lo;
-  s.hi = hi;
-  s.grid = GridSpec<2>(lo, 10.0, IVec2(42, 42));
+  const CrowdSettings s = settings(hi, 42, lo);
   Rng rng(3);
   std::vector<Goal> goals;
   Agents agents;

@@ -16,8 +16,6 @@ namespace msim::crowd {
 
 namespace {
 
-float det(const Vec2f& a, const Vec2f& b) { return a.x() * b.y() - a.y() * b.x(); }
-
 // Parallel lines (in the 1D program) and vanishing bisector normals (in the 3D one).
 constexpr float kEps = 1e-5f;
 

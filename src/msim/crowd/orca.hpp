@@ -51,7 +51,7 @@ inline HalfPlane orcaHalfPlane(const Vec2f& p, const Vec2f& v, float r, float in
       u = (r * invTau - wLen) * normal;
     } else {
       const float leg = std::sqrt(d2 - r * r);  // closest point on a leg of the cone
-      if (p.x() * w.y() - p.y() * w.x() > 0.0f) {
+      if (p.x() * w.y() - p.y() * w.x() > 0.0f) {  // det(p, w) > 0: w left of p, the left leg
         const Vec2f dir = Vec2f(p.x() * leg - p.y() * r, p.x() * r + p.y() * leg) / d2;
         normal = Vec2f(-dir.y(), dir.x());
         u = v.dot(dir) * dir - v;

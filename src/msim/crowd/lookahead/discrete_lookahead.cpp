@@ -69,7 +69,6 @@ void appendLookaheadPlanes(const DiscreteLookahead& l, std::span<const Lookahead
   }
   if (everyone == 0) return;
   const float near2 = l.bandStart2[1];
-  const std::size_t bands = static_cast<std::size_t>(s.levels) + 1;
   // Constraint for agent a against a blocker at position xc moving at vc, of radius rc, seen at `level`.
   const auto avoid = [&](std::size_t a, const Vec2f& xc, const Vec2f& vc, float rc, int level) {
     const LookaheadAgent& g = batch[a];
@@ -86,7 +85,6 @@ void appendLookaheadPlanes(const DiscreteLookahead& l, std::span<const Lookahead
   std::size_t top = 0;
   stack[top++] = {0, everyone};
   std::array<float, kLanes> nearest2, farthest2;
-  std::array<int, kLanes> level;
   while (top > 0) {
     const auto [index, agents] = stack[--top];
     const AgentTree::Node& n = l.tree.node(index);
@@ -105,13 +103,10 @@ void appendLookaheadPlanes(const DiscreteLookahead& l, std::span<const Lookahead
     open &= agents;
     banded &= agents;
     if (banded != 0) {
-      level.fill(0);
-      for (std::size_t b = 0; b < bands; ++b)
-        for (std::size_t a = 0; a < kLanes; ++a) level[a] += nearest2[a] >= l.bandEnds2[b];
       const std::uint32_t clusters = clusterLevels(l, n);
       for (std::uint32_t m = banded; m != 0; m &= m - 1) {
         const std::size_t a = static_cast<std::size_t>(std::countr_zero(m));
-        const int i = level[a];  // 1..depth: nearest2 < reach2
+        const int i = l.levelOfSquaredDistance(nearest2[a]);  // 1..depth: nearest2 < reach2
         if (clusters >> i & 1u) {
           const float horizon = l.horizon[static_cast<std::size_t>(i)];
           avoid(a, n.mean, n.velocity, clusterRadius(n, n.radius * l.shrink[static_cast<std::size_t>(i)], horizon), i);

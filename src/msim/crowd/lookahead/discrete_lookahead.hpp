@@ -35,7 +35,7 @@ struct DiscreteLookahead {
   // The level whose band holds a distance, given squared (0 within R; HorizonSchedule's
   // levelOfDistance tabulated; the traversal compares squares, without square roots), -1 beyond.
   // Counts the band starts 1..levels + 1 at or below it in whole vectors, without a branch per band
-  // (the traversal asks for every leaf member it meets; for nodes it counts a batch side by side).
+  // (the traversal asks for every node and leaf member it meets).
   int levelOfSquaredDistance(float distance2) const {
     int below = 0;
     for (const float start2 : bandEnds2) below += distance2 >= start2;
